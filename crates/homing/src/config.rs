@@ -1,0 +1,189 @@
+//! Homing attributes of one axis (spec §2) and the axis facts homing depends on.
+//!
+//! Plain data, `Copy`, no heap: a validated [`AxisConfig`] is moved into the
+//! engine once and never changes while the cycle runs. Enum spellings follow
+//! `interface.md` so that the TOML layer can map them one to one.
+
+/// Axis configuration (CIP "Axis Configuration").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AxisConfiguration {
+    /// A controlled axis: the drive closes the loop on our command.
+    Servo,
+    /// Only a feedback device: position is read, never commanded.
+    FeedbackOnly,
+    /// No hardware: the command is the position.
+    Virtual,
+}
+
+/// Drive control mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControlMode {
+    Position,
+    Velocity,
+    Torque,
+}
+
+/// Travel mode. A cyclic axis wraps its *axis* position into `[0, unwind)`;
+/// the raw (drive) position never wraps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TravelMode {
+    Linear,
+    Cyclic,
+}
+
+/// Home Mode attribute: 0 Passive, 1 Active.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HomeMode {
+    Passive,
+    Active,
+}
+
+/// Home Direction attribute (0..=3 in CIP order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HomeDirection {
+    UnidirectionalForward,
+    BidirectionalForward,
+    UnidirectionalReverse,
+    BidirectionalReverse,
+}
+
+impl HomeDirection {
+    /// +1.0 for the forward forms, -1.0 for the reverse forms.
+    pub fn sign(self) -> f64 {
+        match self {
+            Self::UnidirectionalForward | Self::BidirectionalForward => 1.0,
+            Self::UnidirectionalReverse | Self::BidirectionalReverse => -1.0,
+        }
+    }
+
+    pub fn is_unidirectional(self) -> bool {
+        matches!(
+            self,
+            Self::UnidirectionalForward | Self::UnidirectionalReverse
+        )
+    }
+}
+
+/// Home Sequence attribute (0..=5 in CIP order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HomeSequence {
+    Immediate,
+    Switch,
+    Marker,
+    SwitchThenMarker,
+    Torque,
+    TorqueThenMarker,
+}
+
+impl HomeSequence {
+    pub fn uses_switch(self) -> bool {
+        matches!(self, Self::Switch | Self::SwitchThenMarker)
+    }
+    pub fn uses_marker(self) -> bool {
+        matches!(
+            self,
+            Self::Marker | Self::SwitchThenMarker | Self::TorqueThenMarker
+        )
+    }
+    pub fn uses_torque(self) -> bool {
+        matches!(self, Self::Torque | Self::TorqueThenMarker)
+    }
+}
+
+/// Everything the engine needs to home one axis.
+///
+/// Units: positions in position units, speeds in units/s, accelerations in
+/// units/s², torques in % of rated, times in seconds. `0.0` means "not set"
+/// where the field says so.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisConfig {
+    // --- axis facts -------------------------------------------------------
+    pub configuration: AxisConfiguration,
+    pub control_mode: ControlMode,
+    pub travel: TravelMode,
+    /// Cyclic only: position units per revolution.
+    pub unwind: f64,
+    /// Conversion constant: feedback counts per position unit.
+    pub counts_per_unit: f64,
+    /// The feedback device has a marker and the drive latches its position.
+    pub marker: bool,
+    /// The drive latches its position on the home switch edge (registration).
+    pub registration: bool,
+    /// Maximum negative / positive travel in axis coordinates, if known.
+    pub travel_limits: Option<(f64, f64)>,
+
+    // --- homing attributes (spec §2) ------------------------------------
+    pub home_mode: HomeMode,
+    pub home_direction: HomeDirection,
+    pub home_sequence: HomeSequence,
+    /// Home Configuration Bits, bit 1.
+    pub home_switch_normally_closed: bool,
+    pub home_position: f64,
+    pub home_offset: f64,
+    pub home_speed: f64,
+    pub home_return_speed: f64,
+    pub home_acceleration: f64,
+    pub home_deceleration: f64,
+    pub home_torque_level: f64,
+    pub home_torque_threshold: f64,
+    pub home_torque_time: f64,
+    /// From the Home operation wrapper: `0.0` = no timeout.
+    pub home_timeout: f64,
+
+    // --- our additions (documented in the README's config table) ---------
+    /// Longest distance one search leg may travel. `0.0` = derive from the
+    /// travel limits (or two revolutions on a cyclic axis); with neither
+    /// known the search is unbounded (and `check` warns).
+    pub search_limit: f64,
+    /// Torque limit the drive runs with normally (both directions, % rated).
+    /// Saved and restored around a torque sequence.
+    pub torque_limit: f64,
+    /// Following-error tolerance the drive runs with normally (units, 0 = off).
+    pub position_error_tolerance: f64,
+    /// Velocity-error tolerance the drive runs with normally (units/s, 0 = off).
+    pub velocity_error_tolerance: f64,
+    /// Time the drive gets to report "enabled" after an active start (s).
+    pub enable_timeout: f64,
+    /// Consecutive cycles without fresh feedback tolerated during homing.
+    pub stale_limit: u32,
+    /// Raw positions beyond ±this (units) are treated as absurd feedback.
+    pub max_position: f64,
+}
+
+impl Default for AxisConfig {
+    /// CIP defaults where CIP has one (Active, bidirectional forward,
+    /// Immediate); zero speeds, which validation rejects for motion sequences.
+    fn default() -> Self {
+        Self {
+            configuration: AxisConfiguration::Servo,
+            control_mode: ControlMode::Position,
+            travel: TravelMode::Linear,
+            unwind: 0.0,
+            counts_per_unit: 1.0,
+            marker: false,
+            registration: false,
+            travel_limits: None,
+            home_mode: HomeMode::Active,
+            home_direction: HomeDirection::BidirectionalForward,
+            home_sequence: HomeSequence::Immediate,
+            home_switch_normally_closed: false,
+            home_position: 0.0,
+            home_offset: 0.0,
+            home_speed: 0.0,
+            home_return_speed: 0.0,
+            home_acceleration: 0.0,
+            home_deceleration: 0.0,
+            home_torque_level: 0.0,
+            home_torque_threshold: 0.0,
+            home_torque_time: 0.0,
+            home_timeout: 0.0,
+            search_limit: 0.0,
+            torque_limit: 100.0,
+            position_error_tolerance: 0.0,
+            velocity_error_tolerance: 0.0,
+            enable_timeout: 1.0,
+            stale_limit: 3,
+            max_position: 1.0e9,
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! What crosses the engine's boundary each cycle: [`Feedback`] and
+//! [`Request`] in, [`Command`] out. Positions are *raw* (the drive's frame,
+//! never redefined and never wrapped) in position units; the engine keeps the
+//! axis-position offset itself.
+
+/// A position latch as the drive reports it (CiA 402 touch probe style).
+///
+/// The engine arms a latch by sending a new non-zero `id`; the drive answers
+/// with the same `id` once armed, and sets `latched` with the exact position of
+/// the first qualifying edge after arming. Matching ids make a latch from an
+/// earlier arming impossible to mistake for a new one, whatever the frame delay.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LatchFeedback {
+    /// Id of the arm request this state belongs to (0 = disarmed).
+    pub id: u8,
+    pub latched: bool,
+    /// Raw position of the latched edge, units.
+    pub position: f64,
+}
+
+/// Drive state bits the engine reacts to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DriveState {
+    /// Power stage on and following the command.
+    pub enabled: bool,
+    /// Drive fault (following error, overload, …): it no longer follows.
+    pub fault: bool,
+}
+
+/// One cycle's feedback for one axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Feedback {
+    /// Raw actual position, units.
+    pub position: f64,
+    /// Actual velocity, units/s.
+    pub velocity: f64,
+    /// Actual torque, % rated, signed (positive pushes forward).
+    pub torque: f64,
+    /// Electrical level of the home switch input (true = contact closed).
+    pub home_switch: bool,
+    /// Hardware overtravel inputs (true = tripped).
+    pub overtravel_positive: bool,
+    pub overtravel_negative: bool,
+    pub marker_latch: LatchFeedback,
+    pub switch_latch: LatchFeedback,
+    pub drive: DriveState,
+}
+
+/// Which electrical edge of the home switch input a registration latch takes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Edge {
+    /// Input goes from open to closed.
+    #[default]
+    Rising,
+    /// Input goes from closed to open.
+    Falling,
+}
+
+/// Arm request for a drive latch.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LatchArm {
+    /// 0 = disarmed; any other value arms, a new value re-arms.
+    pub id: u8,
+    pub edge: Edge,
+}
+
+/// One cycle's command for one axis.
+///
+/// Every field is always finite: the engine never derives a command from
+/// unvalidated feedback.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Command {
+    /// Request the power stage on.
+    pub enable: bool,
+    /// Raw position set-point, units.
+    pub position: f64,
+    /// Velocity set-point / feed-forward, units/s.
+    pub velocity: f64,
+    /// Torque limits in force, % rated (positive direction, negative direction),
+    /// both given as magnitudes.
+    pub torque_limit_positive: f64,
+    pub torque_limit_negative: f64,
+    /// Error tolerances in force (0 = check off).
+    pub position_error_tolerance: f64,
+    pub velocity_error_tolerance: f64,
+    pub marker_arm: LatchArm,
+    pub switch_arm: LatchArm,
+}
+
+/// Control inputs for one cycle, as a PLC program would drive the MAH rung.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Request {
+    /// Rung condition of the Home instruction: a rising edge starts homing.
+    pub home: bool,
+    /// Stop (MAS): aborts homing with ERR 12 / EXERR 1 and stops the axis.
+    pub stop: bool,
+    /// Shutdown (MASD): aborts with ERR 12 / EXERR 12, disables the drive,
+    /// clears HomedStatus. Level: the axis stays shut down while set.
+    pub shutdown: bool,
+}
