@@ -32,7 +32,7 @@
 //! | 41   | 32    | *ours* travel limits empty or reversed |
 //! | 1014 | 0     | homing interrupted externally (the supervisor lost control of the axis, e.g. restarted) |
 //! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
-//! | 1016 | leg   | *ours* search limit: a search leg travelled farther than `search_limit` (EXERR = [`Leg`](crate::Leg) number) |
+//! | 1016 | phase | *ours* search limit: a search leg travelled farther than `search_limit` (EXERR = [`Phase`](crate::Phase) number: 2 seek, 5 return) |
 
 /// Servo message failure.
 pub const ERR_SERVO_MESSAGE: u16 = 12;

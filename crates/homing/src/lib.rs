@@ -1,7 +1,28 @@
-//! Sans-I/O homing engine (see crate docs in later commits).
+//! Sans-I/O CIP Motion homing engine.
+//!
+//! Config + feedback + time in, command + status out: [`Axis::step`] is
+//! called once per controller cycle per axis. No threads, clocks, heap
+//! allocation or I/O happen inside a step, so the engine is deterministic and
+//! is tested cycle by cycle against the plant model in `motion-plant`.
+//!
+//! * [`config`]: the homing attributes (spec §2) and axis facts.
+//! * [`validate`]: every configuration problem at once, with CIP codes.
+//! * [`axis`]: the state machine for every active and passive sequence.
+//! * [`profile`]: jog / stop / trapezoid profiles that never exceed their limits.
+//! * [`codes`]: the ERR / EXERR table.
+//! * [`io`]: the per-cycle feedback, command and request types.
+
+pub mod axis;
 pub mod codes;
 pub mod config;
 pub mod io;
+pub mod position;
+pub mod profile;
+pub mod status;
+pub mod validate;
 
+pub use axis::Axis;
 pub use config::*;
 pub use io::*;
+pub use status::{Phase, Status};
+pub use validate::{advisories, effective_search_limit, validate, ConfigError};

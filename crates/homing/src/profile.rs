@@ -1,0 +1,408 @@
+//! Motion profiles of the homing legs: jog to a speed, stop, and a
+//! point-to-point trapezoid from any starting velocity.
+//!
+//! A profile is planned once, analytically, as at most four constant
+//! acceleration segments followed by either a cruise (jog) or an exact hold
+//! (stop, move). The engine samples it at each cycle's time. Sampling a
+//! continuous profile (instead of integrating velocity cycle by cycle) is what
+//! gives the guarantees the tests check:
+//!
+//! * the speed between two samples is an average of the continuous speed, so
+//!   it never exceeds the configured maximum;
+//! * the second difference of the samples is a weighted average of the
+//!   continuous acceleration, so it stays within `[-deceleration, +acceleration]`
+//!   (in the direction of motion), also across a re-plan because every re-plan
+//!   starts from the exact sampled state;
+//! * a move returns its target bit-exactly once its duration has elapsed: no
+//!   residual creep, no overshoot.
+//!
+//! Acceleration is used while speed magnitude grows, deceleration while it
+//! shrinks, which is how Home Acceleration and Home Deceleration are defined.
+
+const MAX_SEGMENTS: usize = 4;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Segment {
+    /// Time from the profile's start at which the segment begins, s.
+    t0: f64,
+    /// State at the beginning of the segment.
+    p0: f64,
+    v0: f64,
+    /// Constant acceleration over the segment, units/s².
+    a: f64,
+    /// Duration, s.
+    dt: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum End {
+    /// After the segments, stay exactly here.
+    Hold(f64),
+    /// After the segments, keep the final velocity forever (a jog).
+    Cruise,
+}
+
+/// A planned motion. `Copy`, fixed size, no heap.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Profile {
+    start_ns: u64,
+    segs: [Segment; MAX_SEGMENTS],
+    n: usize,
+    /// State at the end of the last segment.
+    p_end: f64,
+    v_end: f64,
+    t_end: f64,
+    end: End,
+}
+
+/// Builds the segment list while tracking the state at its end.
+struct Builder {
+    segs: [Segment; MAX_SEGMENTS],
+    n: usize,
+    t: f64,
+    p: f64,
+    v: f64,
+}
+
+impl Builder {
+    fn new(p: f64, v: f64) -> Self {
+        let zero = Segment {
+            t0: 0.0,
+            p0: p,
+            v0: v,
+            a: 0.0,
+            dt: 0.0,
+        };
+        Self {
+            segs: [zero; MAX_SEGMENTS],
+            n: 0,
+            t: 0.0,
+            p,
+            v,
+        }
+    }
+
+    /// Appends a constant-acceleration segment. Non-positive or non-finite
+    /// durations are dropped: they are rounding leftovers of a zero-length phase.
+    fn push(&mut self, a: f64, dt: f64) {
+        if dt.is_nan() || dt <= 0.0 || !dt.is_finite() || self.n == MAX_SEGMENTS {
+            return;
+        }
+        self.segs[self.n] = Segment {
+            t0: self.t,
+            p0: self.p,
+            v0: self.v,
+            a,
+            dt,
+        };
+        self.n += 1;
+        self.p += self.v * dt + 0.5 * a * dt * dt;
+        self.v += a * dt;
+        self.t += dt;
+    }
+
+    fn finish(self, start_ns: u64, end: End, v_end: f64) -> Profile {
+        let p_end = match end {
+            End::Hold(p) => p,
+            End::Cruise => self.p,
+        };
+        Profile {
+            start_ns,
+            segs: self.segs,
+            n: self.n,
+            p_end,
+            v_end,
+            t_end: self.t,
+            end,
+        }
+    }
+}
+
+impl Profile {
+    /// Stand still at `p`.
+    pub fn hold(now_ns: u64, p: f64) -> Self {
+        Builder::new(p, 0.0).finish(now_ns, End::Hold(p), 0.0)
+    }
+
+    /// Change velocity from `v0` to `v_target` (accelerating at `acc` while the
+    /// speed grows, decelerating at `dec` while it shrinks, through zero if the
+    /// sign changes), then cruise at `v_target` forever.
+    pub fn jog(now_ns: u64, p0: f64, v0: f64, v_target: f64, acc: f64, dec: f64) -> Self {
+        let mut b = Builder::new(p0, v0);
+        if v0 != 0.0 && (v_target == 0.0 || v0.signum() != v_target.signum()) {
+            // Slow down to zero first.
+            b.push(-v0.signum() * dec, v0.abs() / dec);
+            b.v = 0.0;
+            b.push(v_target.signum() * acc, v_target.abs() / acc);
+        } else if v_target.abs() >= v0.abs() {
+            b.push(v_target.signum() * acc, (v_target.abs() - v0.abs()) / acc);
+        } else {
+            b.push(-v0.signum() * dec, (v0.abs() - v_target.abs()) / dec);
+        }
+        b.v = v_target;
+        b.finish(now_ns, End::Cruise, v_target)
+    }
+
+    /// Decelerate at `dec` to a stop and hold there.
+    pub fn stop(now_ns: u64, p0: f64, v0: f64, dec: f64) -> Self {
+        let mut b = Builder::new(p0, v0);
+        if v0 != 0.0 && dec > 0.0 {
+            b.push(-v0.signum() * dec, v0.abs() / dec);
+        }
+        let p = b.p;
+        b.v = 0.0;
+        b.finish(now_ns, End::Hold(p), 0.0)
+    }
+
+    /// Time-optimal trapezoid from `(p0, v0)` to rest at `target`, never faster
+    /// than `vmax`, accelerating at `acc` and decelerating at `dec`.
+    ///
+    /// Starting velocity may be anything: toward the target (the profile keeps
+    /// going, slowing down first if `v0` exceeds `vmax`), away from it (it stops
+    /// and comes back), or too fast to stop in time (it stops past the target
+    /// and comes back). Callers that must never reverse check
+    /// [`stopping_distance`] first.
+    pub fn move_to(
+        now_ns: u64,
+        p0: f64,
+        v0: f64,
+        target: f64,
+        vmax: f64,
+        acc: f64,
+        dec: f64,
+    ) -> Self {
+        let mut b = Builder::new(p0, v0);
+        let s = if target >= p0 { 1.0 } else { -1.0 };
+        let x = (target - p0) * s;
+        let u = v0 * s; // velocity toward the target
+        if u < 0.0 {
+            // Moving away: stop, then come back from rest.
+            b.push(s * dec, -u / dec);
+            b.v = 0.0;
+            rest_to_rest(&mut b, target, vmax, acc, dec);
+        } else {
+            let ds = u * u / (2.0 * dec);
+            let tol = 1e-9 * (1.0 + x.abs());
+            if ds > x + tol {
+                // Cannot stop in time: stop past the target, then come back.
+                b.push(-s * dec, u / dec);
+                b.v = 0.0;
+                rest_to_rest(&mut b, target, vmax, acc, dec);
+            } else {
+                toward(&mut b, s, x, u, vmax, acc, dec);
+            }
+        }
+        b.finish(now_ns, End::Hold(target), 0.0)
+    }
+
+    fn t(&self, now_ns: u64) -> f64 {
+        now_ns.saturating_sub(self.start_ns) as f64 * 1e-9
+    }
+
+    /// Commanded position and velocity at `now_ns`.
+    pub fn sample(&self, now_ns: u64) -> (f64, f64) {
+        let t = self.t(now_ns);
+        if t >= self.t_end {
+            return match self.end {
+                End::Hold(p) => (p, 0.0),
+                End::Cruise => {
+                    let dt = t - self.t_end;
+                    (self.p_end + self.v_end * dt, self.v_end)
+                }
+            };
+        }
+        let mut i = 0;
+        while i + 1 < self.n && t >= self.segs[i + 1].t0 {
+            i += 1;
+        }
+        let s = &self.segs[i];
+        let tau = t - s.t0;
+        (s.p0 + s.v0 * tau + 0.5 * s.a * tau * tau, s.v0 + s.a * tau)
+    }
+
+    /// True once a stop or move has reached its end (always false for a jog).
+    pub fn is_done(&self, now_ns: u64) -> bool {
+        matches!(self.end, End::Hold(_)) && self.t(now_ns) >= self.t_end
+    }
+
+    /// Where a stop or move ends (the jog's cruise start for a jog).
+    pub fn end_position(&self) -> f64 {
+        self.p_end
+    }
+}
+
+/// Distance needed to stop from `v` at deceleration `dec`.
+pub fn stopping_distance(v: f64, dec: f64) -> f64 {
+    if dec > 0.0 {
+        v * v / (2.0 * dec)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// True if a move from `(p, v)` to rest at `target` needs no reversal: at
+/// rest anything is reachable; moving, the velocity must point at the target
+/// and the stopping distance must fit (with the same rounding tolerance that
+/// [`Profile::move_to`] uses to decide it need not overshoot).
+pub fn reaches_without_reversing(p: f64, v: f64, target: f64, dec: f64) -> bool {
+    let x = target - p;
+    if v == 0.0 {
+        return true;
+    }
+    if x * v <= 0.0 {
+        return false;
+    }
+    stopping_distance(v, dec) <= x.abs() + 1e-9 * (1.0 + x.abs())
+}
+
+/// From rest at the builder's position to rest at `target`.
+fn rest_to_rest(b: &mut Builder, target: f64, vmax: f64, acc: f64, dec: f64) {
+    let s = if target >= b.p { 1.0 } else { -1.0 };
+    let x = (target - b.p) * s;
+    toward(b, s, x, 0.0, vmax, acc, dec);
+}
+
+/// Moving toward the target at `u >= 0` with room to stop (`u²/2dec <= x`):
+/// slow to `vmax` if above it, else accelerate to the peak speed, cruise if the
+/// peak reaches `vmax`, and decelerate to rest exactly `x` further on.
+fn toward(b: &mut Builder, s: f64, x: f64, u: f64, vmax: f64, acc: f64, dec: f64) {
+    if u > vmax {
+        b.push(-s * dec, (u - vmax) / dec);
+        let x1 = x - (u * u - vmax * vmax) / (2.0 * dec);
+        let cruise = (x1 - vmax * vmax / (2.0 * dec)).max(0.0);
+        b.push(0.0, cruise / vmax);
+        b.push(-s * dec, vmax / dec);
+        return;
+    }
+    let peak2 = (x + u * u / (2.0 * acc)) / (0.5 / acc + 0.5 / dec);
+    let peak = peak2.max(0.0).sqrt().max(u);
+    if peak > vmax {
+        let d_acc = (vmax * vmax - u * u) / (2.0 * acc);
+        let d_dec = vmax * vmax / (2.0 * dec);
+        b.push(s * acc, (vmax - u) / acc);
+        b.push(0.0, ((x - d_acc - d_dec).max(0.0)) / vmax);
+        b.push(-s * dec, vmax / dec);
+    } else {
+        b.push(s * acc, (peak - u) / acc);
+        b.push(-s * dec, peak / dec);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const T: u64 = 1_000_000; // 1 ms
+
+    /// Samples a profile every `T` until it is done (or `max` cycles).
+    fn run(p: &Profile, max: usize) -> Vec<(f64, f64)> {
+        (0..max).map(|k| p.sample(k as u64 * T)).collect()
+    }
+
+    fn check_limits(xs: &[(f64, f64)], vmax: f64, acc: f64, dec: f64) {
+        let dt = T as f64 * 1e-9;
+        let v: Vec<f64> = xs.windows(2).map(|w| (w[1].0 - w[0].0) / dt).collect();
+        for s in &v {
+            assert!(s.abs() <= vmax * (1.0 + 1e-9) + 1e-9, "speed {s} > {vmax}");
+        }
+        for w in v.windows(2) {
+            let dv = (w[1] - w[0]) / dt;
+            let lim = if w[0].signum() == w[1].signum() && w[1].abs() > w[0].abs() {
+                acc
+            } else if w[0].signum() == w[1].signum() {
+                dec
+            } else {
+                acc.max(dec)
+            };
+            assert!(dv.abs() <= lim * (1.0 + 1e-6) + 1e-6, "accel {dv} > {lim}");
+        }
+    }
+
+    #[test]
+    fn rest_to_rest_trapezoid_lands_exactly() {
+        let p = Profile::move_to(0, 0.0, 0.0, 10.0, 20.0, 500.0, 250.0);
+        let xs = run(&p, 2000);
+        check_limits(&xs, 20.0, 500.0, 250.0);
+        assert_eq!(p.sample(10_000 * T), (10.0, 0.0));
+        // accel 0.04 s, decel 0.08 s, cruise (10 - 0.4 - 0.8)/20 = 0.44 s
+        assert!((p.t_end - 0.56).abs() < 1e-12);
+        assert!(p.is_done(560 * T + 1));
+    }
+
+    #[test]
+    fn triangle_when_too_short_to_cruise() {
+        let p = Profile::move_to(0, 0.0, 0.0, -0.1, 20.0, 500.0, 500.0);
+        let xs = run(&p, 100);
+        check_limits(&xs, 20.0, 500.0, 500.0);
+        // peak = sqrt(0.1 * 500) = 7.07 < 20
+        assert!((p.t_end - 2.0 * (50.0f64).sqrt() / 500.0).abs() < 1e-12);
+        assert_eq!(xs.last().unwrap().0, -0.1);
+    }
+
+    #[test]
+    fn moving_start_toward_target_continues_without_reversing() {
+        // At 20 u/s, 4 units to go, stopping distance 0.4.
+        let p = Profile::move_to(0, 0.0, 20.0, 4.0, 20.0, 500.0, 500.0);
+        let xs = run(&p, 400);
+        check_limits(&xs, 20.0, 500.0, 500.0);
+        assert!(xs.windows(2).all(|w| w[1].0 >= w[0].0));
+        assert_eq!(xs.last().unwrap().0, 4.0);
+    }
+
+    #[test]
+    fn moving_start_faster_than_vmax_slows_first() {
+        let p = Profile::move_to(0, 0.0, 30.0, 10.0, 20.0, 500.0, 500.0);
+        let xs = run(&p, 1000);
+        check_limits(&xs[21..], 20.0, 500.0, 500.0);
+        assert_eq!(xs.last().unwrap().0, 10.0);
+    }
+
+    #[test]
+    fn moving_away_stops_and_comes_back() {
+        let p = Profile::move_to(0, 0.0, -20.0, 1.0, 5.0, 500.0, 400.0);
+        let xs = run(&p, 2000);
+        check_limits(&xs, 20.0, 500.0, 500.0);
+        let min = xs.iter().map(|x| x.0).fold(f64::INFINITY, f64::min);
+        assert!(
+            (min - -0.5).abs() < 1e-3,
+            "stops 20²/800 = 0.5 behind: {min}"
+        );
+        assert_eq!(xs.last().unwrap().0, 1.0);
+    }
+
+    #[test]
+    fn overshoot_when_target_too_close() {
+        let p = Profile::move_to(0, 0.0, 20.0, 0.1, 20.0, 500.0, 500.0);
+        let xs = run(&p, 2000);
+        let max = xs.iter().map(|x| x.0).fold(f64::NEG_INFINITY, f64::max);
+        assert!((max - 0.4).abs() < 1e-3);
+        assert_eq!(xs.last().unwrap().0, 0.1);
+    }
+
+    #[test]
+    fn jog_reverses_through_zero() {
+        let p = Profile::jog(0, 0.0, 10.0, -2.0, 100.0, 50.0);
+        let xs = run(&p, 1000);
+        check_limits(&xs, 10.0, 100.0, 50.0);
+        // 0.2 s decel, 0.02 s accel, then cruise at -2.
+        assert_eq!(p.sample(500 * T).1, -2.0);
+        let (p1, _) = p.sample(300 * T);
+        let (p2, _) = p.sample(400 * T);
+        assert!(((p2 - p1) / 0.1 - -2.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn stop_holds_where_it_stops() {
+        let p = Profile::stop(0, 1.0, -10.0, 100.0);
+        assert_eq!(p.sample(10 * T * 1000).0, p.end_position());
+        assert!((p.end_position() - 0.5).abs() < 1e-12);
+        assert!(!Profile::jog(0, 0.0, 0.0, 1.0, 1.0, 1.0).is_done(u64::MAX));
+    }
+
+    #[test]
+    fn zero_length_move_is_a_hold() {
+        let p = Profile::move_to(0, 3.0, 0.0, 3.0, 1.0, 1.0, 1.0);
+        assert_eq!(p.sample(0), (3.0, 0.0));
+        assert!(p.is_done(0));
+    }
+}

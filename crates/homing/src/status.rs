@@ -1,0 +1,82 @@
+//! The Motion Axis Home instruction's status (EN, DN, ER, IP, PC, ERR, EXERR)
+//! and the axis status bits homing drives (HomingStatus, HomedStatus).
+
+/// Where the engine is in a sequence. The number is reported as EXERR of a
+/// search-limit failure (1016), so it is part of the interface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u16)]
+pub enum Phase {
+    /// Not homing; holding (or tracking the actual position while disabled).
+    #[default]
+    Idle = 0,
+    /// Active start: waiting for the drive to report enabled.
+    Enabling = 1,
+    /// First leg at Home Speed, searching for the first event.
+    Seek = 2,
+    /// Decelerating after the first leg's event.
+    SeekStop = 3,
+    /// Backing the command out of a hard stop before anything else moves.
+    Release = 4,
+    /// Leg at Home Return Speed (switch clear, marker after switch or torque).
+    Return = 5,
+    /// Decelerating after the return leg's event.
+    ReturnStop = 6,
+    /// Trapezoidal move to Home Position.
+    MoveHome = 7,
+    /// Passive: waiting for an external agent to produce the event.
+    Passive = 8,
+    /// Aborted: decelerating to rest, then restoring overridden drive values.
+    Stopping = 9,
+}
+
+impl Phase {
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Idle => "idle",
+            Phase::Enabling => "enabling",
+            Phase::Seek => "seek",
+            Phase::SeekStop => "seek_stop",
+            Phase::Release => "release",
+            Phase::Return => "return",
+            Phase::ReturnStop => "return_stop",
+            Phase::MoveHome => "move_home",
+            Phase::Passive => "passive",
+            Phase::Stopping => "stopping",
+        }
+    }
+}
+
+/// Instruction and axis status after a cycle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Status {
+    /// EN: request seen; cleared when the request drops after DN or ER.
+    pub en: bool,
+    /// DN: the instruction finished (completed, or aborted / errored).
+    pub dn: bool,
+    /// ER: the instruction detected an error; see `err` / `exerr`.
+    pub er: bool,
+    /// IP: homing in process.
+    pub ip: bool,
+    /// PC: process complete — homed *and* at Home Position where the
+    /// sequence moves there. A unidirectional sequence that could not reach
+    /// Home Position without reversing clears IP without PC.
+    pub pc: bool,
+    pub err: u16,
+    pub exerr: u16,
+    /// Axis HomingStatus.
+    pub homing: bool,
+    /// Axis HomedStatus: the machine reference is established.
+    pub homed: bool,
+    /// Axis StoppingStatus: decelerating after an abort.
+    pub stopping: bool,
+    pub phase: Phase,
+    /// Raw position of the home event, once found.
+    pub event_raw: Option<f64>,
+    /// The feedback attribute that was invalid (ERR 12 / EXERR 41).
+    pub bad_attribute: Option<&'static str>,
+    /// Monotonic time homing started and finished, ns.
+    pub started_ns: u64,
+    pub finished_ns: Option<u64>,
+    /// Feedback is fresh and valid (not stale beyond `stale_limit`).
+    pub feedback_ok: bool,
+}

@@ -1,0 +1,440 @@
+//! Configuration validation: every problem at once, each naming the attribute
+//! (by its TOML key) and carrying the CIP code the instruction would report.
+//!
+//! Runs once, outside the real-time cycle; it may allocate.
+
+use crate::codes::*;
+use crate::config::*;
+use std::fmt;
+
+/// One configuration problem.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ConfigError {
+    /// The attribute at fault, spelled as the TOML key.
+    pub attribute: &'static str,
+    pub err: u16,
+    pub exerr: u16,
+    pub message: String,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}: {} (ERR {} EXERR {})",
+            self.attribute, self.message, self.err, self.exerr
+        )
+    }
+}
+
+struct Problems(Vec<ConfigError>);
+
+impl Problems {
+    fn add(&mut self, attribute: &'static str, exerr: u16, message: String) {
+        self.0.push(ConfigError {
+            attribute,
+            err: ERR_ILLEGAL_HOMING_CONFIG,
+            exerr,
+            message,
+        });
+    }
+
+    /// Finite check; and `>= 0` when `non_negative`. Returns whether the value
+    /// is usable for further checks.
+    fn number(&mut self, attribute: &'static str, v: f64, non_negative: bool) -> bool {
+        if !v.is_finite() {
+            self.add(
+                attribute,
+                EX_BAD_NUMBER,
+                format!("{v} is not a finite number"),
+            );
+            false
+        } else if non_negative && v < 0.0 {
+            self.add(attribute, EX_BAD_NUMBER, format!("{v} is negative"));
+            false
+        } else {
+            true
+        }
+    }
+}
+
+/// True for the sequences that command motion (active, not Immediate).
+pub fn moves(cfg: &AxisConfig) -> bool {
+    cfg.home_mode == HomeMode::Active && cfg.home_sequence != HomeSequence::Immediate
+}
+
+/// Checks `cfg` and returns every problem found (empty = valid).
+pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
+    let mut p = Problems(Vec::new());
+
+    // Numbers first: later rules only look at usable values.
+    p.number("home_position", cfg.home_position, false);
+    p.number("home_offset", cfg.home_offset, false);
+    let speed_ok = p.number("home_speed", cfg.home_speed, true);
+    let rspeed_ok = p.number("home_return_speed", cfg.home_return_speed, true);
+    let acc_ok = p.number("home_acceleration", cfg.home_acceleration, true);
+    let dec_ok = p.number("home_deceleration", cfg.home_deceleration, true);
+    let lvl_ok = p.number("home_torque_level", cfg.home_torque_level, true);
+    let thr_ok = p.number("home_torque_threshold", cfg.home_torque_threshold, true);
+    p.number("home_torque_time", cfg.home_torque_time, true);
+    p.number("home_timeout", cfg.home_timeout, true);
+    p.number("search_limit", cfg.search_limit, true);
+    p.number("torque_limit", cfg.torque_limit, true);
+    p.number(
+        "position_error_tolerance",
+        cfg.position_error_tolerance,
+        true,
+    );
+    p.number(
+        "velocity_error_tolerance",
+        cfg.velocity_error_tolerance,
+        true,
+    );
+    p.number("enable_timeout", cfg.enable_timeout, true);
+    if p.number("max_position", cfg.max_position, true) && cfg.max_position == 0.0 {
+        p.add("max_position", EX_BAD_NUMBER, "must be positive".into());
+    }
+
+    if !cfg.counts_per_unit.is_finite() || cfg.counts_per_unit <= 0.0 {
+        p.add(
+            "counts_per_unit",
+            EX_CONVERSION_CONSTANT,
+            format!(
+                "conversion constant {} must be a positive number",
+                cfg.counts_per_unit
+            ),
+        );
+    }
+
+    if cfg.travel == TravelMode::Cyclic {
+        if !cfg.unwind.is_finite() || cfg.unwind <= 0.0 {
+            p.add(
+                "unwind",
+                EX_UNWIND,
+                format!("cyclic axis needs a positive unwind, got {}", cfg.unwind),
+            );
+        } else if cfg.home_position.is_finite()
+            && !(cfg.home_position >= 0.0 && cfg.home_position < cfg.unwind)
+        {
+            p.add(
+                "home_position",
+                EX_CYCLIC_HOME_POSITION,
+                format!(
+                    "{} is outside [0, {}) of the cyclic axis",
+                    cfg.home_position, cfg.unwind
+                ),
+            );
+        }
+    }
+
+    if let Some((lo, hi)) = cfg.travel_limits {
+        if !lo.is_finite() || !hi.is_finite() || lo >= hi {
+            p.add(
+                "travel_limits",
+                EX_TRAVEL_LIMITS,
+                format!("[{lo}, {hi}] is not an interval"),
+            );
+        } else if cfg.travel == TravelMode::Linear
+            && cfg.home_position.is_finite()
+            && !(lo..=hi).contains(&cfg.home_position)
+        {
+            p.add(
+                "home_position",
+                EX_HOME_POSITION_LIMITS,
+                format!(
+                    "{} is outside the travel limits [{lo}, {hi}]",
+                    cfg.home_position
+                ),
+            );
+        }
+    }
+
+    let seq = cfg.home_sequence;
+    let active = cfg.home_mode == HomeMode::Active;
+
+    if active && cfg.configuration == AxisConfiguration::FeedbackOnly {
+        p.add(
+            "home_mode",
+            EX_ACTIVE_ON_FEEDBACK_ONLY,
+            "active homing needs a servo axis; a feedback-only axis can only home passive".into(),
+        );
+    }
+    if cfg.configuration == AxisConfiguration::Virtual && seq != HomeSequence::Immediate {
+        p.add(
+            "home_sequence",
+            EX_SEQUENCE_INCOMPATIBLE,
+            "a virtual axis has no switch, marker or drive: only immediate homing applies".into(),
+        );
+    }
+    if !active && seq.uses_torque() {
+        p.add(
+            "home_sequence",
+            EX_SEQUENCE_INCOMPATIBLE,
+            "torque sequences need commanded motion into a hard stop: not valid for passive homing"
+                .into(),
+        );
+    }
+    if seq.uses_marker() && !cfg.marker {
+        p.add(
+            "home_sequence",
+            EX_NO_MARKER,
+            "marker sequence but the feedback device has no marker (marker = false)".into(),
+        );
+    }
+
+    if moves(cfg) {
+        if cfg.control_mode == ControlMode::Torque {
+            p.add(
+                "control_mode",
+                EX_TORQUE_CONTROL_MODE,
+                "active homing needs position or velocity control mode".into(),
+            );
+        }
+        if seq.uses_torque() && cfg.home_direction.is_unidirectional() {
+            p.add(
+                "home_direction",
+                EX_UNIDIRECTIONAL_TORQUE,
+                "torque sequences push into a hard stop and come back: only bidirectional directions are valid".into(),
+            );
+        }
+        if speed_ok && cfg.home_speed == 0.0 {
+            p.add(
+                "home_speed",
+                EX_HOME_SPEED_ZERO,
+                "home speed is zero".into(),
+            );
+        }
+        let uses_return = !cfg.home_direction.is_unidirectional() || seq.uses_torque();
+        if rspeed_ok && uses_return && cfg.home_return_speed == 0.0 {
+            p.add(
+                "home_return_speed",
+                EX_RETURN_SPEED_ZERO,
+                "home return speed is zero".into(),
+            );
+        }
+        if acc_ok && cfg.home_acceleration == 0.0 {
+            p.add(
+                "home_acceleration",
+                EX_ACCELERATION_ZERO,
+                "home acceleration is zero: the axis could never start".into(),
+            );
+        }
+        if dec_ok && cfg.home_deceleration == 0.0 {
+            p.add(
+                "home_deceleration",
+                EX_DECELERATION_ZERO,
+                "home deceleration is zero: the axis could never stop".into(),
+            );
+        }
+        if seq.uses_torque() && lvl_ok && thr_ok {
+            let (lvl, thr) = (cfg.home_torque_level, cfg.home_torque_threshold);
+            if lvl == 0.0 || lvl > 100.0 {
+                p.add(
+                    "home_torque_level",
+                    EX_TORQUE_LEVEL,
+                    format!("{lvl} % is not in (0, 100] %"),
+                );
+            } else if thr == 0.0 || thr > lvl {
+                p.add(
+                    "home_torque_threshold",
+                    EX_TORQUE_LEVEL,
+                    format!(
+                        "{thr} % must be above 0 and at most the torque level {lvl} %, \
+                         or the hard stop can never be detected"
+                    ),
+                );
+            }
+        }
+    }
+    p.0
+}
+
+/// Search limit in force: explicit, else derived from the travel limits
+/// (110 % of the span: a search may start at one end and find its switch at
+/// the other), else two revolutions on a cyclic axis, else unbounded.
+pub fn effective_search_limit(cfg: &AxisConfig) -> f64 {
+    if cfg.search_limit > 0.0 {
+        cfg.search_limit
+    } else if let Some((lo, hi)) = cfg.travel_limits {
+        1.1 * (hi - lo)
+    } else if cfg.travel == TravelMode::Cyclic && cfg.unwind > 0.0 {
+        2.0 * cfg.unwind
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Things that are legal but that a controls engineer would want pointed out.
+/// `cycle_s` is the controller period.
+pub fn advisories(cfg: &AxisConfig, cycle_s: f64) -> Vec<String> {
+    let mut out = Vec::new();
+    if moves(cfg) && effective_search_limit(cfg).is_infinite() {
+        out.push(
+            "search_limit: no search limit and no travel limits: a search that never finds its \
+             event runs until the timeout or a hardware limit"
+                .into(),
+        );
+    }
+    let seq = cfg.home_sequence;
+    if seq.uses_switch() && !cfg.registration {
+        let v = if moves(cfg) && !cfg.home_direction.is_unidirectional() {
+            cfg.home_return_speed
+        } else {
+            cfg.home_speed
+        };
+        if v > 0.0 && !seq.uses_marker() {
+            out.push(format!(
+                "home switch sampled once per cycle: event uncertainty up to {:.6} units \
+                 (half of {v} units/s x {cycle_s} s); registration = true or a marker sequence \
+                 removes it",
+                0.5 * v * cycle_s
+            ));
+        }
+    }
+    if moves(cfg)
+        && !cfg.home_direction.is_unidirectional()
+        && cfg.home_return_speed > cfg.home_speed
+    {
+        out.push("home_return_speed is above home_speed: the precise leg is the fast one".into());
+    }
+    if cfg.home_timeout == 0.0 && moves(cfg) {
+        out.push("home_timeout = 0: homing has no time limit".into());
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn active_switch() -> AxisConfig {
+        AxisConfig {
+            home_sequence: HomeSequence::Switch,
+            home_speed: 10.0,
+            home_return_speed: 1.0,
+            home_acceleration: 100.0,
+            home_deceleration: 100.0,
+            ..AxisConfig::default()
+        }
+    }
+
+    fn codes(cfg: &AxisConfig) -> Vec<(&'static str, u16)> {
+        validate(cfg)
+            .iter()
+            .map(|e| (e.attribute, e.exerr))
+            .collect()
+    }
+
+    #[test]
+    fn valid_config_has_no_problems() {
+        assert!(validate(&active_switch()).is_empty());
+        assert!(
+            validate(&AxisConfig::default()).is_empty(),
+            "immediate needs nothing"
+        );
+    }
+
+    #[test]
+    fn cip_codes_for_zero_speeds() {
+        let cfg = AxisConfig {
+            home_speed: 0.0,
+            home_return_speed: 0.0,
+            ..active_switch()
+        };
+        assert_eq!(
+            codes(&cfg),
+            vec![("home_speed", 6), ("home_return_speed", 7)]
+        );
+    }
+
+    #[test]
+    fn unidirectional_does_not_need_return_speed() {
+        let cfg = AxisConfig {
+            home_direction: HomeDirection::UnidirectionalReverse,
+            home_return_speed: 0.0,
+            ..active_switch()
+        };
+        assert!(validate(&cfg).is_empty());
+    }
+
+    #[test]
+    fn every_problem_reported_at_once() {
+        let cfg = AxisConfig {
+            configuration: AxisConfiguration::FeedbackOnly,
+            control_mode: ControlMode::Torque,
+            travel: TravelMode::Cyclic,
+            unwind: 360.0,
+            home_position: 360.0,
+            home_direction: HomeDirection::UnidirectionalForward,
+            home_sequence: HomeSequence::TorqueThenMarker,
+            home_speed: f64::NAN,
+            home_return_speed: -1.0,
+            home_acceleration: 0.0,
+            home_deceleration: 0.0,
+            home_torque_level: 30.0,
+            home_torque_threshold: 40.0,
+            ..AxisConfig::default()
+        };
+        let got = codes(&cfg);
+        for want in [
+            ("home_speed", EX_BAD_NUMBER),
+            ("home_return_speed", EX_BAD_NUMBER),
+            ("home_position", EX_CYCLIC_HOME_POSITION),
+            ("home_mode", EX_ACTIVE_ON_FEEDBACK_ONLY),
+            ("home_sequence", EX_NO_MARKER),
+            ("control_mode", EX_TORQUE_CONTROL_MODE),
+            ("home_direction", EX_UNIDIRECTIONAL_TORQUE),
+            ("home_acceleration", EX_ACCELERATION_ZERO),
+            ("home_deceleration", EX_DECELERATION_ZERO),
+            ("home_torque_threshold", EX_TORQUE_LEVEL),
+        ] {
+            assert!(got.contains(&want), "missing {want:?} in {got:?}");
+        }
+        assert!(validate(&cfg).iter().all(|e| e.err == 41));
+    }
+
+    #[test]
+    fn passive_torque_and_virtual_switch_are_incompatible() {
+        let cfg = AxisConfig {
+            home_mode: HomeMode::Passive,
+            home_sequence: HomeSequence::Torque,
+            ..AxisConfig::default()
+        };
+        assert_eq!(codes(&cfg), vec![("home_sequence", 4)]);
+        let cfg = AxisConfig {
+            configuration: AxisConfiguration::Virtual,
+            ..active_switch()
+        };
+        assert_eq!(codes(&cfg), vec![("home_sequence", 4)]);
+    }
+
+    #[test]
+    fn limits_and_conversion() {
+        let cfg = AxisConfig {
+            counts_per_unit: 0.0,
+            travel_limits: Some((-10.0, 10.0)),
+            home_position: 11.0,
+            ..active_switch()
+        };
+        assert_eq!(
+            codes(&cfg),
+            vec![("counts_per_unit", 30), ("home_position", 31)]
+        );
+        let cfg = AxisConfig {
+            travel_limits: Some((10.0, -10.0)),
+            ..active_switch()
+        };
+        assert_eq!(codes(&cfg), vec![("travel_limits", 32)]);
+    }
+
+    #[test]
+    fn search_limit_derivation() {
+        let mut cfg = active_switch();
+        assert!(effective_search_limit(&cfg).is_infinite());
+        cfg.travel_limits = Some((-100.0, 100.0));
+        assert!((effective_search_limit(&cfg) - 220.0).abs() < 1e-9);
+        cfg.search_limit = 50.0;
+        assert_eq!(effective_search_limit(&cfg), 50.0);
+        assert!(!advisories(&cfg, 0.001).is_empty());
+    }
+}
