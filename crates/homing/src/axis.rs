@@ -218,9 +218,7 @@ impl Axis {
         self.requests(now_ns, request);
         match fresh {
             Some(s) => self.advance(now_ns, &s),
-            None => {
-                self.check_timeout(now_ns);
-            }
+            None => self.advance_blind(now_ns),
         }
         self.status.phase = self.phase;
         self.status.stopping = self.phase == Phase::Stopping;
@@ -560,6 +558,16 @@ impl Axis {
                 }
             }
             _ => {}
+        }
+    }
+
+    /// A cycle without valid feedback: profiles run on, nothing is detected.
+    /// An abort's stop still finishes; a release (which needs the actual
+    /// position) waits for feedback, keeping the reduced torque limits.
+    fn advance_blind(&mut self, now: u64) {
+        self.check_timeout(now);
+        if self.phase == Phase::Stopping && !self.overrides && self.profile.is_done(now) {
+            self.phase = Phase::Idle;
         }
     }
 
@@ -934,7 +942,8 @@ fn check_feedback(fb: &Feedback, max_position: f64) -> Result<(), &'static str> 
     if bad(fb.position, max_position) {
         return Err("feedback.position");
     }
-    if !fb.velocity.is_finite() {
+    // A speed of more than `max_position` units per second is not a reading either.
+    if bad(fb.velocity, max_position) {
         return Err("feedback.velocity");
     }
     // More than ten times rated torque is not a reading, it is a broken frame.
