@@ -6,8 +6,8 @@ fn demo_parses() {
     assert_eq!(m.axes.len(), 4);
     assert_eq!(m.supervisor.cycle_us, 1000);
     let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
-    assert_eq!(names, ["X", "C", "Z", "U"]);
-    assert_eq!(m.axes[0].sim.switch, Some((0.0, 5.0)));
+    assert_eq!(names, ["U", "X", "C", "Z"]);
+    assert_eq!(m.axes[1].sim.switch, Some((0.0, 5.0)));
     assert_eq!(m.axes[0].engine.stale_limit, 5);
 }
 
@@ -78,10 +78,10 @@ fn demo_homes_in_simulation() {
     use motion_plant::Plant;
     let m = parse(DEMO_TOML).unwrap();
     let want = [
+        ("U", 2.0, f64::NAN),
         ("X", -7.5, -7.5),
         ("C", 123.4, 168.4),
         ("Z", -30.0, -28.0),
-        ("U", 2.0, f64::NAN),
     ];
     for (a, (name, event, final_raw)) in m.axes.iter().zip(want) {
         assert_eq!(a.name, name);
