@@ -47,6 +47,9 @@
 //! is reused on the next start. Resources of a process that died (kill -9) are
 //! removed by `Node::try_cleanup_dead_nodes`, and automatically when a node is
 //! created or dropped or a service is opened in the same domain.
+//! [`cleanup_domain`], called by each process after it dropped its node, does
+//! both: it cleans dead nodes and, once no live node remains, removes the
+//! node-counter segment, so nothing of the domain is left in `/dev/shm`.
 //!
 //! # Signals
 //!
@@ -69,8 +72,8 @@ use iceoryx2::port::subscriber::{Subscriber, SubscriberCreateError};
 use iceoryx2::port::update_connections::{ConnectionFailure, UpdateConnections};
 use iceoryx2::port::{LoanError, ReceiveError, SendError};
 use iceoryx2::prelude::{
-    ipc, BackpressureStrategy, FileName, NodeName, Path, SemanticString, ServiceName,
-    SignalHandlingMode,
+    ipc, BackpressureStrategy, CallbackProgression, FileName, NodeName, NodeState, Path,
+    SemanticString, ServiceName, SignalHandlingMode,
 };
 use iceoryx2::sample::Sample;
 use iceoryx2::service::builder::event::{EventOpenError, EventOpenOrCreateError};
@@ -618,6 +621,9 @@ pub struct Ports<Tx: Frame, Rx: Frame> {
     tx_ready: Arc<str>,
     rx_service: Arc<str>,
     rx_ready: Arc<str>,
+    /// The listener's file descriptor (a unix datagram socket on Linux), read
+    /// once: iceoryx2 guarantees it does not change for the port's lifetime.
+    listener_fd: i32,
     next_sequence: u64,
     skipped: u64,
 }
@@ -713,11 +719,18 @@ impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
                     error,
                 })?;
 
+        // SAFETY: only the number is kept; the listener owns the descriptor and
+        // outlives every use (it is a field of the same struct).
+        let listener_fd = unsafe {
+            iceoryx2_bb_posix::file_descriptor::FileDescriptorBased::file_descriptor(&listener)
+                .native_handle()
+        };
         Ok(Self {
             publisher,
             notifier,
             subscriber,
             listener,
+            listener_fd,
             tx_service,
             tx_ready,
             rx_service,
@@ -848,6 +861,46 @@ impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
         }
     }
 
+    /// Waits for the peer's wake-up until the absolute `CLOCK_MONOTONIC`
+    /// time `deadline_ns` (ns); `Ok(true)` = woken, `Ok(false)` = deadline.
+    ///
+    /// Use this, not [`Self::wait`], where timing matters. `Listener::timed_wait`
+    /// relies on the socket's `SO_RCVTIMEO`, which the kernel counts in jiffies
+    /// (a 0.5 ms timeout sleeps up to 4 ms at HZ=250) and which treats a
+    /// timeout below 1 µs as "forever". Here the descriptor is polled with
+    /// `ppoll`, whose timeout is an hrtimer (no slack for a SCHED_FIFO
+    /// thread), and the wake-up is then consumed with `try_wait`. A past
+    /// deadline returns at once. No heap allocation.
+    pub fn wait_until(&mut self, deadline_ns: u64) -> Result<bool, IpcError> {
+        loop {
+            if self.try_wait()? {
+                return Ok(true);
+            }
+            let now = monotonic_ns();
+            if now >= deadline_ns {
+                return Ok(false);
+            }
+            let rem = deadline_ns - now;
+            let ts = libc::timespec {
+                tv_sec: (rem / 1_000_000_000) as libc::time_t,
+                tv_nsec: (rem % 1_000_000_000) as libc::c_long,
+            };
+            let mut pfd = libc::pollfd {
+                fd: self.listener_fd,
+                events: libc::POLLIN,
+                revents: 0,
+            };
+            // SAFETY: one valid pollfd, a valid timespec, no signal mask.
+            let rc = unsafe { libc::ppoll(&mut pfd, 1, &ts, core::ptr::null()) };
+            if rc == 0 {
+                return self.try_wait();
+            }
+            // rc > 0: readable, consumed at the top; rc < 0: EINTR (or a
+            // descriptor error that try_wait reports): go round, the
+            // deadline bounds the loop.
+        }
+    }
+
     /// Non-blocking [`Self::wait`]: consumes pending wake-ups, `Ok(true)` if
     /// there were any.
     pub fn try_wait(&mut self) -> Result<bool, IpcError> {
@@ -919,6 +972,133 @@ impl<Tx: Frame, Rx: Frame> fmt::Debug for Ports<Tx, Rx> {
     }
 }
 
+/// What [`cleanup_domain`] found and did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CleanupReport {
+    /// Nodes of the domain whose process is alive (e.g. the peer still runs).
+    pub alive: usize,
+    /// Dead nodes (process gone without cleaning up, e.g. after `kill -9`)
+    /// whose stale resources were removed now.
+    pub dead_cleaned: usize,
+    /// Dead nodes whose resources could not be removed (permissions, another
+    /// process still busy cleaning them, another iceoryx2 version).
+    pub dead_failed: usize,
+    /// Nodes whose state could not be determined (another user's, or a node
+    /// caught half-created). Counted as alive: the domain is not torn down.
+    pub unknown: usize,
+    /// The domain's persistent node-counter segment
+    /// (`/dev/shm/{file_prefix}…_node.0_10_0.global_mgmt`) was removed.
+    pub removed_global_mgmt: bool,
+    /// Why the domain could not be inspected or the segment not removed, if so.
+    pub error: Option<String>,
+}
+
+impl CleanupReport {
+    /// True if nothing of the domain is known to remain: no live, unknown or
+    /// uncleanable node and no error (the segment itself may have been absent).
+    pub fn domain_gone(&self) -> bool {
+        self.alive == 0 && self.unknown == 0 && self.dead_failed == 0 && self.error.is_none()
+    }
+}
+
+impl fmt::Display for CleanupReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} live node(s), {} dead node(s) cleaned",
+            self.alive + self.unknown,
+            self.dead_cleaned
+        )?;
+        if self.dead_failed > 0 {
+            write!(f, ", {} dead node(s) NOT cleaned", self.dead_failed)?;
+        }
+        if self.removed_global_mgmt {
+            write!(f, ", node-counter segment removed")?;
+        }
+        if let Some(e) = &self.error {
+            write!(f, "; {e}")?;
+        }
+        Ok(())
+    }
+}
+
+/// How long [`cleanup_domain`] waits for another process that is cleaning up
+/// the same dead node at the same moment.
+const CLEANUP_WAIT: Duration = Duration::from_millis(200);
+
+/// Tidies the iceoryx2 domain of `cfg` on the way out. Call it after this
+/// process dropped all its ports and its node (`motion-supervisor` and
+/// `motion-io` both do); it creates nothing (no node, no service).
+///
+/// 1. Lists the nodes of the domain (`Node::list`).
+/// 2. Removes the stale resources of every dead node (a peer killed with
+///    SIGKILL leaves its shared memory, its ports in the services and its node
+///    files behind).
+/// 3. If no live (or undeterminable) node remains and every dead one was
+///    cleaned, removes the domain's persistent node-counter segment, the one
+///    file iceoryx2 0.10 never removes by itself (see the module docs). After
+///    that nothing named `{file_prefix}*` is left in `/dev/shm`.
+///
+/// # The race, and why it is acceptable
+///
+/// Between the listing (step 1) and the removal (step 3) another process may
+/// start a node in the same domain. Node creation only uses the segment to
+/// draw a node counter: a process that already opened it keeps its mapping
+/// and works normally; the next node simply creates a fresh segment whose
+/// counter starts again at 0. Node ids combine pid, counter and creation time
+/// (ns), so a restarted counter does not produce duplicate ids. Only if the
+/// removal hits the few microseconds in which the other process is *creating*
+/// the segment can its node creation fail; it then reports the error and a
+/// restart succeeds. The window exists only while the domain has no live node
+/// at all, i.e. at the moment the last process leaves, which makes it
+/// practically irrelevant; a lock across processes would cost more than it
+/// saves.
+///
+/// Never panics; failures are reported in [`CleanupReport::error`].
+pub fn cleanup_domain(cfg: &IpcConfig) -> CleanupReport {
+    let mut report = CleanupReport::default();
+    let icfg = match cfg.iceoryx2_config() {
+        Ok(c) => c,
+        Err(e) => {
+            report.error = Some(e.to_string());
+            return report;
+        }
+    };
+    let listed = Node::<ipc::Service>::list(&icfg, |state| {
+        match state {
+            NodeState::Alive(_) => report.alive += 1,
+            NodeState::Dead(dead) => match dead.blocking_remove_stale_resources(CLEANUP_WAIT) {
+                Ok(()) => report.dead_cleaned += 1,
+                Err(_) => report.dead_failed += 1,
+            },
+            NodeState::Inaccessible(_) | NodeState::Undefined(_) => report.unknown += 1,
+        }
+        CallbackProgression::Continue
+    });
+    if let Err(e) = listed {
+        report.error = Some(format!(
+            "cannot list the nodes of the iceoryx2 domain {:?} (iceoryx2: {e:?})",
+            cfg.file_prefix()
+        ));
+        return report;
+    }
+    if !report.domain_gone() {
+        return report;
+    }
+    // SAFETY: no process of the domain is alive (just checked); see the race
+    // discussion above for a node created between the check and this call.
+    match unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&icfg) } {
+        Ok(removed) => report.removed_global_mgmt = removed,
+        Err(e) => {
+            report.error = Some(format!(
+                "cannot remove the node-counter segment of {:?} (iceoryx2: {e:?})",
+                cfg.file_prefix()
+            ))
+        }
+    }
+    report
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -980,6 +1160,40 @@ mod tests {
         fn header_mut(&mut self) -> &mut FrameHeader {
             &mut self.header
         }
+    }
+
+    fn shm_entries(cfg: &IpcConfig) -> Vec<String> {
+        let prefix = cfg.file_prefix();
+        std::fs::read_dir("/dev/shm")
+            .map(|rd| {
+                rd.flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.starts_with(&prefix))
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn cleanup_domain_keeps_a_live_domain_and_removes_an_empty_one() {
+        let env = TestEnv::new("cln");
+        {
+            let node = env.cfg.create_node("motion-io").unwrap();
+            let _io = IoPorts::create(&node, &env.cfg.prefix).unwrap();
+            let r = cleanup_domain(&env.cfg);
+            assert_eq!(r.alive, 1, "{r:?}");
+            assert!(!r.removed_global_mgmt && !r.domain_gone(), "{r:?}");
+            assert!(!shm_entries(&env.cfg).is_empty());
+        }
+        let r = cleanup_domain(&env.cfg);
+        println!("after drop: {r}");
+        assert_eq!(r.alive, 0, "{r:?}");
+        assert!(r.removed_global_mgmt && r.domain_gone(), "{r:?}");
+        assert_eq!(shm_entries(&env.cfg), Vec::<String>::new());
+        // idempotent, and creates nothing
+        let r = cleanup_domain(&env.cfg);
+        assert!(!r.removed_global_mgmt && r.domain_gone(), "{r:?}");
+        assert_eq!(shm_entries(&env.cfg), Vec::<String>::new());
     }
 
     #[test]
