@@ -1,0 +1,100 @@
+//! Command-line and config mistakes: exit 2, every mistake printed, nothing
+//! created in /dev/shm.
+
+mod common;
+
+use std::time::Duration;
+
+use common::*;
+
+/// A config with several independent mistakes.
+fn bad_toml(prefix: &str) -> String {
+    format!(
+        r#"
+[supervisor]
+cycle_us = 5
+service_prefix = "{prefix}"
+io = "bogus"
+io_watchdog_cycles = 0
+colour = "blue"
+
+[[axis]]
+name = "X"
+counts_per_unit = 1000.0
+home_sequence = "marker"
+home_speed = -3.0
+home_direction = "sideways"
+
+[axis.sim]
+marker_every = -1.0
+"#
+    )
+}
+
+#[test]
+fn config_with_several_mistakes_exits_2_and_prints_every_one() {
+    let prefix = unique_prefix();
+    let _guard = DomainGuard(prefix.clone());
+    let text = bad_toml(&prefix);
+    let expected = motion_config::parse(&text).expect_err("the config has mistakes");
+    assert!(expected.len() >= 5, "{expected:?}");
+    let cfg = TempConfig::new("bad", &text);
+    let mut io = Io::spawn(&["--config", &cfg.arg()]);
+    let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
+    assert_eq!(st.code(), Some(2), "{}", io.stderr());
+    let err = io.stderr();
+    for p in &expected {
+        let line = format!("motion-io: config: {p}");
+        assert!(
+            io.lines.iter().any(|(_, l)| *l == line),
+            "missing {line:?} in\n{err}"
+        );
+    }
+    assert_eq!(
+        io.count("motion-io: config: "),
+        expected.len(),
+        "one line per problem:\n{err}"
+    );
+    println!("{} problems reported:\n{err}", expected.len());
+    // nothing was created
+    assert_eq!(shm_entries(&prefix), Vec::<String>::new());
+    finish(None, &prefix);
+}
+
+#[test]
+fn unreadable_config_file_exits_2() {
+    let mut io = Io::spawn(&["--config", "/nonexistent/motion-io.toml"]);
+    let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
+    assert_eq!(st.code(), Some(2));
+    assert!(
+        io.find("motion-io: config: file: cannot read /nonexistent/motion-io.toml")
+            .is_some(),
+        "{}",
+        io.stderr()
+    );
+}
+
+#[test]
+fn command_line_mistakes_exit_2_with_usage() {
+    for (args, needle) in [
+        (&["--backend", "ethercat"][..], "unknown backend"),
+        (&["--cpu"][..], "--cpu needs a value"),
+        (&["--priority", "0"][..], "1..=99"),
+        (&["--frobnicate"][..], "unknown option \"--frobnicate\""),
+        (&["stray"][..], "unexpected argument"),
+    ] {
+        let mut io = Io::spawn(args);
+        let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
+        assert_eq!(st.code(), Some(2), "{args:?}");
+        let err = io.stderr();
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(err.contains("usage: motion-io"), "{args:?}: {err}");
+    }
+    // --help is not a mistake
+    let st = std::process::Command::new(BIN)
+        .arg("--help")
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&st.stdout).contains("--exit-with-supervisor"));
+}

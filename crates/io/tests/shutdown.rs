@@ -1,0 +1,147 @@
+//! SIGTERM/SIGINT: every axis stopped, exit 0, nothing left in /dev/shm.
+//! SIGKILL: the stale resources are removed by the cleanup helper.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::*;
+use motion_frames::ipc::cleanup_domain;
+use motion_frames::{AxisCommand, IpcConfig, CW_ENABLE, SW_ENABLED};
+use nix::sys::signal::Signal;
+
+const STOP_LINE: &str = "motion-io: signal: every axis stopped";
+
+#[test]
+fn sigterm_while_moving_stops_every_axis_and_exits_0() {
+    let prefix = unique_prefix();
+    let _guard = DomainGuard(prefix.clone());
+    let cfg = TempConfig::new("term", &one_axis_toml("iotest_unused", 50));
+    let mut io = Io::spawn(&["--config", &cfg.arg(), "--service-prefix", &prefix]);
+    io.wait_line("backend sim", Duration::from_secs(10))
+        .expect("start line");
+    let mut sup = Sup::new(&prefix);
+    sup.connect(1);
+    let mut pacer = Pacer::new(Duration::from_millis(1));
+    let mut pos = 0;
+    for k in 0..50 {
+        pacer.wait();
+        pos += 30;
+        let a = sup
+            .exchange(
+                |f| {
+                    f.header.axis_count = 1;
+                    f.axes[0] = AxisCommand {
+                        target_position: pos,
+                        target_velocity: 30_000.0,
+                        torque_limit_positive: 100.0,
+                        torque_limit_negative: 100.0,
+                        control_word: CW_ENABLE,
+                        ..AxisCommand::ZERO
+                    };
+                },
+                Duration::from_secs(2),
+            )
+            .expect("answer");
+        if k >= 2 {
+            assert_eq!(a.fb.axes[0].status_word, SW_ENABLED);
+        }
+    }
+
+    let t0 = Instant::now();
+    io.signal(Signal::SIGTERM);
+    let st = io
+        .wait_exit(Duration::from_secs(2))
+        .expect("not exited within 2 s of SIGTERM");
+    let took = t0.elapsed();
+    println!("exit {st:?} {took:?} after SIGTERM");
+    assert_eq!(st.code(), Some(0), "{}", io.stderr());
+    assert!(io.find(STOP_LINE).is_some(), "{}", io.stderr());
+    assert!(io.find("SIGTERM received after").is_some());
+    // the last frame, if still readable, shows the axis at rest
+    if let Some(f) = sup.latest() {
+        println!("last feedback after SIGTERM: {:?}", f.axes[0]);
+        assert_eq!(f.answers_sequence, 0);
+        assert_eq!(f.axes[0].velocity, 0.0);
+        assert_eq!(f.axes[0].status_word & SW_ENABLED, 0);
+    }
+    finish(Some(sup), &prefix);
+}
+
+#[test]
+fn sigint_before_any_command_exits_0_and_leaves_nothing() {
+    let prefix = unique_prefix();
+    let _guard = DomainGuard(prefix.clone());
+    // built-in demo machine, prefix overridden
+    let mut io = Io::spawn(&["--service-prefix", &prefix]);
+    let start = io
+        .wait_line("backend sim", Duration::from_secs(10))
+        .expect("start line");
+    let (demo, _) = motion_config::load(None).expect("demo machine");
+    let names: Vec<_> = demo.axes.iter().map(|a| a.name.as_str()).collect();
+    let axes = format!("{} axes ({})", names.len(), names.join(", "));
+    assert!(start.1.contains(&axes), "{axes:?} not in {}", start.1);
+    assert!(
+        start.1.contains("deploy/demo.toml (built in)"),
+        "{}",
+        start.1
+    );
+    assert!(
+        !shm_entries(&prefix).is_empty(),
+        "no iceoryx2 files while running?"
+    );
+    let t0 = Instant::now();
+    io.signal(Signal::SIGINT);
+    let st = io.wait_exit(Duration::from_secs(2)).expect("no exit");
+    println!("exit after SIGINT in {:?}", t0.elapsed());
+    assert_eq!(st.code(), Some(0), "{}", io.stderr());
+    assert!(io.find(STOP_LINE).is_some());
+    assert!(
+        io.find("node-counter segment removed").is_some(),
+        "{}",
+        io.stderr()
+    );
+    // motion-io cleaned up by itself: nothing of the domain is left
+    assert_eq!(shm_entries(&prefix), Vec::<String>::new());
+    finish(None, &prefix);
+}
+
+#[test]
+fn sigkilled_peer_is_cleaned_up_by_the_helper() {
+    let prefix = unique_prefix();
+    let _guard = DomainGuard(prefix.clone());
+    let mut io = Io::spawn(&["--service-prefix", &prefix]);
+    io.wait_line("backend sim", Duration::from_secs(10))
+        .expect("start line");
+    let mut sup = Sup::new(&prefix);
+    sup.connect(4);
+    drop(sup);
+    let killed = Instant::now();
+    io.kill9();
+    assert!(
+        !shm_entries(&prefix).is_empty(),
+        "a killed process leaves files"
+    );
+
+    // the killed node shows as dead after a moment; the helper cleans it
+    let cfg = IpcConfig::new(&prefix);
+    let mut cleaned = 0;
+    loop {
+        let r = cleanup_domain(&cfg);
+        cleaned += r.dead_cleaned;
+        if r.domain_gone() && r.removed_global_mgmt {
+            println!(
+                "{:?} after SIGKILL: {r}; dead nodes cleaned: {cleaned}",
+                killed.elapsed()
+            );
+            break;
+        }
+        assert!(
+            killed.elapsed() < Duration::from_secs(5),
+            "not cleaned: {r:?}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert_eq!(cleaned, 1);
+    assert_eq!(shm_entries(&prefix), Vec::<String>::new());
+}

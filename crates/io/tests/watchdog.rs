@@ -1,0 +1,279 @@
+//! The command watchdog: the supervisor falls silent, motion-io stops every
+//! axis, disables it with a fault, and (with `--exit-with-supervisor`) exits;
+//! without the flag it serves a new supervisor when commands resume.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::*;
+use motion_frames::{AxisCommand, FeedbackFrame, CW_ENABLE, SW_ENABLED, SW_FAULT};
+use nix::sys::signal::Signal;
+
+const WATCHDOG_CYCLES: u32 = 20;
+const STEP: i64 = 30; // counts per cycle = 30 units/s
+const WATCHDOG_LINE: &str = "motion-io: watchdog: no command for ";
+const STOPPED_LINE: &str = "motion-io: watchdog: every axis stopped and disabled";
+
+fn moving(pos: i64) -> impl FnOnce(&mut motion_frames::CommandFrame) {
+    move |f| {
+        f.header.axis_count = 1;
+        f.axes[0] = AxisCommand {
+            target_position: pos,
+            target_velocity: (STEP * 1000) as f64,
+            torque_limit_positive: 100.0,
+            torque_limit_negative: 100.0,
+            control_word: CW_ENABLE,
+            ..AxisCommand::ZERO
+        };
+    }
+}
+
+/// 100 commands, enabled and moving; returns the last commanded position
+/// and when its answer arrived.
+fn drive_100(sup: &mut Sup) -> (i64, Instant) {
+    let mut pacer = Pacer::new(Duration::from_millis(1));
+    let mut pos = 0;
+    let mut last = None;
+    for k in 0..100 {
+        pacer.wait();
+        if k >= 3 {
+            pos += STEP;
+        }
+        let a = sup
+            .exchange(moving(pos), Duration::from_secs(2))
+            .expect("answer");
+        if k >= 2 {
+            assert_eq!(a.fb.axes[0].status_word, SW_ENABLED, "k {k}");
+            assert_eq!(a.fb.axes[0].position, pos);
+        }
+        last = Some(Instant::now());
+    }
+    (pos, last.unwrap())
+}
+
+/// Keeps receiving feedback until `until` holds or `timeout` passes.
+fn collect_until(
+    sup: &mut Sup,
+    io: &mut Io,
+    timeout: Duration,
+    mut until: impl FnMut(&mut Io) -> bool,
+) -> Vec<FeedbackFrame> {
+    let deadline = Instant::now() + timeout;
+    let mut frames = Vec::new();
+    while Instant::now() < deadline {
+        let _ = sup.ports.wait(Duration::from_millis(2));
+        while let Some(f) = sup.latest() {
+            frames.push(*f);
+        }
+        if until(io) {
+            break;
+        }
+    }
+    frames
+}
+
+/// Checks the stop as seen in the unsolicited feedback frames.
+fn check_stop(frames: &[FeedbackFrame], last_pos: i64) -> FeedbackFrame {
+    let stop: Vec<_> = frames.iter().filter(|f| f.answers_sequence == 0).collect();
+    assert!(!stop.is_empty(), "no feedback during the stop");
+    let mut prev_pos = last_pos;
+    let mut prev_vel = (STEP * 1000) as f64;
+    for f in &stop {
+        assert_eq!(f.header.axis_count, 1);
+        assert_eq!(f.io_received_ns, 0);
+        let ax = &f.axes[0];
+        assert!(ax.position >= prev_pos, "moved backwards: {ax:?}");
+        assert!(ax.velocity <= prev_vel + 1e-6, "accelerated: {ax:?}");
+        assert!(ax.velocity >= 0.0);
+        prev_pos = ax.position;
+        prev_vel = ax.velocity;
+    }
+    let last = stop[stop.len() - 1];
+    let ax = &last.axes[0];
+    assert_eq!(ax.velocity, 0.0, "{ax:?}");
+    assert_ne!(ax.status_word & SW_FAULT, 0, "no fault: {ax:?}");
+    assert_eq!(ax.status_word & SW_ENABLED, 0, "still enabled: {ax:?}");
+    // 30 units/s at 500 units/s²: 0.9 units ideal, 0.885 in 1 ms steps
+    let travelled = ax.position - last_pos;
+    assert!(
+        (850..=920).contains(&travelled),
+        "stopping distance {travelled} counts"
+    );
+    println!(
+        "stop seen in {} feedback frames: {travelled} counts after the last command",
+        stop.len()
+    );
+    *last
+}
+
+fn parse_watchdog_line(line: &str) -> (u64, f64) {
+    // "motion-io: watchdog: no command for N cycles (X ms): stopping every axis"
+    let rest = line.split(WATCHDOG_LINE).nth(1).expect("watchdog line");
+    let (n, rest) = rest.split_once(" cycles (").expect("cycles");
+    let (ms, tail) = rest.split_once(" ms)").expect("ms");
+    assert_eq!(tail, ": stopping every axis", "{line}");
+    (n.parse().unwrap(), ms.parse().unwrap())
+}
+
+fn watchdog_stop_and_exit(spin: bool) {
+    let prefix = unique_prefix();
+    let _guard = DomainGuard(prefix.clone());
+    let cfg = TempConfig::new("wd", &one_axis_toml("iotest_unused", WATCHDOG_CYCLES));
+    // --quiet: no start line to wait for, so the supervisor side comes first
+    let mut sup = Sup::new(&prefix);
+    let cfg_arg = cfg.arg();
+    let mut args = vec![
+        "--config",
+        &cfg_arg,
+        "--service-prefix",
+        &prefix,
+        "--exit-with-supervisor",
+        "--quiet",
+    ];
+    if spin {
+        args.push("--spin");
+    }
+    let mut io = Io::spawn(&args);
+    sup.connect(1);
+    let (last_pos, last_at) = drive_100(&mut sup);
+
+    // silence: keep receiving feedback as a live supervisor would
+    let frames = collect_until(&mut sup, &mut io, Duration::from_secs(10), |io| {
+        io.find(STOPPED_LINE).is_some()
+    });
+    let w = io.find(WATCHDOG_LINE).expect("watchdog line");
+    let s = io.find(STOPPED_LINE).expect("stopped line");
+    assert!(w < s);
+    assert_eq!(io.count(WATCHDOG_LINE), 1, "one watchdog line");
+    let (wd_at, wd_line) = io.lines[w].clone();
+    let (cycles, ms) = parse_watchdog_line(&wd_line);
+    let after = wd_at.duration_since(last_at);
+    println!("watchdog line {after:?} after the last answer: {cycles} cycles, {ms} ms");
+    assert!(cycles >= u64::from(WATCHDOG_CYCLES));
+    assert!(ms >= f64::from(WATCHDOG_CYCLES) - 0.5);
+    assert!(
+        after < Duration::from_millis(u64::from(WATCHDOG_CYCLES) + 1000),
+        "watchdog too late: {after:?}"
+    );
+    check_stop(&frames, last_pos);
+    // --quiet hides the informational lines, not the watchdog
+    assert!(io.find("first command").is_none(), "{}", io.stderr());
+
+    // gone supervisor: exit 0 about 1 s after the stop
+    let stopped_at = io.lines[s].0;
+    let st = io
+        .wait_exit(Duration::from_secs(10))
+        .expect("motion-io did not exit");
+    let exit_after = stopped_at.elapsed();
+    println!("exited {exit_after:?} after the stopped line: {st:?}");
+    assert_eq!(st.code(), Some(0), "{}", io.stderr());
+    assert!(exit_after >= Duration::from_millis(900), "{exit_after:?}");
+    finish(Some(sup), &prefix);
+}
+
+#[test]
+fn watchdog_stops_every_axis_then_exits_with_the_supervisor() {
+    watchdog_stop_and_exit(false);
+}
+
+#[test]
+fn watchdog_in_spin_mode() {
+    watchdog_stop_and_exit(true);
+}
+
+#[test]
+fn watchdog_then_commands_resume_with_the_fault_handshake() {
+    let prefix = unique_prefix();
+    let _guard = DomainGuard(prefix.clone());
+    let cfg = TempConfig::new("wdr", &one_axis_toml("iotest_unused", WATCHDOG_CYCLES));
+    let mut io = Io::spawn(&["--config", &cfg.arg(), "--service-prefix", &prefix]);
+    io.wait_line("backend sim", Duration::from_secs(10))
+        .expect("start line");
+    let mut sup = Sup::new(&prefix);
+    sup.connect(1);
+    let (last_pos, _) = drive_100(&mut sup);
+    let frames = collect_until(&mut sup, &mut io, Duration::from_secs(10), |io| {
+        io.find(STOPPED_LINE).is_some()
+    });
+    let stopped = check_stop(&frames, last_pos);
+    let at = stopped.axes[0].position;
+    assert!(io.find("commands resumed").is_none());
+
+    // without --exit-with-supervisor it keeps waiting (well past 1 s)
+    let frames = collect_until(&mut sup, &mut io, Duration::from_millis(1500), |_| false);
+    assert!(io.wait_exit(Duration::ZERO).is_none(), "exited");
+    // status heartbeat while stopped
+    assert!(
+        frames
+            .iter()
+            .any(|f| f.answers_sequence == 0 && f.axes[0].status_word == SW_FAULT),
+        "no heartbeat"
+    );
+
+    let hold = |enable: bool| {
+        move |f: &mut motion_frames::CommandFrame| {
+            f.header.axis_count = 1;
+            f.axes[0] = AxisCommand {
+                target_position: at,
+                torque_limit_positive: 100.0,
+                torque_limit_negative: 100.0,
+                control_word: if enable { CW_ENABLE } else { 0 },
+                ..AxisCommand::ZERO
+            };
+        }
+    };
+    let t = Duration::from_secs(2);
+    // enable still requested: no edge, the fault stays
+    let a = sup.exchange(hold(true), t).expect("answer");
+    assert_eq!(a.fb.axes[0].status_word, SW_FAULT);
+    assert_eq!(a.fb.axes[0].position, at);
+    assert!(io
+        .wait_line("motion-io: commands resumed", Duration::from_secs(2))
+        .is_some());
+    // false -> true resets the fault; enabled after the enable delay
+    let a = sup.exchange(hold(false), t).expect("answer");
+    assert_eq!(
+        a.fb.axes[0].status_word, SW_FAULT,
+        "still reported while off"
+    );
+    let mut status = Vec::new();
+    for _ in 0..4 {
+        let a = sup.exchange(hold(true), t).expect("answer");
+        status.push(a.fb.axes[0].status_word);
+    }
+    assert_eq!(status, [0, 0, SW_ENABLED, SW_ENABLED]);
+    assert_eq!(io.count("commands resumed"), 1);
+
+    io.signal(Signal::SIGTERM);
+    let st = io.wait_exit(Duration::from_secs(5)).expect("exit");
+    assert_eq!(st.code(), Some(0), "{}", io.stderr());
+    finish(Some(sup), &prefix);
+}
+
+#[test]
+fn exit_with_supervisor_but_no_supervisor_exits_1_after_10_s() {
+    let prefix = unique_prefix();
+    let _guard = DomainGuard(prefix.clone());
+    let cfg = TempConfig::new("nosup", &one_axis_toml("iotest_unused", WATCHDOG_CYCLES));
+    let t0 = Instant::now();
+    let mut io = Io::spawn(&[
+        "--config",
+        &cfg.arg(),
+        "--service-prefix",
+        &prefix,
+        "--exit-with-supervisor",
+    ]);
+    let st = io.wait_exit(Duration::from_secs(20)).expect("no exit");
+    let took = t0.elapsed();
+    println!("exited after {took:?}: {st:?}");
+    assert_eq!(st.code(), Some(1), "{}", io.stderr());
+    assert!(took >= Duration::from_secs(10), "{took:?}");
+    assert!(
+        io.find("error: no command from the supervisor within 10 s")
+            .is_some(),
+        "{}",
+        io.stderr()
+    );
+    finish(None, &prefix);
+}
