@@ -76,6 +76,23 @@ impl<'a> Reader<'a> {
         }
     }
 
+    pub fn i32(&mut self, key: &str, default: i32) -> i32 {
+        match self.get(key) {
+            None => default,
+            Some(toml::Value::Integer(i)) => match i32::try_from(*i) {
+                Ok(x) => x,
+                Err(_) => {
+                    self.problem(key, format!("{i} is not a 32-bit integer"));
+                    default
+                }
+            },
+            Some(v) => {
+                self.wrong_type(key, "an integer", v);
+                default
+            }
+        }
+    }
+
     pub fn bool(&mut self, key: &str, default: bool) -> bool {
         match self.get(key) {
             None => default,

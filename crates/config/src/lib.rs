@@ -48,6 +48,15 @@ pub struct SupervisorConfig {
     pub io_watchdog_cycles: u32,
     /// `mlockall` the process (default true).
     pub lock_memory: bool,
+    /// SCHED_FIFO priority of a spawned `motion-io` (0: normal scheduling).
+    /// Default: 10 below the cycle, still above the kernel's IRQ threads (50).
+    pub io_priority: i32,
+    /// CPU a spawned `motion-io` is pinned to; `None`: another CPU than the
+    /// cycle's, if the machine has one.
+    pub io_cpu: Option<usize>,
+    /// Hold `/dev/cpu_dma_latency` at this many µs while running (default 0,
+    /// as cyclictest does); negative: leave the idle states alone.
+    pub cpu_dma_latency_us: i32,
 }
 
 impl SupervisorConfig {
@@ -81,7 +90,7 @@ impl MachineConfig {
 pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
     let table: toml::Table = match text.parse() {
         Ok(t) => t,
-        Err(e) => return Err(vec![Problem::syntax(&e)]),
+        Err(e) => return Err(vec![Problem::syntax(text, &e)]),
     };
     let mut problems = Vec::new();
     let mut top = Reader::new(&table, None, "", &mut problems);
@@ -161,6 +170,18 @@ fn parse_supervisor(t: Option<&toml::Table>, problems: &mut Vec<Problem>) -> Sup
     let stale_cycles = r.u32("stale_cycles", 3);
     let io_watchdog_cycles = r.u32("io_watchdog_cycles", 50);
     let lock_memory = r.bool("lock_memory", true);
+    let cpu_dma_latency_us = r.i32("cpu_dma_latency_us", 0);
+    let io_priority = r.i32("io_priority", (priority - 10).max(1));
+    let io_cpu = match r.i32("io_cpu", -1) {
+        c if c >= 0 => Some(c as usize),
+        _ => None,
+    };
+    if !(0..=99).contains(&io_priority) {
+        r.problem(
+            "io_priority",
+            format!("{io_priority} is outside 0..=99 (0: normal scheduling)"),
+        );
+    }
     if !(20..=100_000).contains(&cycle_us) {
         r.problem("cycle_us", format!("{cycle_us} µs is outside 20..=100000"));
     }
@@ -194,6 +215,9 @@ fn parse_supervisor(t: Option<&toml::Table>, problems: &mut Vec<Problem>) -> Sup
         stale_cycles,
         io_watchdog_cycles,
         lock_memory,
+        io_priority,
+        io_cpu,
+        cpu_dma_latency_us,
     }
 }
 

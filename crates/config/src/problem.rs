@@ -33,10 +33,16 @@ impl Problem {
         }
     }
 
-    pub fn syntax(e: &toml::de::Error) -> Self {
+    /// A TOML syntax error, located by line and column in `text`.
+    pub fn syntax(text: &str, e: &toml::de::Error) -> Self {
         let msg = e.message().to_string();
         let key = match e.span() {
-            Some(s) => format!("byte {}", s.start),
+            Some(s) => {
+                let before = &text[..s.start.min(text.len())];
+                let line = before.matches('\n').count() + 1;
+                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                format!("line {line}, column {col}")
+            }
             None => "file".to_string(),
         };
         Self::new(None, &key, format!("TOML syntax: {msg}"))

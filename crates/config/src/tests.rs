@@ -8,7 +8,7 @@ fn demo_parses() {
     let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["U", "X", "C", "Z"]);
     assert_eq!(m.axes[1].sim.switch, Some((0.0, 5.0)));
-    assert_eq!(m.axes[0].engine.stale_limit, 5);
+    assert_eq!(m.axes[0].engine.stale_limit, 10);
 }
 
 #[test]
@@ -66,6 +66,7 @@ fn duplicate_names_and_syntax_errors() {
         .any(|p| p.to_string() == "axis A: name: axis name used twice"));
     let p = parse("[[axis]\n").unwrap_err();
     assert!(p[0].message.starts_with("TOML syntax"));
+    assert_eq!(p[0].key, "line 1, column 8", "{}", p[0]);
     let p = parse("[supervisor]\n").unwrap_err();
     assert!(p.iter().any(|p| p.key == "axis"));
 }

@@ -62,6 +62,7 @@ mod allocator;
 pub mod clock;
 pub mod counting;
 pub mod environment;
+pub mod pm_qos;
 mod pool;
 mod remote_free;
 pub mod thread;
@@ -70,6 +71,7 @@ pub mod timer;
 pub use allocator::RtAllocator;
 pub use clock::now_ns;
 pub use environment::check_environment;
+pub use pm_qos::{hold_cpu_dma_latency, DmaLatencyGuard};
 pub use thread::{enter_realtime, RtConfig, RtReport, SchedPolicy};
 pub use timer::{PeriodicTimer, Wakeup};
 

@@ -26,7 +26,6 @@ use motion_rt::{counting, enter_realtime, now_ns, rt_pool, PeriodicTimer, RtConf
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::thread::JoinHandle;
-use std::time::Duration;
 
 pub struct RtSettings {
     pub machine: MachineConfig,
@@ -181,11 +180,7 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
             let budget_end = wake.deadline_ns + s.reply_budget_ns;
             // At most a few wake-ups per cycle (a stray one, then ours).
             for _ in 0..4 {
-                let now = now_ns();
-                if now >= budget_end {
-                    break;
-                }
-                match ports.wait(Duration::from_nanos(budget_end - now)) {
+                match ports.wait_until(budget_end) {
                     Ok(true) | Err(_) => {
                         if let Ok(Some(sample)) = ports.receive_latest() {
                             let answers = sample.payload().answers_sequence;

@@ -32,10 +32,15 @@ pub struct Session {
     pub totals: HistSet,
     started: Instant,
     prefix: String,
+    /// PM QoS request held for the session (dropped at the end).
+    _idle_latency: Option<motion_rt::DmaLatencyGuard>,
+    /// Warnings about the environment, printed once.
+    pub warnings: Vec<String>,
 }
 
 /// What is left after [`Session::finish`].
 pub struct Finished {
+    pub warnings: Vec<String>,
     pub machine: MachineConfig,
     pub outcome: Option<RtOutcome>,
     pub totals: HistSet,
@@ -48,9 +53,42 @@ pub struct Finished {
     pub wall_s: f64,
 }
 
+/// Where a spawned `motion-io` runs: pinned to another CPU than the cycle
+/// (it must not wake up on the real-time core) and SCHED_FIFO below the
+/// cycle, as a fieldbus master would be. A starved I/O process shows up as
+/// stale feedback, and the engines abort homing on that.
+fn io_placement(m: &MachineConfig) -> Vec<String> {
+    let sup = &m.supervisor;
+    let mut args = Vec::new();
+    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cpu = sup
+        .io_cpu
+        .or_else(|| (cpus > 1).then_some(if sup.cpu == 0 { 1 } else { 0 }));
+    if let Some(c) = cpu {
+        args.push("--cpu".to_string());
+        args.push(c.to_string());
+    }
+    if sup.io_priority > 0 {
+        args.push("--priority".to_string());
+        args.push(sup.io_priority.to_string());
+    }
+    args
+}
+
 impl Session {
     pub fn start(machine: MachineConfig, opts: &SessionOptions) -> Result<Session, String> {
         signals::install();
+        let mut warnings = Vec::new();
+        let idle_latency = match machine.supervisor.cpu_dma_latency_us {
+            us if us >= 0 => match motion_rt::hold_cpu_dma_latency(us) {
+                Ok(g) => Some(g),
+                Err(w) => {
+                    warnings.push(w);
+                    None
+                }
+            },
+            _ => None,
+        };
         let shared = Arc::new(Shared::new(4, 8));
         let settings = RtSettings::new(machine.clone(), opts.service_prefix.clone());
         let rt = rt_thread::spawn(settings, shared.clone())
@@ -64,6 +102,8 @@ impl Session {
             totals: HistSet::new(),
             started: Instant::now(),
             prefix: opts.service_prefix.clone(),
+            _idle_latency: idle_latency,
+            warnings,
         };
         // The thread creates the ports before it says Running.
         let until = Instant::now() + Duration::from_secs(10);
@@ -78,11 +118,10 @@ impl Session {
             }
         }
         if s.machine.supervisor.io == IoMode::Sim {
-            let io = IoChild::spawn(
-                opts.config_path.as_deref(),
-                &opts.service_prefix,
-                &opts.io_args,
-            );
+            // Options given by the caller come last and win.
+            let mut args = io_placement(&s.machine);
+            args.extend(opts.io_args.iter().cloned());
+            let io = IoChild::spawn(opts.config_path.as_deref(), &opts.service_prefix, &args);
             match io {
                 Ok(io) => s.io = Some(io),
                 Err(e) => {
@@ -112,6 +151,9 @@ impl Session {
             }
             if let Some(e) = self.check_alive() {
                 return Err(e);
+            }
+            if let Some(sig) = signals::received() {
+                return Err(format!("signal {sig} while waiting for the I/O process"));
             }
             if Instant::now() > until {
                 let how = match self.machine.supervisor.io {
@@ -199,6 +241,7 @@ impl Session {
         let _ =
             motion_frames::ipc::cleanup_domain(&motion_frames::IpcConfig::new(self.prefix.clone()));
         Finished {
+            warnings: std::mem::take(&mut self.warnings),
             machine: self.machine.clone(),
             outcome,
             totals: std::mem::take(&mut self.totals),

@@ -45,17 +45,15 @@ pub fn home(common: &Common, names: &[String], json: bool, parallel: bool, timeo
         session.finish();
         return 1;
     }
-    if !json {
-        eprintln!(
-            "motion-supervisor: homing {} axis(es) of {source}{}",
-            order.len(),
-            if parallel {
-                " in parallel"
-            } else {
-                " in config order"
-            }
-        );
-    }
+    eprintln!(
+        "motion-supervisor: homing {} axis(es) of {source}{}",
+        order.len(),
+        if parallel {
+            " in parallel"
+        } else {
+            " in config order"
+        }
+    );
 
     let mut notes: Vec<Option<String>> = vec![None; session.machine.axes.len()];
     let mut interrupted = None;
@@ -109,6 +107,23 @@ pub fn home(common: &Common, names: &[String], json: bool, parallel: bool, timeo
     }
     if let Some(sig) = interrupted {
         eprintln!("motion-supervisor: signal {sig}: stopping every axis");
+        // Stop what is in process and let it come to rest, so the result
+        // shows how homing ended (ERR 12 / EXERR 1) before leaving.
+        for &i in &order {
+            session.send(Control::Stop(i));
+        }
+        let until = Instant::now() + Duration::from_secs(10);
+        while Instant::now() < until {
+            std::thread::sleep(Duration::from_millis(10));
+            session.poll();
+            let busy = order.iter().any(|&i| {
+                let s = snap_of(&session, i);
+                s.status.ip || s.status.stopping || s.cmd_velocity != 0.0
+            });
+            if !busy {
+                break;
+            }
+        }
     }
     if let Some(e) = session.check_alive() {
         eprintln!("motion-supervisor: {e}");

@@ -63,6 +63,9 @@ fn rt_lines(f: &crate::session::Finished) -> Vec<String> {
     if let Some(r) = f.outcome.as_ref().and_then(|o| o.report.as_ref()) {
         out.push(format!("real-time thread: {r}"));
     }
+    for w in &f.warnings {
+        out.push(format!("  warning: {w}"));
+    }
     out.push(format!(
         "allocations in the cycle after warm-up: {} system-allocator calls, {} served by the RT pool",
         f.system_calls_in_cycle, f.pool_allocs_in_cycle
@@ -87,6 +90,7 @@ fn rt_json(f: &crate::session::Finished) -> serde_json::Value {
             "memory_locked": r.memory_locked,
             "warnings": r.warnings,
         })),
+        "warnings": f.warnings,
         "allocations": {
             "system_calls_in_cycle": f.system_calls_in_cycle,
             "pool_allocs_in_cycle": f.pool_allocs_in_cycle,
