@@ -1,1 +1,282 @@
-//! Helpers for the end-to-end tests.
+//! Helpers for the end-to-end tests: locate the binaries, write configs with
+//! unique service prefixes, run processes, find leftovers in /dev/shm.
+//!
+//! Every test uses its own iceoryx2 service prefix, so tests run in parallel
+//! and each can check that it left nothing behind.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+/// `target/<profile>/<name>`, found from the test executable's location
+/// (`target/<profile>/deps/<test>`).
+pub fn bin(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    let dir = exe.parent().and_then(Path::parent).expect("target dir");
+    let p = dir.join(name);
+    assert!(
+        p.exists(),
+        "{} not built: run the tests with `cargo test --workspace`",
+        p.display()
+    );
+    p
+}
+
+/// A service prefix no other test (or run) uses.
+pub fn unique_prefix(tag: &str) -> String {
+    static N: AtomicU32 = AtomicU32::new(0);
+    format!(
+        "e2e_{tag}_{}_{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    )
+}
+
+/// A config file removed on drop.
+pub struct TempConfig {
+    pub path: PathBuf,
+    pub prefix: String,
+}
+
+impl Drop for TempConfig {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Writes `[supervisor]` (1 kHz, the unique prefix, sim I/O) and `axes`.
+/// `stale_cycles` is generous: several tests run in parallel on a small CI
+/// machine, and these tests are about sequences, not about a starved peer.
+pub fn config(tag: &str, supervisor_extra: &str, axes: &str) -> TempConfig {
+    let prefix = unique_prefix(tag);
+    let path = std::env::temp_dir().join(format!("{prefix}.toml"));
+    let stale = if supervisor_extra.contains("stale_cycles") {
+        ""
+    } else {
+        "stale_cycles = 20\n"
+    };
+    let text = format!(
+        "[supervisor]\ncycle_us = 1000\ncpu = 1\npriority = 80\nio = \"sim\"\n\
+         service_prefix = \"{prefix}\"\n{stale}{supervisor_extra}\n{axes}"
+    );
+    std::fs::write(&path, text).expect("write config");
+    TempConfig { path, prefix }
+}
+
+/// Files of this prefix's iceoryx2 domain in /dev/shm.
+pub fn shm_leftovers(prefix: &str) -> Vec<String> {
+    let want = format!("iox2_{prefix}_");
+    std::fs::read_dir("/dev/shm")
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.starts_with(&want))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Asserts that the domain left nothing behind (waits briefly: a process
+/// may still be cleaning up when its parent has already returned).
+pub fn assert_clean(prefix: &str) {
+    let until = Instant::now() + Duration::from_secs(3);
+    loop {
+        let left = shm_leftovers(prefix);
+        if left.is_empty() {
+            return;
+        }
+        assert!(Instant::now() < until, "left in /dev/shm: {left:?}");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// Result of a finished process.
+pub struct Run {
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+impl Run {
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::from_str(self.stdout.trim()).unwrap_or_else(|e| {
+            panic!(
+                "stdout is not JSON ({e}):\n{}\nstderr:\n{}",
+                self.stdout, self.stderr
+            )
+        })
+    }
+}
+
+impl From<Output> for Run {
+    fn from(o: Output) -> Self {
+        Run {
+            code: o.status.code(),
+            stdout: String::from_utf8_lossy(&o.stdout).into_owned(),
+            stderr: String::from_utf8_lossy(&o.stderr).into_owned(),
+        }
+    }
+}
+
+/// Runs `motion-supervisor <args>` to completion.
+pub fn supervisor(args: &[&str]) -> Run {
+    Command::new(bin("motion-supervisor"))
+        .args(args)
+        .env("MOTION_IO_BIN", bin("motion-io"))
+        .output()
+        .expect("run motion-supervisor")
+        .into()
+}
+
+/// Starts `motion-supervisor <args>` with piped stdout/stderr.
+pub fn spawn_supervisor(args: &[&str]) -> Child {
+    Command::new(bin("motion-supervisor"))
+        .args(args)
+        .env("MOTION_IO_BIN", bin("motion-io"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn motion-supervisor")
+}
+
+/// A running process whose stderr is read line by line in the background,
+/// so a test can wait for a message and still get everything at the end.
+pub struct Watched {
+    pub child: Child,
+    lines: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+    reader: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Watched {
+    pub fn new(mut child: Child) -> Self {
+        let lines = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let err = child.stderr.take().expect("piped stderr");
+        let sink = lines.clone();
+        let reader = std::thread::spawn(move || {
+            use std::io::BufRead;
+            for l in std::io::BufReader::new(err).lines().map_while(Result::ok) {
+                sink.lock().unwrap().push(l);
+            }
+        });
+        Self {
+            child,
+            lines,
+            reader: Some(reader),
+        }
+    }
+
+    /// Waits until a stderr line contains `needle`.
+    pub fn wait_line(&self, needle: &str, timeout: Duration) -> bool {
+        wait_for(timeout, || {
+            self.lines
+                .lock()
+                .unwrap()
+                .iter()
+                .any(|l| l.contains(needle))
+        })
+    }
+
+    /// Waits for the process (and everyone holding its stderr) to finish.
+    pub fn finish(mut self) -> Run {
+        let mut stdout = String::new();
+        if let Some(mut o) = self.child.stdout.take() {
+            let _ = o.read_to_string(&mut stdout);
+        }
+        let status = self.child.wait().expect("wait");
+        if let Some(r) = self.reader.take() {
+            let _ = r.join();
+        }
+        let stderr = self.lines.lock().unwrap().join("\n");
+        Run {
+            code: status.code(),
+            stdout,
+            stderr,
+        }
+    }
+}
+
+/// Collects a child's output (waits for it to exit).
+pub fn finish(mut child: Child) -> Run {
+    let mut stdout = String::new();
+    let mut stderr = String::new();
+    if let Some(mut o) = child.stdout.take() {
+        let _ = o.read_to_string(&mut stdout);
+    }
+    if let Some(mut e) = child.stderr.take() {
+        let _ = e.read_to_string(&mut stderr);
+    }
+    let status = child.wait().expect("wait");
+    Run {
+        code: status.code(),
+        stdout,
+        stderr,
+    }
+}
+
+/// Pid of a running process whose command line contains `needle` and whose
+/// executable is `name`.
+pub fn find_process(name: &str, needle: &str) -> Option<i32> {
+    for e in std::fs::read_dir("/proc").ok()?.flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else {
+            continue;
+        };
+        let Ok(cmd) = std::fs::read(format!("/proc/{pid}/cmdline")) else {
+            continue;
+        };
+        let args: Vec<String> = cmd
+            .split(|b| *b == 0)
+            .map(|a| String::from_utf8_lossy(a).into_owned())
+            .collect();
+        let is_name = args.first().is_some_and(|a| a.ends_with(name));
+        if is_name && args.iter().any(|a| a == needle) {
+            return Some(pid);
+        }
+    }
+    None
+}
+
+/// Waits until `f` is true or `timeout` passes.
+pub fn wait_for(timeout: Duration, mut f: impl FnMut() -> bool) -> bool {
+    let until = Instant::now() + timeout;
+    while Instant::now() < until {
+        if f() {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    f()
+}
+
+/// Sends `sig` to `pid`.
+pub fn signal(pid: i32, sig: nix::sys::signal::Signal) {
+    let _ = nix::sys::signal::kill(nix::unistd::Pid::from_raw(pid), sig);
+}
+
+/// The row of axis `name` in `home --json` output.
+pub fn axis<'a>(v: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    v["axes"]
+        .as_array()
+        .and_then(|a| a.iter().find(|r| r["name"] == name))
+        .unwrap_or_else(|| panic!("no axis {name} in {v}"))
+}
+
+/// `x` as f64 (panics with context).
+pub fn num(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} is not a number in {v}"))
+}
+
+/// One count at 1000 counts per unit, plus rounding.
+pub const COUNT: f64 = 0.001 + 1e-9;
+
+pub fn close(v: &serde_json::Value, key: &str, want: f64, tol: f64) {
+    let got = num(v, key);
+    assert!(
+        (got - want).abs() <= tol,
+        "{} {key} = {got}, want {want} ± {tol}\n{v}",
+        v["name"]
+    );
+}

@@ -1,0 +1,198 @@
+//! Failures end to end: a dead I/O process, a dead supervisor, a signal,
+//! a broken config. Nothing may hang, move on bad data, or leave shared
+//! memory behind.
+
+use motion_tests::*;
+use nix::sys::signal::Signal;
+use std::time::Duration;
+
+/// One slow linear axis: a switch 40 units away at 5 u/s (8 s of seeking).
+fn slow_axis(tag: &str) -> TempConfig {
+    config(
+        tag,
+        "stale_cycles = 5\nio_watchdog_cycles = 50\n",
+        r#"
+[[axis]]
+name = "S"
+counts_per_unit = 1000.0
+home_sequence = "switch"
+home_direction = "bidirectional_forward"
+home_speed = 5.0
+home_return_speed = 1.0
+home_acceleration = 100.0
+home_deceleration = 100.0
+home_timeout = 60.0
+[axis.sim]
+start = -40.0
+switch = [0.0, 5.0]
+"#,
+    )
+}
+
+/// Starts `home --json` on `cfg` and returns once homing has begun.
+fn homing(cfg: &TempConfig) -> Watched {
+    let w = Watched::new(spawn_supervisor(&[
+        "home",
+        "--json",
+        "--config",
+        cfg.path.to_str().unwrap(),
+    ]));
+    assert!(
+        w.wait_line("homing 1 axis", Duration::from_secs(20)),
+        "homing never started"
+    );
+    // Into the seek.
+    std::thread::sleep(Duration::from_millis(500));
+    w
+}
+
+fn io_pid(prefix: &str) -> i32 {
+    let mut pid = None;
+    assert!(
+        wait_for(Duration::from_secs(10), || {
+            pid = find_process("motion-io", prefix);
+            pid.is_some()
+        }),
+        "motion-io for {prefix} never appeared"
+    );
+    pid.unwrap()
+}
+
+#[test]
+fn io_killed_mid_homing_aborts_the_axis_and_exits_cleanly() {
+    let cfg = slow_axis("killio");
+    let w = homing(&cfg);
+    signal(io_pid(&cfg.prefix), Signal::SIGKILL);
+    let run = w.finish();
+    assert_eq!(run.code, Some(1), "{}\n{}", run.stdout, run.stderr);
+    let v = run.json();
+    let s = axis(&v, "S");
+    assert_eq!(s["er"], true, "{s}");
+    assert_eq!(
+        (num(s, "err"), num(s, "exerr")),
+        (12.0, 40.0),
+        "feedback lost: {s}"
+    );
+    assert_eq!(s["homed"], false);
+    assert!(run.stderr.contains("motion-io"), "{}", run.stderr);
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn supervisor_killed_mid_homing_makes_io_stop_its_axes() {
+    let cfg = slow_axis("killsup");
+    let w = homing(&cfg);
+    let io = io_pid(&cfg.prefix);
+    signal(w.child.id() as i32, Signal::SIGKILL);
+    // motion-io shares the supervisor's stderr: reading it to the end waits
+    // for motion-io to stop its axes and exit on its own.
+    let run = w.finish();
+    assert!(
+        run.stderr.contains("watchdog: no command"),
+        "no watchdog report:\n{}",
+        run.stderr
+    );
+    assert!(
+        run.stderr.contains("every axis stopped"),
+        "axes not reported stopped:\n{}",
+        run.stderr
+    );
+    assert!(
+        wait_for(Duration::from_secs(5), || find_process(
+            "motion-io",
+            &cfg.prefix
+        )
+        .is_none()),
+        "motion-io {io} still running"
+    );
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn sigterm_stops_every_axis_and_exits_cleanly() {
+    let cfg = slow_axis("sigterm");
+    let w = homing(&cfg);
+    signal(w.child.id() as i32, Signal::SIGTERM);
+    let run = w.finish();
+    assert_eq!(run.code, Some(128 + 15), "{}\n{}", run.stdout, run.stderr);
+    let v = run.json();
+    let s = axis(&v, "S");
+    assert_eq!(
+        (num(s, "err"), num(s, "exerr")),
+        (12.0, 1.0),
+        "stopped on request: {s}"
+    );
+    assert!(run.stderr.contains("stopping every axis"), "{}", run.stderr);
+    assert!(wait_for(Duration::from_secs(5), || find_process(
+        "motion-io",
+        &cfg.prefix
+    )
+    .is_none()));
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn a_config_with_several_mistakes_prints_all_of_them() {
+    let cfg = config(
+        "badcfg",
+        "stale_cycles = -1\n",
+        r#"
+[[axis]]
+name = "X"
+home_sequence = "marker"
+home_speed = 0.0
+home_return_speed = 1.0
+home_acceleration = 100.0
+home_deceleration = 0.0
+home_mood = "happy"
+
+[[axis]]
+name = "Y"
+travel = "cyclic"
+unwind = 360.0
+home_position = 400.0
+home_direction = "sideways"
+"#,
+    );
+    for cmd in ["check", "home"] {
+        let run = supervisor(&[cmd, "--config", cfg.path.to_str().unwrap()]);
+        assert_eq!(run.code, Some(2), "{cmd}: {}\n{}", run.stdout, run.stderr);
+        for want in [
+            "supervisor.stale_cycles: -1 is not a non-negative 32-bit integer",
+            "axis X: home_mood: unknown key",
+            "axis X: home_speed: home speed is zero (ERR 41 EXERR 6)",
+            "axis X: home_deceleration: home deceleration is zero",
+            "axis X: home_sequence: marker sequence but the feedback device has no marker (marker = false) (ERR 41 EXERR 21)",
+            "axis Y: home_direction: \"sideways\"",
+            "axis Y: home_position: 400 is outside [0, 360) of the cyclic axis (ERR 41 EXERR 24)",
+        ] {
+            assert!(run.stderr.contains(want), "{cmd}: missing {want:?} in\n{}", run.stderr);
+        }
+    }
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn check_accepts_the_default_machine() {
+    let run = supervisor(&["check"]);
+    assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
+    assert!(run.stdout.contains("4 axes"), "{}", run.stdout);
+    assert!(
+        run.stdout.contains("real-time environment"),
+        "{}",
+        run.stdout
+    );
+}
+
+#[test]
+fn unknown_axis_is_refused() {
+    let run = supervisor(&[
+        "home",
+        "--axis",
+        "W",
+        "--service-prefix",
+        &unique_prefix("noaxis"),
+    ]);
+    assert_eq!(run.code, Some(2));
+    assert!(run.stderr.contains("no axis 'W'"), "{}", run.stderr);
+}
