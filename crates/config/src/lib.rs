@@ -283,6 +283,7 @@ fn parse_axis(
         unwind: r.f64("unwind", 0.0),
         counts_per_unit: r.f64("counts_per_unit", 1.0),
         marker: r.bool("marker", false),
+        marker_latch: r.bool("marker_latch", true),
         registration: r.bool("registration", false),
         travel_limits: r.pair("travel_limits"),
         home_mode: r.choice(
@@ -323,6 +324,7 @@ fn parse_axis(
         home_torque_threshold: r.f64("home_torque_threshold", 0.0),
         home_torque_time: r.f64("home_torque_time", 0.0),
         home_timeout: r.f64("home_timeout", 0.0),
+        home_creep_speed: r.f64("home_creep_speed", 0.0),
         search_limit: r.f64("search_limit", 0.0),
         torque_limit: r.f64("torque_limit", d.torque_limit),
         position_error_tolerance: r.f64("position_error_tolerance", 0.0),

@@ -31,7 +31,7 @@
 use motion_homing::{Command, DriveState, Edge, Feedback, LatchArm, LatchFeedback};
 
 use crate::frame::{
-    AxisCommand, AxisFeedback, CW_ENABLE, DI_HOME_SWITCH, DI_OVERTRAVEL_NEGATIVE,
+    AxisCommand, AxisFeedback, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE,
     DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED, SW_FAULT,
 };
 
@@ -149,6 +149,9 @@ pub fn feedback_to_axis(fb: &Feedback, counts_per_unit: f64) -> AxisFeedback {
     if fb.overtravel_negative {
         di |= DI_OVERTRAVEL_NEGATIVE;
     }
+    if fb.marker_pulse {
+        di |= DI_MARKER_PULSE;
+    }
     let mut sw = 0;
     if fb.drive.enabled {
         sw |= SW_ENABLED;
@@ -181,6 +184,7 @@ pub fn axis_to_feedback(af: &AxisFeedback, counts_per_unit: f64) -> Feedback {
         home_switch: af.digital_inputs & DI_HOME_SWITCH != 0,
         overtravel_positive: af.digital_inputs & DI_OVERTRAVEL_POSITIVE != 0,
         overtravel_negative: af.digital_inputs & DI_OVERTRAVEL_NEGATIVE != 0,
+        marker_pulse: af.digital_inputs & DI_MARKER_PULSE != 0,
         marker_latch: LatchFeedback {
             id: af.marker_latch_id,
             latched: af.marker_latched != 0,

@@ -73,6 +73,9 @@ pub const DI_OVERTRAVEL_POSITIVE: u32 = 1 << 1;
 /// [`AxisFeedback::digital_inputs`] bit 2: negative hardware overtravel tripped.
 /// Bits 3..=31 are reserved: sent as 0, ignored by the receiver.
 pub const DI_OVERTRAVEL_NEGATIVE: u32 = 1 << 2;
+/// [`AxisFeedback::digital_inputs`] bit 3: an encoder index pulse passed during
+/// the last cycle (for drives that cannot latch the marker position).
+pub const DI_MARKER_PULSE: u32 = 1 << 3;
 
 /// [`AxisCommand::switch_arm_edge`]: latch on the open → closed transition.
 pub const EDGE_RISING: u8 = 0;
@@ -203,7 +206,8 @@ pub struct AxisFeedback {
     /// Actual torque, % rated, signed (positive pushes forward).
     pub torque: f32,
     /// Input bits: [`DI_HOME_SWITCH`] (bit 0, contact closed),
-    /// [`DI_OVERTRAVEL_POSITIVE`] (bit 1), [`DI_OVERTRAVEL_NEGATIVE`] (bit 2);
+    /// [`DI_OVERTRAVEL_POSITIVE`] (bit 1), [`DI_OVERTRAVEL_NEGATIVE`] (bit 2),
+    /// [`DI_MARKER_PULSE`] (bit 3);
     /// bits 3..=31 reserved (0).
     pub digital_inputs: u32,
     /// Status bits: [`SW_ENABLED`] (bit 0), [`SW_FAULT`] (bit 1); bits 2..=15

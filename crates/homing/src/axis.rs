@@ -129,6 +129,9 @@ pub struct Axis {
     pc_on_rest: bool,
     /// Stopping: the release back onto the actual position has been planned.
     released: bool,
+    /// A marker was found at speed by a drive without a latch: creep back
+    /// over it once the current stop ends. Holds its approximate position.
+    creep_to: Option<f64>,
     enabling_since: u64,
     last_command: Command,
 }
@@ -169,6 +172,7 @@ impl Axis {
             torque_point: 0.0,
             pc_on_rest: false,
             released: false,
+            creep_to: None,
             enabling_since: 0,
             last_command: cmd,
         }
@@ -350,6 +354,7 @@ impl Axis {
         self.status.ip = true;
         self.status.homing = true;
         self.status.homed = false;
+        self.creep_to = None;
 
         if self.cfg.home_sequence == HomeSequence::Immediate {
             // Actual and command position become Home Position: nothing moves,
@@ -469,6 +474,7 @@ impl Axis {
                 | Phase::Return
                 | Phase::ReturnStop
                 | Phase::MoveHome
+                | Phase::Creep
         );
         if !moving_phase && self.phase != Phase::Stopping && !s.fb.drive.enabled {
             // Nobody holds the axis: follow it, so enabling never jumps.
@@ -497,7 +503,7 @@ impl Axis {
         if self.check_timeout(now) {
             return;
         }
-        if matches!(self.phase, Phase::Seek | Phase::Return) {
+        if matches!(self.phase, Phase::Seek | Phase::Return | Phase::Creep) {
             let p = self.profile.sample(now).0;
             if (p - self.search.start).abs() > self.search_limit {
                 let leg = self.phase as u16;
@@ -526,9 +532,22 @@ impl Axis {
                     self.on_seek_event(now, at);
                 }
             }
+            Phase::SeekStop | Phase::ReturnStop if done && self.creep_to.is_some() => {
+                self.start_creep(now)
+            }
             Phase::SeekStop if done => self.on_seek_stopped(now, s),
             Phase::Release if done => self.on_released(now, s),
             Phase::Return => {
+                if let Some(at) = self.detect(now, s) {
+                    if self.search.goal != Goal::SwitchClear && self.creeps() {
+                        self.creep_to = Some(at);
+                    } else {
+                        self.event(at);
+                    }
+                    self.stop_into(now, Phase::ReturnStop);
+                }
+            }
+            Phase::Creep => {
                 if let Some(at) = self.detect(now, s) {
                     self.event(at);
                     self.stop_into(now, Phase::ReturnStop);
@@ -604,15 +623,15 @@ impl Axis {
                     }
                     self.search.edge = Some(at);
                 }
-                self.marker_after_edge(s)
+                self.marker_after_edge(prev_pos, s)
             }
             Goal::SwitchDetectThenMarker => {
                 if detected && self.search.edge.is_none() {
                     self.search.edge = Some(self.edge_position(prev_pos, s));
                 }
-                self.marker_after_edge(s)
+                self.marker_after_edge(prev_pos, s)
             }
-            Goal::Marker => self.latched_marker(s),
+            Goal::Marker => self.marker_seen(prev_pos, s),
             Goal::Torque => {
                 if s.fb.torque * self.dir >= self.cfg.home_torque_threshold {
                     let since = *self.search.over_since.get_or_insert(now);
@@ -629,8 +648,8 @@ impl Axis {
 
     /// The latched marker if it lies beyond the switch edge in the direction
     /// the axis went; an earlier one is rejected and the latch re-armed.
-    fn marker_after_edge(&mut self, s: &Sample) -> Option<f64> {
-        let m = self.latched_marker(s)?;
+    fn marker_after_edge(&mut self, prev_pos: f64, s: &Sample) -> Option<f64> {
+        let m = self.marker_seen(prev_pos, s)?;
         match self.search.edge {
             Some(e) if (m - e) * (s.fb.position - e) >= 0.0 => Some(m),
             _ => {
@@ -640,9 +659,42 @@ impl Axis {
         }
     }
 
-    fn latched_marker(&self, s: &Sample) -> Option<f64> {
+    /// The marker, if one was passed: the latched position, or for a drive
+    /// without a latch the midpoint of the samples around the index pulse.
+    fn marker_seen(&self, prev_pos: f64, s: &Sample) -> Option<f64> {
+        if !self.cfg.marker_latch {
+            return s.fb.marker_pulse.then(|| 0.5 * (prev_pos + s.fb.position));
+        }
         let l = s.fb.marker_latch;
         (self.marker_id != 0 && l.id == self.marker_id && l.latched).then_some(l.position)
+    }
+
+    /// A marker found at speed is refined by a creep leg (no latch, a creep
+    /// speed, a bidirectional active sequence: creeping back reverses).
+    fn creeps(&self) -> bool {
+        !self.cfg.marker_latch
+            && self.cfg.home_creep_speed > 0.0
+            && self.cfg.home_mode == HomeMode::Active
+            && !self.cfg.home_direction.is_unidirectional()
+    }
+
+    /// At rest just past a marker found at speed: creep back over it.
+    fn start_creep(&mut self, now: u64) {
+        let Some(target) = self.creep_to.take() else {
+            return;
+        };
+        let (p, v) = self.profile.sample(now);
+        let dir = if target >= p { 1.0 } else { -1.0 };
+        self.begin_search(Goal::Marker, p);
+        self.profile = Profile::jog(
+            now,
+            p,
+            v,
+            dir * self.cfg.home_creep_speed,
+            self.cfg.home_acceleration,
+            self.cfg.home_deceleration,
+        );
+        self.phase = Phase::Creep;
     }
 
     /// Switch edge position: the registration latch where the drive has one,
@@ -676,6 +728,7 @@ impl Axis {
             return self.unidirectional_after_event(now);
         }
         match seq {
+            HomeSequence::Marker if self.creeps() => self.creep_to = Some(at),
             HomeSequence::Marker => self.event(at),
             HomeSequence::Torque => {
                 self.torque_point = at;
@@ -821,6 +874,7 @@ impl Axis {
         self.status.exerr = exerr;
         self.marker_id = 0;
         self.switch_id = 0;
+        self.creep_to = None;
         if !self.status.ip {
             // Refused at start: nothing was started, nothing to stop.
             return;

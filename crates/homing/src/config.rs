@@ -107,6 +107,10 @@ pub struct AxisConfig {
     pub counts_per_unit: f64,
     /// The feedback device has a marker and the drive latches its position.
     pub marker: bool,
+    /// The drive latches the marker position (touch probe). Without a latch
+    /// the drive only reports that an index pulse passed in the last cycle,
+    /// and the marker is known to one cycle of travel.
+    pub marker_latch: bool,
     /// The drive latches its position on the home switch edge (registration).
     pub registration: bool,
     /// Maximum negative / positive travel in axis coordinates, if known.
@@ -131,6 +135,11 @@ pub struct AxisConfig {
     pub home_timeout: f64,
 
     // --- our additions (documented in the README's config table) ---------
+    /// Creep speed (units/s) of the seek / back-off / creep scheme, for drives
+    /// without a marker latch: after a marker found at speed, stop and creep
+    /// back over it at this speed, so its uncertainty is creep × cycle / 2.
+    /// `0.0` = no creep leg. Bidirectional active sequences only.
+    pub home_creep_speed: f64,
     /// Longest distance one search leg may travel. `0.0` = derive from the
     /// travel limits (or two revolutions on a cyclic axis); with neither
     /// known the search is unbounded (and `check` warns).
@@ -161,6 +170,7 @@ impl Default for AxisConfig {
             unwind: 0.0,
             counts_per_unit: 1.0,
             marker: false,
+            marker_latch: true,
             registration: false,
             travel_limits: None,
             home_mode: HomeMode::Active,
@@ -177,6 +187,7 @@ impl Default for AxisConfig {
             home_torque_threshold: 0.0,
             home_torque_time: 0.0,
             home_timeout: 0.0,
+            home_creep_speed: 0.0,
             search_limit: 0.0,
             torque_limit: 100.0,
             position_error_tolerance: 0.0,

@@ -43,6 +43,10 @@ pub struct Feedback {
     pub overtravel_negative: bool,
     pub marker_latch: LatchFeedback,
     pub switch_latch: LatchFeedback,
+    /// An index pulse passed during the last cycle. Drives without a marker
+    /// position latch report only this (`marker_latch = false` in the
+    /// config); the engine then knows the marker to one cycle of travel.
+    pub marker_pulse: bool,
     pub drive: DriveState,
 }
 

@@ -27,6 +27,8 @@ pub enum Phase {
     Passive = 8,
     /// Aborted: decelerating to rest, then restoring overridden drive values.
     Stopping = 9,
+    /// Creeping back over a marker found at speed (drives without a latch).
+    Creep = 10,
 }
 
 impl Phase {
@@ -42,6 +44,7 @@ impl Phase {
             Phase::MoveHome => "move_home",
             Phase::Passive => "passive",
             Phase::Stopping => "stopping",
+            Phase::Creep => "creep",
         }
     }
 }

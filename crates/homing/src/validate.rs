@@ -79,6 +79,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
     p.number("home_torque_time", cfg.home_torque_time, true);
     p.number("home_timeout", cfg.home_timeout, true);
     p.number("search_limit", cfg.search_limit, true);
+    p.number("home_creep_speed", cfg.home_creep_speed, true);
     p.number("torque_limit", cfg.torque_limit, true);
     p.number(
         "position_error_tolerance",
@@ -288,6 +289,17 @@ pub fn advisories(cfg: &AxisConfig, cycle_s: f64) -> Vec<String> {
                  (half of {v} units/s x {cycle_s} s); registration = true or a marker sequence \
                  removes it",
                 0.5 * v * cycle_s
+            ));
+        }
+    }
+    if seq.uses_marker() && cfg.marker && !cfg.marker_latch {
+        let creeps =
+            moves(cfg) && !cfg.home_direction.is_unidirectional() && cfg.home_creep_speed > 0.0;
+        if !creeps {
+            out.push(format!(
+                "marker without a position latch and no creep leg: the marker is known only to \
+                 half a cycle of travel ({cycle_s} s x speed / 2); set home_creep_speed \
+                 (bidirectional) or use a drive that latches"
             ));
         }
     }

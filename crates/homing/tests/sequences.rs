@@ -354,6 +354,62 @@ fn variant_rows() -> Vec<Case> {
         },
     ));
 
+    // Drives without a marker latch: the index pulse is only known to one
+    // cycle of travel (midpoint, error <= speed x T / 2); the creep leg of
+    // the seek / back-off / creep scheme stops past it and creeps back over
+    // it at the creep speed, shrinking the error to creep x T / 2.
+    const CREEP: f64 = 0.5;
+    let sw_c = CREEP * T / 2.0 + 1e-9;
+    let (c, p) = with(Marker, BidirectionalForward, &|c, _| c.marker_latch = false);
+    rows.push(case(
+        "bidir marker, no latch, no creep: -47.5 +- 20 x 0.001 / 2",
+        c,
+        p,
+        ok(-47.5, SW_V, Final::Raw(-47.5, SW_V)),
+    ));
+    let (c, p) = with(Marker, BidirectionalForward, &|c, _| {
+        c.marker_latch = false;
+        c.home_creep_speed = CREEP;
+    });
+    rows.push(case(
+        "bidir marker, no latch, creep 0.5: -47.5 +- 0.5 x 0.001 / 2",
+        c,
+        p,
+        ok(-47.5, sw_c, Final::Raw(-47.5, sw_c)),
+    ));
+    let (c, p) = with(SwitchThenMarker, BidirectionalReverse, &|c, _| {
+        c.marker_latch = false;
+        c.home_creep_speed = CREEP;
+        c.home_offset = 1.0;
+    });
+    rows.push(case(
+        "bidir STM reverse, no latch, creep: marker 12.5 +- creep error, rest at +1",
+        c,
+        p,
+        ok(12.5, sw_c, Final::Raw(13.5, sw_c)),
+    ));
+    let (c, p) = with(TorqueThenMarker, BidirectionalForward, &|c, _| {
+        c.marker_latch = false;
+        c.home_creep_speed = CREEP;
+    });
+    rows.push(case(
+        "torque then marker, no latch, creep: 92.5 +- creep error",
+        c,
+        p,
+        ok(92.5, sw_c, Final::Raw(92.5, sw_c)),
+    ));
+    let (c, p) = with(Marker, UnidirectionalForward, &|c, _| {
+        c.marker_latch = false;
+        c.home_creep_speed = CREEP; // creeping back would reverse: not used
+        c.home_offset = 3.0;
+    });
+    rows.push(case(
+        "unidir marker, no latch: no creep (it would reverse), -47.5 +- 0.01, on to +3",
+        c,
+        p,
+        ok(-47.5, SW_V, Final::Raw(-44.5, SW_V)),
+    ));
+
     // Switch active at start.
     let (c, p) = with(Switch, BidirectionalForward, &|_, p| p.start = 2.0);
     rows.push(case(

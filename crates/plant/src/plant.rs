@@ -37,6 +37,8 @@ pub struct Plant {
     /// actual position, so taking over at standstill shows no acceleration.
     history: [f64; 2],
     marker_latch: Latch,
+    /// A marker was passed in the last step (index pulse, no position).
+    marker_pulse: bool,
     switch_latch: Latch,
 }
 
@@ -56,6 +58,7 @@ impl Plant {
             torque: 0.0,
             history: [cfg.start; 2],
             marker_latch: Latch::default(),
+            marker_pulse: false,
             switch_latch: Latch::default(),
             cfg,
         }
@@ -135,6 +138,7 @@ impl Plant {
     /// Latch the first marker and the first switch edge of the armed sense
     /// passed on `old → new`.
     fn capture(&mut self, old: f64, new: f64) {
+        self.marker_pulse = self.markers.first_passed(old, new).is_some();
         if self.marker_latch.waiting() {
             self.marker_latch
                 .capture(self.markers.first_passed(old, new));
@@ -166,6 +170,7 @@ impl Plant {
             overtravel_negative,
             marker_latch: self.marker_latch.feedback(),
             switch_latch: self.switch_latch.feedback(),
+            marker_pulse: self.marker_pulse,
             drive: self.drive.state(),
         }
     }
