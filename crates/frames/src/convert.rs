@@ -246,6 +246,7 @@ mod tests {
                 latched: false,
                 position: 0.0,
             },
+            marker_pulse: true,
             drive: DriveState {
                 enabled: true,
                 fault: true,
@@ -365,7 +366,10 @@ mod tests {
         assert_eq!(w.position, -49999);
         assert_eq!(w.velocity, 2000.0);
         assert_eq!(w.torque, -12.5);
-        assert_eq!(w.digital_inputs, DI_HOME_SWITCH | DI_OVERTRAVEL_NEGATIVE);
+        assert_eq!(
+            w.digital_inputs,
+            DI_HOME_SWITCH | DI_OVERTRAVEL_NEGATIVE | DI_MARKER_PULSE
+        );
         assert_eq!(w.status_word, SW_ENABLED | SW_FAULT);
         assert_eq!((w.marker_latch_id, w.marker_latched), (3, 1));
         assert_eq!((w.switch_latch_id, w.switch_latched), (9, 0));
