@@ -60,6 +60,7 @@ fn io_pid(prefix: &str) -> i32 {
 
 #[test]
 fn io_killed_mid_homing_aborts_the_axis_and_exits_cleanly() {
+    let _serial = serial();
     let cfg = slow_axis("killio");
     let w = homing(&cfg);
     signal(io_pid(&cfg.prefix), Signal::SIGKILL);
@@ -80,6 +81,7 @@ fn io_killed_mid_homing_aborts_the_axis_and_exits_cleanly() {
 
 #[test]
 fn supervisor_killed_mid_homing_makes_io_stop_its_axes() {
+    let _serial = serial();
     let cfg = slow_axis("killsup");
     let w = homing(&cfg);
     let io = io_pid(&cfg.prefix);
@@ -110,6 +112,7 @@ fn supervisor_killed_mid_homing_makes_io_stop_its_axes() {
 
 #[test]
 fn sigterm_stops_every_axis_and_exits_cleanly() {
+    let _serial = serial();
     let cfg = slow_axis("sigterm");
     let w = homing(&cfg);
     signal(w.child.id() as i32, Signal::SIGTERM);
@@ -133,6 +136,7 @@ fn sigterm_stops_every_axis_and_exits_cleanly() {
 
 #[test]
 fn a_config_with_several_mistakes_prints_all_of_them() {
+    let _serial = serial();
     let cfg = config(
         "badcfg",
         "stale_cycles = -1\n",
@@ -174,6 +178,7 @@ home_direction = "sideways"
 
 #[test]
 fn check_accepts_the_default_machine() {
+    let _serial = serial();
     let run = supervisor(&["check"]);
     assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
     assert!(run.stdout.contains("4 axes"), "{}", run.stdout);
@@ -186,6 +191,7 @@ fn check_accepts_the_default_machine() {
 
 #[test]
 fn unknown_axis_is_refused() {
+    let _serial = serial();
     let run = supervisor(&[
         "home",
         "--axis",

@@ -9,6 +9,7 @@ use motion_tests::*;
 
 #[test]
 fn homing_the_default_machine_makes_no_system_allocator_call() {
+    let _serial = serial();
     let prefix = unique_prefix("noalloc");
     let run = supervisor(&["home", "--json", "--service-prefix", &prefix]);
     assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
@@ -29,6 +30,7 @@ fn homing_the_default_machine_makes_no_system_allocator_call() {
 
 #[test]
 fn run_mode_makes_no_system_allocator_call() {
+    let _serial = serial();
     let prefix = unique_prefix("noalloc_run");
     let run = supervisor(&[
         "run",

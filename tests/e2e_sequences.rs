@@ -42,6 +42,7 @@ fn homed(v: &serde_json::Value, name: &str) -> serde_json::Value {
 
 #[test]
 fn switch_family() {
+    let _serial = serial();
     let cfg = config(
         "switch",
         "",
@@ -106,6 +107,7 @@ marker_at = 3.3
 
 #[test]
 fn marker_family_on_cyclic_axes() {
+    let _serial = serial();
     let cfg = config(
         "marker",
         "",
@@ -171,6 +173,7 @@ marker_at = 100.0
 
 #[test]
 fn torque_family() {
+    let _serial = serial();
     let cfg = config(
         "torque",
         "",
@@ -233,6 +236,7 @@ marker_at = 1.0
 
 #[test]
 fn passive_and_immediate_family() {
+    let _serial = serial();
     let cfg = config(
         "passive",
         "",
@@ -288,6 +292,7 @@ home_position = 3.0
 
 #[test]
 fn default_machine() {
+    let _serial = serial();
     let prefix = unique_prefix("demo");
     let run = supervisor(&["home", "--json", "--service-prefix", &prefix]);
     assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);

@@ -10,6 +10,18 @@ use std::process::{Child, Command, Output, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
+/// Runs the process-spawning tests of one test binary one at a time.
+///
+/// Each test starts a SCHED_FIFO supervisor and an I/O process; several at
+/// once on a 2-core CI machine (with a kernel that is not PREEMPT_RT, where
+/// process start-up work in the kernel is not preemptible) can starve an I/O
+/// process past `stale_cycles`, and the engines then — correctly — abort
+/// homing with ERR 12/40. These tests are about behaviour, so they take turns.
+pub fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    LOCK.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 /// `target/<profile>/<name>`, found from the test executable's location
 /// (`target/<profile>/deps/<test>`).
 pub fn bin(name: &str) -> PathBuf {
