@@ -663,7 +663,10 @@ impl Axis {
     /// without a latch the midpoint of the samples around the index pulse.
     fn marker_seen(&self, prev_pos: f64, s: &Sample) -> Option<f64> {
         if !self.cfg.marker_latch {
-            return s.fb.marker_pulse.then_some(0.5 * (prev_pos + s.fb.position));
+            return s
+                .fb
+                .marker_pulse
+                .then_some(0.5 * (prev_pos + s.fb.position));
         }
         let l = s.fb.marker_latch;
         (self.marker_id != 0 && l.id == self.marker_id && l.latched).then_some(l.position)
