@@ -870,7 +870,9 @@ impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
     /// timeout below 1 µs as "forever". Here the descriptor is polled with
     /// `ppoll`, whose timeout is an hrtimer (no slack for a SCHED_FIFO
     /// thread), and the wake-up is then consumed with `try_wait`. A past
-    /// deadline returns at once. No heap allocation.
+    /// deadline returns at once. A signal ends the wait early with
+    /// [`IpcError::Interrupted`], so the caller can look at its flags. No heap
+    /// allocation.
     pub fn wait_until(&mut self, deadline_ns: u64) -> Result<bool, IpcError> {
         loop {
             if self.try_wait()? {
@@ -895,9 +897,13 @@ impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
             if rc == 0 {
                 return self.try_wait();
             }
-            // rc > 0: readable, consumed at the top; rc < 0: EINTR (or a
-            // descriptor error that try_wait reports): go round, the
-            // deadline bounds the loop.
+            if rc < 0 && std::io::Error::last_os_error().raw_os_error() == Some(libc::EINTR) {
+                return Err(IpcError::Interrupted {
+                    service: self.rx_ready.clone(),
+                });
+            }
+            // rc > 0: readable, consumed at the top; another error is reported
+            // by try_wait at the top; the deadline bounds the loop.
         }
     }
 

@@ -13,7 +13,6 @@
 //! within 10 s (`--exit-with-supervisor`); 2 on a command-line or config
 //! mistake.
 
-mod alarm;
 mod backend;
 mod cli;
 mod run;

@@ -3,9 +3,9 @@
 //!
 //! # Timing
 //!
-//! Event mode sleeps in `Listener::timed_wait` until the supervisor's
-//! `command_ready` wake-up or the next *tick*; `--spin` polls the subscriber
-//! instead. Ticks are the clock of everything that happens without a command.
+//! Event mode sleeps in [`IoPorts::wait_until`] (`ppoll` on the listener,
+//! an hrtimer-exact timeout) until the supervisor's `command_ready` wake-up
+//! or the next *tick*; `--spin` polls the subscriber instead. Ticks are the clock of everything that happens without a command.
 //! While commands flow there is one tick, at the watchdog's deadline: the
 //! missed cycles are the time since the last command divided by the cycle,
 //! and `io_watchdog_cycles` of them trip it. Once tripped, every tick (one per
@@ -13,16 +13,13 @@
 //! after the stop the loop ticks at [`IDLE_PERIOD_NS`] only (a command still
 //! wakes it at once).
 //!
-//! The wait's own timeout is too coarse to be the clock (see
-//! [`crate::alarm`]): a POSIX timer interrupts the wait exactly at the tick.
-//! Without it (it could not be created) ticks are late by the kernel's socket
-//! timeout granularity.
+//! (iceoryx2's own `timed_wait` counts its timeout in jiffies — 4 ms at
+//! HZ=250 — and is therefore not used.)
 
 use std::time::Duration;
 
 use motion_frames::{monotonic_ns, FeedbackFrame, IoPorts, IpcError};
 
-use crate::alarm::Alarm;
 use crate::backend::Backend;
 use crate::say::{Once, Say};
 use crate::signals;
@@ -91,7 +88,6 @@ struct Faults {
     publish: Once,
     notify: Once,
     connect: Once,
-    alarm: Once,
 }
 
 struct Loop<'a> {
@@ -107,28 +103,12 @@ struct Loop<'a> {
     scratch: Box<FeedbackFrame>,
     faults: Faults,
     commands: u64,
-    /// Precise tick wake-up (event mode only).
-    alarm: Option<Alarm>,
 }
 
 /// Runs until a signal arrives or (with `--exit-with-supervisor`) the
 /// supervisor is gone. Never panics on bad frames or IPC failures: they are
 /// reported once and the loop carries on.
 pub fn run(ports: &mut IoPorts, backend: &mut dyn Backend, s: &Settings) -> Outcome {
-    let alarm = if s.spin {
-        None
-    } else {
-        match Alarm::new() {
-            Ok(a) => Some(a),
-            Err(e) => {
-                s.say.always(format_args!(
-                    "warning: {e}: watchdog ticks will be as coarse as the kernel's socket \
-                     timeouts"
-                ));
-                None
-            }
-        }
-    };
     let now = monotonic_ns();
     let mut l = Loop {
         ports,
@@ -141,7 +121,6 @@ pub fn run(ports: &mut IoPorts, backend: &mut dyn Backend, s: &Settings) -> Outc
         scratch: Box::new(FeedbackFrame::ZERO),
         faults: Faults::default(),
         commands: 0,
-        alarm,
     };
     l.run()
 }
@@ -168,8 +147,7 @@ impl Loop<'_> {
             }
             let timeout = self.next_tick_ns.saturating_sub(monotonic_ns());
             if !self.s.spin && timeout >= MIN_WAIT_NS {
-                self.arm_alarm();
-                match self.ports.wait(Duration::from_nanos(timeout)) {
+                match self.ports.wait_until(self.next_tick_ns) {
                     Ok(_) => {
                         self.faults.wait.clear();
                     }
@@ -191,18 +169,6 @@ impl Loop<'_> {
                 }
             } else if self.s.spin {
                 std::hint::spin_loop();
-            }
-        }
-    }
-
-    fn arm_alarm(&mut self) {
-        let say = self.say();
-        if let Some(alarm) = &mut self.alarm {
-            match alarm.arm_at(self.next_tick_ns) {
-                Ok(()) => {
-                    self.faults.alarm.clear();
-                }
-                Err(e) => self.faults.alarm.fail(&say, format_args!("warning: {e}")),
             }
         }
     }

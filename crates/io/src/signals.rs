@@ -5,10 +5,9 @@
 //! The iceoryx2 node is created with signal handling disabled, so these are
 //! the only handlers. They are installed with `SA_RESTART`, so that ordinary
 //! system calls (a write to stderr, a futex inside iceoryx2) are resumed
-//! transparently; the blocking wait for a command is a socket receive with
-//! `SO_RCVTIMEO`, which the kernel never restarts: it returns `EINTR` at once
-//! (reported by the ports as `IpcError::Interrupted`), and the loop sees the
-//! flag.
+//! transparently; the blocking wait for a command is a `ppoll`, which the
+//! kernel never restarts: it returns `EINTR` at once (reported by the ports
+//! as `IpcError::Interrupted`), and the loop sees the flag.
 
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 
@@ -21,10 +20,6 @@ extern "C" fn on_termination(sig: libc::c_int) {
     // async-signal-safe: two atomic stores
     SIGNAL.store(sig, Ordering::Relaxed);
     REQUESTED.store(true, Ordering::SeqCst);
-}
-
-extern "C" fn on_wakeup(_sig: libc::c_int) {
-    // nothing: the signal exists to interrupt the wait (see `crate::alarm`)
 }
 
 fn install(sig: Signal, handler: extern "C" fn(libc::c_int)) -> Result<(), String> {
@@ -44,11 +39,6 @@ fn install(sig: Signal, handler: extern "C" fn(libc::c_int)) -> Result<(), Strin
 pub fn install_termination() -> Result<(), String> {
     install(Signal::SIGINT, on_termination)?;
     install(Signal::SIGTERM, on_termination)
-}
-
-/// Installs a handler that does nothing for `sig`, a wake-up signal.
-pub fn install_wakeup(sig: Signal) -> Result<(), String> {
-    install(sig, on_wakeup)
 }
 
 /// True once SIGINT or SIGTERM arrived.
