@@ -10,6 +10,7 @@
 //! adds are listed in the README's configuration table.
 
 mod keys;
+pub mod names;
 mod problem;
 
 use keys::Reader;
@@ -257,62 +258,22 @@ fn parse_axis(
         HomeSequence as HS, TravelMode as TM,
     };
     let engine = AxisConfig {
-        configuration: r.choice(
-            "configuration",
-            &[
-                ("servo", AC::Servo),
-                ("feedback_only", AC::FeedbackOnly),
-                ("virtual", AC::Virtual),
-            ],
-            AC::Servo,
-        ),
-        control_mode: r.choice(
-            "control_mode",
-            &[
-                ("position", CM::Position),
-                ("velocity", CM::Velocity),
-                ("torque", CM::Torque),
-            ],
-            CM::Position,
-        ),
-        travel: r.choice(
-            "travel",
-            &[("linear", TM::Linear), ("cyclic", TM::Cyclic)],
-            TM::Linear,
-        ),
+        configuration: r.choice("configuration", names::CONFIGURATIONS, AC::Servo),
+        control_mode: r.choice("control_mode", names::CONTROL_MODES, CM::Position),
+        travel: r.choice("travel", names::TRAVEL_MODES, TM::Linear),
         unwind: r.f64("unwind", 0.0),
         counts_per_unit: r.f64("counts_per_unit", 1.0),
         marker: r.bool("marker", false),
         marker_latch: r.bool("marker_latch", true),
         registration: r.bool("registration", false),
         travel_limits: r.pair("travel_limits"),
-        home_mode: r.choice(
-            "home_mode",
-            &[("active", HM::Active), ("passive", HM::Passive)],
-            HM::Active,
-        ),
+        home_mode: r.choice("home_mode", names::HOME_MODES, HM::Active),
         home_direction: r.choice(
             "home_direction",
-            &[
-                ("unidirectional_forward", HD::UnidirectionalForward),
-                ("bidirectional_forward", HD::BidirectionalForward),
-                ("unidirectional_reverse", HD::UnidirectionalReverse),
-                ("bidirectional_reverse", HD::BidirectionalReverse),
-            ],
+            names::HOME_DIRECTIONS,
             HD::BidirectionalForward,
         ),
-        home_sequence: r.choice(
-            "home_sequence",
-            &[
-                ("immediate", HS::Immediate),
-                ("switch", HS::Switch),
-                ("marker", HS::Marker),
-                ("switch_then_marker", HS::SwitchThenMarker),
-                ("torque", HS::Torque),
-                ("torque_then_marker", HS::TorqueThenMarker),
-            ],
-            HS::Immediate,
-        ),
+        home_sequence: r.choice("home_sequence", names::HOME_SEQUENCES, HS::Immediate),
         home_switch_normally_closed: r.bool("home_switch_normally_closed", false),
         home_position: r.f64("home_position", 0.0),
         home_offset: r.f64("home_offset", 0.0),

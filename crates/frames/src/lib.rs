@@ -23,18 +23,8 @@ pub use ipc::{
     service_names, IoPorts, IpcConfig, IpcError, Ports, Sent, ServiceNames, SupervisorPorts,
 };
 
-/// `CLOCK_MONOTONIC` now, in ns. The clock is system-wide on Linux, so values
-/// taken in `motion-supervisor` and `motion-io` can be compared directly (the
-/// frame timestamps use it). Allocation-free, vDSO call.
-pub fn monotonic_ns() -> u64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: valid pointer to a timespec; CLOCK_MONOTONIC always exists on Linux.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
-    debug_assert_eq!(rc, 0);
-    (ts.tv_sec as u64)
-        .saturating_mul(1_000_000_000)
-        .saturating_add(ts.tv_nsec as u64)
-}
+/// `CLOCK_MONOTONIC` now, in ns: the clock of every frame timestamp. It is
+/// system-wide on Linux, so values taken in `motion-supervisor` and
+/// `motion-io` compare directly. (The runtime's clock, under the name the
+/// frame code uses.)
+pub use motion_rt::now_ns as monotonic_ns;

@@ -1,35 +1,8 @@
 //! What `home` prints: one row per axis (table or the JSON of interface.md).
 
 use crate::shared::AxisSnap;
+use motion_config::names::{name_of, HOME_DIRECTIONS, HOME_MODES, HOME_SEQUENCES};
 use motion_config::AxisEntry;
-use motion_homing::{HomeDirection, HomeMode, HomeSequence};
-
-pub fn mode_name(m: HomeMode) -> &'static str {
-    match m {
-        HomeMode::Active => "active",
-        HomeMode::Passive => "passive",
-    }
-}
-
-pub fn sequence_name(s: HomeSequence) -> &'static str {
-    match s {
-        HomeSequence::Immediate => "immediate",
-        HomeSequence::Switch => "switch",
-        HomeSequence::Marker => "marker",
-        HomeSequence::SwitchThenMarker => "switch_then_marker",
-        HomeSequence::Torque => "torque",
-        HomeSequence::TorqueThenMarker => "torque_then_marker",
-    }
-}
-
-pub fn direction_name(d: HomeDirection) -> &'static str {
-    match d {
-        HomeDirection::UnidirectionalForward => "unidirectional_forward",
-        HomeDirection::BidirectionalForward => "bidirectional_forward",
-        HomeDirection::UnidirectionalReverse => "unidirectional_reverse",
-        HomeDirection::BidirectionalReverse => "bidirectional_reverse",
-    }
-}
 
 /// The result of one axis.
 #[derive(Clone, Debug)]
@@ -48,9 +21,9 @@ impl Row {
         let c = &entry.engine;
         Self {
             name: entry.name.clone(),
-            mode: mode_name(c.home_mode),
-            sequence: sequence_name(c.home_sequence),
-            direction: direction_name(c.home_direction),
+            mode: name_of(HOME_MODES, c.home_mode),
+            sequence: name_of(HOME_SEQUENCES, c.home_sequence),
+            direction: name_of(HOME_DIRECTIONS, c.home_direction),
             snap,
             note,
         }

@@ -1,7 +1,7 @@
-use super::{load, prefix, rt_json, rt_lines};
+use super::{load, rt_json, rt_lines, start};
 use crate::cli::Common;
 use crate::report::{self, Row};
-use crate::session::{Session, SessionOptions};
+use crate::session::Session;
 use crate::shared::{AxisSnap, Control};
 use crate::signals;
 use std::time::{Duration, Instant};
@@ -28,23 +28,9 @@ pub fn home(common: &Common, names: &[String], json: bool, parallel: bool, timeo
     if order.is_empty() {
         order = (0..m.axes.len()).collect();
     }
-    let opts = SessionOptions {
-        config_path: common.config.clone(),
-        service_prefix: prefix(common, &m),
-        io_args: Vec::new(),
-    };
-    let mut session = match Session::start(m, &opts) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("motion-supervisor: {e}");
-            return 1;
-        }
-    };
-    if let Err(e) = session.wait_io(Duration::from_secs(10)) {
-        eprintln!("motion-supervisor: {e}");
-        session.finish();
+    let Some(mut session) = start(common, m, &[]) else {
         return 1;
-    }
+    };
     eprintln!(
         "motion-supervisor: homing {} axis(es) of {source}{}",
         order.len(),

@@ -5,6 +5,7 @@ mod home;
 mod run;
 
 use crate::cli::{Cli, Common};
+use crate::session::{Session, SessionOptions};
 use motion_config::MachineConfig;
 
 pub fn run(c: Cli) -> i32 {
@@ -48,6 +49,29 @@ fn load(common: &Common) -> Option<(MachineConfig, String)> {
             None
         }
     }
+}
+
+/// Starts the cycle and the I/O process and waits until it answers; prints
+/// why not and returns `None` on failure (everything started is stopped).
+fn start(common: &Common, m: MachineConfig, io_args: &[String]) -> Option<Session> {
+    let opts = SessionOptions {
+        config_path: common.config.clone(),
+        service_prefix: prefix(common, &m),
+        io_args: io_args.to_vec(),
+    };
+    let mut session = match Session::start(m, &opts) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("motion-supervisor: {e}");
+            return None;
+        }
+    };
+    if let Err(e) = session.wait_io(std::time::Duration::from_secs(10)) {
+        eprintln!("motion-supervisor: {e}");
+        session.finish();
+        return None;
+    }
+    Some(session)
 }
 
 fn prefix(common: &Common, m: &MachineConfig) -> String {

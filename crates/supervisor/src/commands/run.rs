@@ -1,6 +1,5 @@
-use super::{load, prefix, rt_json, rt_lines};
+use super::{load, rt_json, rt_lines, start};
 use crate::cli::Common;
-use crate::session::{Session, SessionOptions};
 use crate::signals;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -15,23 +14,9 @@ pub fn run(
     let Some((m, source)) = load(common) else {
         return 2;
     };
-    let opts = SessionOptions {
-        config_path: common.config.clone(),
-        service_prefix: prefix(common, &m),
-        io_args: io_args.to_vec(),
-    };
-    let mut session = match Session::start(m, &opts) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("motion-supervisor: {e}");
-            return 1;
-        }
-    };
-    if let Err(e) = session.wait_io(Duration::from_secs(10)) {
-        eprintln!("motion-supervisor: {e}");
-        session.finish();
+    let Some(mut session) = start(common, m, io_args) else {
         return 1;
-    }
+    };
     if !json {
         eprintln!(
             "motion-supervisor: running {source} at {} µs; SIGINT/SIGTERM to stop",
