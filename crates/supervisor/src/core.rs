@@ -131,6 +131,11 @@ impl Core {
         }
     }
 
+    /// A frame the ports refused (wrong layout version, bad header).
+    pub fn note_rejected(&mut self) {
+        self.frames_rejected += 1;
+    }
+
     pub fn exiting(&self) -> bool {
         self.exiting
     }

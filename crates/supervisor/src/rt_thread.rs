@@ -155,9 +155,13 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
             core.control(c);
         }
 
-        if let Ok(Some(sample)) = ports.receive_latest() {
-            pending = Some(sample);
-            pending_fresh = true;
+        match ports.receive_latest() {
+            Ok(Some(sample)) => {
+                pending = Some(sample);
+                pending_fresh = true;
+            }
+            Ok(None) => {}
+            Err(_) => core.note_rejected(),
         }
         let fresh = if pending_fresh {
             pending.as_ref().map(|p| p.payload())
