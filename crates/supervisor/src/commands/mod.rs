@@ -94,6 +94,12 @@ fn rt_lines(f: &crate::session::Finished) -> Vec<String> {
         "allocations in the cycle after warm-up: {} system-allocator calls, {} served by the RT pool",
         f.system_calls_in_cycle, f.pool_allocs_in_cycle
     ));
+    if let Some(s) = f.snapshot.as_deref() {
+        out.push(format!(
+            "feedback frames: {} answered cycles, {} cycles without a fresh frame, {} refused",
+            s.frames_received, s.frames_missing, s.frames_rejected
+        ));
+    }
     let pct = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{:.1} %", v * 100.0));
     out.push(format!(
         "cpu: motion-supervisor {}, motion-io {} (of one core, over {:.1} s)",
@@ -120,5 +126,10 @@ fn rt_json(f: &crate::session::Finished) -> serde_json::Value {
             "pool_allocs_in_cycle": f.pool_allocs_in_cycle,
         },
         "cpu": {"supervisor": f.supervisor_cpu, "io": f.io_cpu, "wall_s": f.wall_s},
+        "frames": f.snapshot.as_deref().map(|s| serde_json::json!({
+            "received": s.frames_received,
+            "missing": s.frames_missing,
+            "refused": s.frames_rejected,
+        })),
     })
 }
