@@ -1,1 +1,19 @@
-//! Benchmarks: see README Performance.
+//! Shared pieces of the benchmarks (see `bench/README.md`):
+//!
+//! * `jitter` — the supervisor's real cycle side by side with cyclictest;
+//! * `ipc` — the command/feedback round trip through iceoryx2, next to a bare
+//!   iceoryx2 ping-pong;
+//! * `benches/engine.rs` — criterion benches of one engine step and one
+//!   whole cycle's compute.
+//!
+//! Nothing here runs in a real-time loop except [`sys::sleep_until`] and the
+//! IPC bench's measuring thread; the rest is orchestration, parsing and
+//! reporting.
+
+pub mod args;
+pub mod cyclictest;
+pub mod hist;
+pub mod machine;
+pub mod proc;
+pub mod svg;
+pub mod sys;

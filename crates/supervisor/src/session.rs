@@ -225,12 +225,19 @@ impl Session {
 
     /// Stops every axis and disables the drives (Control::Exit), ends the
     /// real-time thread, then the I/O process; cleans up shared memory.
-    pub fn finish(mut self) -> Finished {
+    pub fn finish(self) -> Finished {
+        self.finish_with(|_| {})
+    }
+
+    /// [`Self::finish`], showing each histogram interval handed over during
+    /// shut-down to `each` (the interval log must not lose the last one).
+    pub fn finish_with(mut self, each: impl FnMut(&HistSet)) -> Finished {
         let io_cpu = self.io.as_mut().and_then(|io| io.cpu_share());
         let supervisor_cpu = crate::cpu::process_cpu_seconds(std::process::id())
             .map(|s| s / self.started.elapsed().as_secs_f64());
         let outcome = self.shutdown_rt();
-        self.poll();
+        self.shared.collect_intervals(&mut self.totals, each);
+        self.shared.latest_snapshot(&mut self.snapshot);
         let io_exit = self
             .io
             .as_mut()

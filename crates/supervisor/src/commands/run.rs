@@ -74,7 +74,11 @@ pub fn run(
             );
         }
     };
-    let f = session.finish();
+    let f = session.finish_with(|h| {
+        if let Some(w) = hlog_writer.as_mut() {
+            w.interval(h);
+        }
+    });
     if let Some(w) = hlog_writer.as_mut() {
         w.finish();
     }

@@ -1,0 +1,338 @@
+//! Engine benchmarks (criterion): one `Axis::step` in the middle of a homing
+//! leg, and one whole cycle's compute (`Core::step` + `Core::fill`) for 1, 8,
+//! 32 and 64 axes. Goals: ≤ 100 ns per axis step, ≤ 10 µs for a 64-axis
+//! cycle. A summary table against the goals is printed at the end.
+//!
+//! `cargo bench -p motion-bench --bench engine` (≈ 20 s of measuring).
+
+use criterion::{BatchSize, BenchmarkId, Criterion};
+use motion_config::{MachineConfig, DEMO_TOML};
+use motion_frames::{axis_to_command, feedback_to_axis, CommandFrame, FeedbackFrame};
+use motion_homing::{Axis, Feedback, Phase, Request};
+use motion_plant::Plant;
+use motion_supervisor::core::Core;
+use motion_supervisor::shared::Control;
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, SystemTime};
+
+/// Axis counts of the cycle benchmark.
+const AXES: [usize; 4] = [1, 8, 32, 64];
+/// Cycles of real homing (against the plants) before a cycle is measured.
+const CYCLE_WARMUP: u64 = 400;
+
+fn demo() -> MachineConfig {
+    motion_config::parse(DEMO_TOML).expect("the built-in demo machine parses")
+}
+
+/// The inputs of one real engine step, captured mid-homing.
+struct Captured {
+    axis: Axis,
+    feedback: Feedback,
+    now: u64,
+    request: Request,
+    cycle: u64,
+}
+
+/// Homes the demo axis `name` against its plant, cycle by cycle, until
+/// `stop(axis, feedback)` holds before a step: returns that step's inputs.
+fn home_until(name: &str, mut stop: impl FnMut(&Axis, &Feedback) -> bool) -> Captured {
+    let m = demo();
+    let a = m
+        .axes
+        .iter()
+        .find(|a| a.name == name)
+        .expect("demo axis exists");
+    let mut axis = Axis::new(a.engine);
+    let mut plant = Plant::new(a.sim);
+    let dt_ns = m.supervisor.cycle_ns();
+    let dt = dt_ns as f64 * 1e-9;
+    let mut fb = plant.feedback();
+    for k in 0..200_000u64 {
+        let now = k * dt_ns;
+        // the rung goes high in cycle 1: a rising edge
+        let request = Request {
+            home: k >= 1,
+            ..Request::default()
+        };
+        if k > 1 && stop(&axis, &fb) {
+            return Captured {
+                axis,
+                feedback: fb,
+                now,
+                request,
+                cycle: k,
+            };
+        }
+        let cmd = axis.step(now, Some(&fb), &request);
+        fb = plant.step(&cmd, dt);
+    }
+    panic!("axis {name}: the state to benchmark was never reached");
+}
+
+/// Axis X (switch then marker) in the middle of its first leg: seeking the
+/// switch at Home Speed, past acceleration.
+fn seek_state() -> Captured {
+    home_until("X", |a, fb| {
+        a.status().phase == Phase::Seek && fb.position > -10.0
+    })
+}
+
+/// Axis Z (torque) pushing into its hard stop: torque over the threshold for
+/// 5 cycles, the torque time (20 ms) not yet reached.
+fn torque_state() -> Captured {
+    let m = demo();
+    let threshold = m
+        .axes
+        .iter()
+        .find(|a| a.name == "Z")
+        .expect("demo axis Z")
+        .engine
+        .home_torque_threshold;
+    let mut over = 0;
+    home_until("Z", move |a, fb| {
+        if a.status().phase == Phase::Seek && fb.torque.abs() >= threshold {
+            over += 1;
+        }
+        over > 5
+    })
+}
+
+/// Checks that stepping a copy of `c` is real work in `phase`.
+fn check(name: &str, c: &Captured, phase: Phase) {
+    let mut a = c.axis.clone();
+    let cmd = a.step(c.now, Some(&c.feedback), &c.request);
+    assert_eq!(
+        a.status().phase,
+        phase,
+        "{name}: not in {phase:?} after the step"
+    );
+    assert!(a.status().ip, "{name}: homing not in process");
+    eprintln!(
+        "{name}: cycle {} of a real homing, phase {}, position {:.3}, torque {:.1} %, command v {:.1}",
+        c.cycle,
+        a.status().phase.name(),
+        c.feedback.position,
+        c.feedback.torque,
+        cmd.velocity
+    );
+}
+
+fn engine_step(c: &mut Criterion) {
+    let mut g = c.benchmark_group("engine_step");
+    for (name, state, phase) in [
+        ("seek", seek_state(), Phase::Seek),
+        ("torque_detect", torque_state(), Phase::Seek),
+    ] {
+        check(&format!("engine_step/{name}"), &state, phase);
+        // Each iteration steps a fresh copy of the captured axis (the copy
+        // is made outside the timed loop), with the feedback the plant gave.
+        g.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || state.axis.clone(),
+                |axis| {
+                    axis.step(
+                        black_box(state.now),
+                        Some(black_box(&state.feedback)),
+                        black_box(&state.request),
+                    )
+                },
+                BatchSize::SmallInput,
+            )
+        });
+    }
+    g.finish();
+}
+
+/// `n` axes: the demo axes repeated, starting with the moving ones
+/// (X, C, Z, U, X, ...), names made unique.
+fn machine(n: usize) -> MachineConfig {
+    let d = demo();
+    let axes = (0..n)
+        .map(|i| {
+            let mut a = d.axes[(i + 1) % d.axes.len()].clone();
+            a.name = format!("{}{}", a.name, i);
+            a
+        })
+        .collect();
+    MachineConfig {
+        supervisor: d.supervisor.clone(),
+        axes,
+    }
+}
+
+/// A core homing every axis against its plant for [`CYCLE_WARMUP`] cycles:
+/// the core, the last feedback frame, a command frame and the next cycle's
+/// time.
+fn homing_core(m: &MachineConfig) -> (Core, FeedbackFrame, CommandFrame, u64) {
+    let mut core = Core::new(m);
+    let mut plants: Vec<Plant> = m.axes.iter().map(|a| Plant::new(a.sim)).collect();
+    let mut fb = FeedbackFrame::default();
+    let mut cmd = CommandFrame::default();
+    let dt_ns = m.supervisor.cycle_ns();
+    let dt = dt_ns as f64 * 1e-9;
+    fb.header.axis_count = m.axes.len() as u32;
+    for (i, (a, p)) in m.axes.iter().zip(&plants).enumerate() {
+        fb.axes[i] = feedback_to_axis(&p.feedback(), a.engine.counts_per_unit);
+    }
+    for k in 0..CYCLE_WARMUP {
+        if k == 10 {
+            for i in 0..m.axes.len() {
+                core.control(Control::Home(i));
+            }
+        }
+        core.step(k * dt_ns, Some(&fb));
+        core.fill(&mut cmd);
+        for (i, (a, p)) in m.axes.iter().zip(plants.iter_mut()).enumerate() {
+            let c = axis_to_command(&cmd.axes[i], a.engine.counts_per_unit);
+            let f = p.step(&c, dt);
+            fb.axes[i] = feedback_to_axis(&f, a.engine.counts_per_unit);
+        }
+    }
+    (core, fb, cmd, CYCLE_WARMUP * dt_ns)
+}
+
+fn phases(core: &Core) -> String {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for a in core.axes() {
+        let n = a.status().phase.name();
+        match counts.iter_mut().find(|c| c.0 == n) {
+            Some(c) => c.1 += 1,
+            None => counts.push((n, 1)),
+        }
+    }
+    counts
+        .iter()
+        .map(|(n, k)| format!("{k} {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn cycle(c: &mut Criterion) {
+    let mut g = c.benchmark_group("cycle");
+    for n in AXES {
+        let m = machine(n);
+        let (mut core, fb, mut cmd, now) = homing_core(&m);
+        let before = phases(&core);
+        assert!(
+            core.axes().iter().all(|a| a.status().ip),
+            "cycle/{n}: every axis should be homing: {before}"
+        );
+        // The same cycle over and over: same time, same feedback. Every
+        // engine runs its full step (validation, event checks, profile
+        // sample) and stays where it is, so every iteration does the same
+        // real work; the frame conversion runs for every axis.
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| {
+                core.step(black_box(now), Some(black_box(&fb)));
+                core.fill(black_box(&mut cmd));
+            })
+        });
+        let after = phases(&core);
+        eprintln!("cycle/{n}: axes {before}; after the run: {after}");
+        assert_eq!(before, after, "cycle/{n}: the state moved during the run");
+    }
+    g.finish();
+}
+
+/// Where criterion writes its reports: $CRITERION_HOME, else
+/// `<target>/criterion` of the target directory this bench was built in.
+fn criterion_dir() -> PathBuf {
+    if let Some(h) = std::env::var_os("CRITERION_HOME") {
+        return PathBuf::from(h);
+    }
+    std::env::current_exe()
+        .ok()
+        .and_then(|e| {
+            let deps = e.parent()?;
+            (deps.file_name()? == "deps").then(|| deps.parent()?.parent().map(Path::to_path_buf))?
+        })
+        .map_or_else(
+            || PathBuf::from("target/criterion"),
+            |t| t.join("criterion"),
+        )
+}
+
+/// Criterion's estimate (slope, else mean) and median, ns, if measured
+/// after `since`.
+fn estimate(dir: &Path, id: &str, since: SystemTime) -> Option<(f64, f64)> {
+    let p = dir.join(id).join("new").join("estimates.json");
+    let fresh = std::fs::metadata(&p).ok()?.modified().ok()? >= since;
+    if !fresh {
+        return None;
+    }
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&p).ok()?).ok()?;
+    let point = |k: &str| v.get(k)?.get("point_estimate")?.as_f64();
+    Some((point("slope").or_else(|| point("mean"))?, point("median")?))
+}
+
+fn fmt_ns(ns: f64) -> String {
+    if ns >= 1000.0 {
+        format!("{:.2} µs", ns / 1000.0)
+    } else {
+        format!("{ns:.1} ns")
+    }
+}
+
+fn summary(dir: &Path, since: SystemTime) {
+    println!(
+        "\n== engine benchmarks vs goals (criterion estimates; reports in {})",
+        dir.display()
+    );
+    println!(
+        "{:<26}{:>12}{:>12}{:>12}   {:<22}verdict",
+        "benchmark", "time", "median", "per axis", "goal"
+    );
+    let mut rows: Vec<(String, usize, Option<f64>)> = vec![
+        ("engine_step/seek".into(), 1, Some(100.0)),
+        ("engine_step/torque_detect".into(), 1, Some(100.0)),
+    ];
+    for n in AXES {
+        rows.push((format!("cycle/{n}"), n, (n == 64).then_some(10_000.0)));
+    }
+    for (id, n, goal) in rows {
+        let Some((t, med)) = estimate(dir, &id, since) else {
+            println!("{id:<26}{:>12}", "(not measured in this run)");
+            continue;
+        };
+        let (goal_txt, verdict) = match goal {
+            Some(g) if n == 1 && id.starts_with("engine") => (
+                "≤ 100 ns per axis".to_string(),
+                if t <= g { "ok" } else { "MISSED" },
+            ),
+            Some(g) => (
+                format!("≤ {} per cycle", fmt_ns(g)),
+                if t <= g { "ok" } else { "MISSED" },
+            ),
+            None => ("-".to_string(), ""),
+        };
+        println!(
+            "{id:<26}{:>12}{:>12}{:>12}   {goal_txt:<22}{verdict}",
+            fmt_ns(t),
+            fmt_ns(med),
+            fmt_ns(t / n as f64)
+        );
+    }
+    println!(
+        "cycle/N = Core::step + Core::fill for N homing axes (engine steps + counts↔units for every axis)"
+    );
+}
+
+fn main() {
+    let since = SystemTime::now() - Duration::from_secs(1);
+    let dir = criterion_dir();
+    let args: Vec<String> = std::env::args().collect();
+    let mut c = Criterion::default()
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_millis(1500))
+        .sample_size(50)
+        .without_plots()
+        .output_directory(&dir)
+        .configure_from_args();
+    engine_step(&mut c);
+    cycle(&mut c);
+    c.final_summary();
+    if !args.iter().any(|a| a == "--list" || a == "--test") {
+        summary(&dir, since);
+    }
+}
