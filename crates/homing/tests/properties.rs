@@ -243,7 +243,7 @@ fn bidirectional_ends_at_home_position() {
     use HomeSequence::*;
     const SEQS: &[HomeSequence] = &[Switch, Marker, SwitchThenMarker, Torque, TorqueThenMarker];
     let worst = Worst::default();
-    runner(160)
+    runner(256)
         .run(&machine(SEQS), |m| {
             let dir = if m.forward {
                 HomeDirection::BidirectionalForward
@@ -304,7 +304,7 @@ fn unidirectional_never_reverses() {
     use HomeSequence::*;
     const SEQS: &[HomeSequence] = &[Switch, Marker, SwitchThenMarker];
     let worst = Worst::default();
-    runner(160)
+    runner(256)
         .run(&(machine(SEQS), any::<bool>()), |(m, cyclic)| {
             let dir = if m.forward {
                 HomeDirection::UnidirectionalForward
@@ -386,7 +386,7 @@ fn passive_events_within_precision() {
     use HomeSequence::*;
     const SEQS: &[HomeSequence] = &[Switch, Marker, SwitchThenMarker];
     let worst = Worst::default();
-    runner(120)
+    runner(256)
         .run(&(machine(SEQS), 0.5..20.0f64), |(m, speed)| {
             let s = m.dir();
             let edge = if m.forward { m.sw_lo } else { m.sw_hi() };
@@ -444,7 +444,7 @@ fn every_abort_restores_the_drive() {
         Just(Cause::Nan),
         Just(Cause::Shutdown),
     ];
-    runner(160)
+    runner(256)
         .run(&(machine(SEQS), cause, 0.0..1.0f64), |(m, cause, when)| {
             let dir = if m.forward {
                 HomeDirection::BidirectionalForward
@@ -497,7 +497,7 @@ fn bad_feedback_never_becomes_a_bad_command() {
     const SEQS: &[HomeSequence] = &[Switch, Marker, SwitchThenMarker, Torque];
     let bad =
         prop::sample::select(&[f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300][..]);
-    runner(200)
+    runner(256)
         .run(
             &(machine(SEQS), 0usize..6, bad, 1usize..3000, 1usize..20),
             |(m, field, value, at, len)| {

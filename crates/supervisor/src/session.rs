@@ -185,11 +185,17 @@ impl Session {
         None
     }
 
-    pub fn send(&self, c: Control) {
-        // The queue holds 256 requests; the cycle drains it every period.
+    /// Queues a request for the cycle; false if the cycle has not taken
+    /// requests for a second (it drains the 256-entry queue every period).
+    pub fn send(&self, c: Control) -> bool {
+        let until = Instant::now() + Duration::from_secs(1);
         while !self.shared.send(c) {
+            if Instant::now() > until {
+                return false;
+            }
             std::thread::sleep(Duration::from_millis(1));
         }
+        true
     }
 
     pub fn elapsed(&self) -> Duration {
@@ -209,7 +215,7 @@ impl Session {
     fn shutdown_rt(&mut self) -> Option<RtOutcome> {
         let h = self.rt.take()?;
         if !matches!(self.shared.phase(), Phase::Exited | Phase::Failed) {
-            self.send(Control::Exit);
+            let _ = self.send(Control::Exit);
         }
         // Stopping axes at home deceleration takes well under this.
         let until = Instant::now() + Duration::from_secs(30);

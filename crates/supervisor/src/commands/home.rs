@@ -55,7 +55,7 @@ pub fn home(common: &Common, names: &[String], json: bool, parallel: bool, timeo
             .map(|&i| snap_of(&session, i).homes_started)
             .collect();
         for &i in batch {
-            session.send(Control::Home(i));
+            let _ = session.send(Control::Home(i));
         }
         let deadline = Instant::now() + Duration::from_secs_f64(timeout_s);
         let mut stopped = false;
@@ -76,7 +76,7 @@ pub fn home(common: &Common, names: &[String], json: bool, parallel: bool, timeo
             if !stopped && Instant::now() > deadline {
                 for &i in batch {
                     notes[i] = Some(format!("no result within --timeout {timeout_s} s: stopped"));
-                    session.send(Control::Stop(i));
+                    let _ = session.send(Control::Stop(i));
                 }
                 stopped = true;
             }
@@ -96,7 +96,7 @@ pub fn home(common: &Common, names: &[String], json: bool, parallel: bool, timeo
         // Stop what is in process and let it come to rest, so the result
         // shows how homing ended (ERR 12 / EXERR 1) before leaving.
         for &i in &order {
-            session.send(Control::Stop(i));
+            let _ = session.send(Control::Stop(i));
         }
         let until = Instant::now() + Duration::from_secs(10);
         while Instant::now() < until {
