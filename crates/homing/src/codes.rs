@@ -30,7 +30,7 @@
 //! | 41   | 30    | *ours* conversion constant not positive |
 //! | 41   | 31    | *ours* home position outside the travel limits |
 //! | 41   | 32    | *ours* travel limits empty or reversed |
-//! | 1014 | 0     | homing interrupted externally (the supervisor lost control of the axis, e.g. restarted) |
+//! | 1014 | 0     | homing interrupted externally: the wrapper's code, kept for tools that map it; this engine reports every interruption it sees more precisely (a stop request or the supervisor shutting down: 12/1, a shutdown: 12/12, lost feedback: 12/40) |
 //! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
 //! | 1016 | phase | *ours* search limit: a search leg travelled farther than `search_limit` (EXERR = [`Phase`](crate::Phase) number: 2 seek, 5 return) |
 
