@@ -10,13 +10,7 @@ use hdrhistogram::Histogram;
 use std::path::Path;
 use std::time::{Duration, SystemTime};
 
-/// Highest value a histogram holds, ns (as `motion_supervisor::stats`).
-pub const HIGHEST_NS: u64 = 10_000_000_000;
-
-/// An empty histogram with the supervisor's bounds.
-pub fn new_hist() -> Histogram<u64> {
-    Histogram::new_with_bounds(1, HIGHEST_NS, 3).expect("static histogram bounds are valid")
-}
+pub use motion_supervisor::stats::{histogram as new_hist, HIGHEST_NS};
 
 /// Adds `b` into `a`; values beyond `a`'s range saturate instead of failing.
 pub fn merge(a: &mut Histogram<u64>, b: &Histogram<u64>) {
@@ -27,75 +21,12 @@ pub fn merge(a: &mut Histogram<u64>, b: &Histogram<u64>) {
     }
 }
 
-/// Distribution of one histogram, µs.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Pct {
-    pub count: u64,
-    pub min: f64,
-    pub p50: f64,
-    pub p99: f64,
-    pub p999: f64,
-    pub p9999: f64,
-    pub max: f64,
-}
+/// Distribution of one histogram, µs: the supervisor's own summary type, so
+/// both tools' numbers are computed the same way.
+pub type Pct = motion_supervisor::stats::Percentiles;
 
 /// Column names of [`Pct::values`].
 pub const COLUMNS: [&str; 6] = ["min", "p50", "p99", "p99.9", "p99.99", "max"];
-
-impl Pct {
-    /// Percentiles as the supervisor computes them (`value_at_quantile`).
-    pub fn of(h: &Histogram<u64>) -> Self {
-        if h.is_empty() {
-            return Self::default();
-        }
-        let us = |ns: u64| ns as f64 / 1000.0;
-        Self {
-            count: h.len(),
-            min: us(h.min()),
-            p50: us(h.value_at_quantile(0.50)),
-            p99: us(h.value_at_quantile(0.99)),
-            p999: us(h.value_at_quantile(0.999)),
-            p9999: us(h.value_at_quantile(0.9999)),
-            max: us(h.max()),
-        }
-    }
-
-    /// Reads the supervisor's `{"min", "p50", ..., "count"}` object (µs).
-    pub fn from_json(v: &serde_json::Value) -> Option<Self> {
-        let f = |k: &str| v.get(k).and_then(|x| x.as_f64());
-        Some(Self {
-            count: v.get("count").and_then(|x| x.as_u64())?,
-            min: f("min")?,
-            p50: f("p50")?,
-            p99: f("p99")?,
-            p999: f("p999")?,
-            p9999: f("p9999")?,
-            max: f("max")?,
-        })
-    }
-
-    pub fn values(&self) -> [f64; 6] {
-        [
-            self.min, self.p50, self.p99, self.p999, self.p9999, self.max,
-        ]
-    }
-
-    /// `self / other` per column (`None` where `other` is 0).
-    pub fn ratio(&self, other: &Pct) -> [Option<f64>; 6] {
-        let a = self.values();
-        let b = other.values();
-        std::array::from_fn(|i| (b[i] > 0.0).then(|| a[i] / b[i]))
-    }
-
-    pub fn to_json(self) -> serde_json::Value {
-        let r = |x: f64| (x * 10.0).round() / 10.0;
-        serde_json::json!({
-            "min": r(self.min), "p50": r(self.p50), "p99": r(self.p99),
-            "p999": r(self.p999), "p9999": r(self.p9999), "max": r(self.max),
-            "count": self.count,
-        })
-    }
-}
 
 /// A µs figure for a table cell: one decimal below 1000, none above.
 pub fn us(x: f64) -> String {

@@ -6,15 +6,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// `CLOCK_MONOTONIC` now, ns (the clock the supervisor and cyclictest use).
-pub fn now_ns() -> u64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: a valid timespec pointer; CLOCK_MONOTONIC always exists.
-    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
-    ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
-}
+pub use motion_rt::now_ns;
 
 /// Sleeps until the absolute monotonic time `deadline_ns` (retries EINTR
 /// with the same deadline).
@@ -124,59 +116,67 @@ pub fn cpus() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
-/// Pins the calling thread to `cpu`.
-pub fn pin_current_thread(cpu: usize) -> Result<(), String> {
-    use nix::sched::{sched_setaffinity, CpuSet};
-    use nix::unistd::Pid;
-    let mut set = CpuSet::new();
-    set.set(cpu).map_err(|e| format!("cpu {cpu}: {e}"))?;
-    sched_setaffinity(Pid::from_raw(0), &set).map_err(|e| format!("pin to cpu {cpu}: {e}"))
+/// Pins the calling thread to `cpu` (if given), SCHED_FIFO at `priority` (if
+/// given), memory locked — with the runtime the supervisor itself uses, so
+/// the benchmark threads are set up exactly like the cycle. Returns the
+/// settings the OS refused, as warnings.
+pub fn enter_rt(cpu: Option<usize>, priority: Option<i32>) -> Vec<String> {
+    match priority {
+        Some(priority) => {
+            motion_rt::enter_realtime(&motion_rt::RtConfig {
+                cpu,
+                priority,
+                lock_memory: true,
+                ..motion_rt::RtConfig::default()
+            })
+            .warnings
+        }
+        None => {
+            let mut w = Vec::new();
+            if let Some(c) = cpu {
+                if !core_pin(c) {
+                    w.push(format!("cannot pin to cpu {c}"));
+                }
+            }
+            if let Err(e) = nix::sys::mman::mlockall(
+                nix::sys::mman::MlockAllFlags::MCL_CURRENT
+                    | nix::sys::mman::MlockAllFlags::MCL_FUTURE,
+            ) {
+                w.push(format!("mlockall: {e}"));
+            }
+            w
+        }
+    }
 }
 
-/// SCHED_FIFO at `priority` for the calling thread.
-pub fn set_fifo(priority: i32) -> Result<(), String> {
-    let p = libc::sched_param {
-        sched_priority: priority,
-    };
-    // SAFETY: a valid sched_param; pid 0 is the calling thread.
-    let rc = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &p) };
-    if rc == 0 {
-        Ok(())
-    } else {
-        Err(format!(
-            "SCHED_FIFO {priority}: {} (run as root or raise RLIMIT_RTPRIO)",
-            std::io::Error::last_os_error()
-        ))
-    }
+fn core_pin(cpu: usize) -> bool {
+    use nix::sched::{sched_setaffinity, CpuSet};
+    let mut set = CpuSet::new();
+    set.set(cpu).is_ok() && sched_setaffinity(nix::unistd::Pid::from_raw(0), &set).is_ok()
 }
 
 /// Whether this process may run a thread SCHED_FIFO at `priority` (tried
 /// on a throw-away thread).
 pub fn can_use_fifo(priority: i32) -> Result<(), String> {
-    std::thread::spawn(move || set_fifo(priority))
-        .join()
-        .unwrap_or_else(|_| Err("probe thread panicked".into()))
+    std::thread::spawn(move || {
+        let r = motion_rt::enter_realtime(&motion_rt::RtConfig {
+            cpu: None,
+            priority,
+            lock_memory: false,
+            prefault_stack: 0,
+        });
+        match r.policy {
+            motion_rt::SchedPolicy::Fifo => Ok(()),
+            _ => Err(r.warnings.join("; ")),
+        }
+    })
+    .join()
+    .unwrap_or_else(|_| Err("probe thread panicked".into()))
 }
 
-/// `mlockall(MCL_CURRENT | MCL_FUTURE)`.
-pub fn lock_memory() -> Result<(), String> {
-    use nix::sys::mman::{mlockall, MlockAllFlags};
-    mlockall(MlockAllFlags::MCL_CURRENT | MlockAllFlags::MCL_FUTURE)
-        .map_err(|e| format!("mlockall: {e}"))
-}
-
-/// Holds `/dev/cpu_dma_latency` at `us` while the returned file is open
-/// (as the supervisor and cyclictest do: no deep idle states).
-pub fn hold_cpu_dma_latency(us: i32) -> Result<std::fs::File, String> {
-    use std::io::Write;
-    let mut f = std::fs::OpenOptions::new()
-        .write(true)
-        .open("/dev/cpu_dma_latency")
-        .map_err(|e| format!("/dev/cpu_dma_latency: {e}"))?;
-    f.write_all(&us.to_ne_bytes())
-        .map_err(|e| format!("/dev/cpu_dma_latency: {e}"))?;
-    Ok(f)
-}
+/// Holds `/dev/cpu_dma_latency` at `us` while the guard lives (as the
+/// supervisor and cyclictest do: no deep idle states).
+pub use motion_rt::hold_cpu_dma_latency;
 
 /// A real-time thread somewhere on the machine.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

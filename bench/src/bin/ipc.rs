@@ -22,8 +22,8 @@ use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc::{self, Running};
 use motion_bench::sys::{self, now_ns};
 use motion_frames::ipc::{
-    cleanup_domain, HISTORY, MAX_LISTENERS, MAX_NOTIFIERS, MAX_PUBLISHERS, MAX_SUBSCRIBERS,
-    SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED,
+    cleanup_domain, ppoll_until, PollWake, HISTORY, MAX_LISTENERS, MAX_NOTIFIERS, MAX_PUBLISHERS,
+    MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED,
 };
 use motion_frames::{CommandFrame, FeedbackFrame, IpcConfig, SupervisorPorts};
 use std::path::PathBuf;
@@ -189,8 +189,8 @@ fn bench_main() -> i32 {
         );
         return 1;
     }
-    if let Err(e) = sys::lock_memory() {
-        eprintln!("ipc: warning: {e}");
+    for w in sys::enter_rt(None, None) {
+        eprintln!("ipc: warning: {w}");
     }
     // as the supervisor does by default (cpu_dma_latency_us = 0)
     let _idle = match o.cpu_dma_latency {
@@ -426,8 +426,10 @@ fn run_mode(
     let worker = std::thread::Builder::new()
         .name("ipc-measure".into())
         .spawn(move || -> Result<Measured, String> {
-            sys::pin_current_thread(cpu)?;
-            sys::set_fifo(prio)?;
+            let refused = sys::enter_rt(Some(cpu), Some(prio));
+            if !refused.is_empty() {
+                return Err(refused.join("; "));
+            }
             let ipc = IpcConfig::new(prefix_owned.clone());
             let node = ipc.create_node("motion-bench").map_err(|e| e.to_string())?;
             if bare {
@@ -635,23 +637,7 @@ impl<const TX: usize, const RX: usize> BareSide<TX, RX> {
             if self.try_wait() {
                 return true;
             }
-            let now = now_ns();
-            if now >= deadline_ns {
-                return false;
-            }
-            let rem = deadline_ns - now;
-            let ts = libc::timespec {
-                tv_sec: (rem / 1_000_000_000) as libc::time_t,
-                tv_nsec: (rem % 1_000_000_000) as libc::c_long,
-            };
-            let mut pfd = libc::pollfd {
-                fd: self.fd,
-                events: libc::POLLIN,
-                revents: 0,
-            };
-            // SAFETY: one valid pollfd, a valid timespec, no signal mask.
-            let rc = unsafe { libc::ppoll(&mut pfd, 1, &ts, std::ptr::null()) };
-            if rc == 0 {
+            if ppoll_until(self.fd, deadline_ns) == PollWake::Deadline {
                 return self.try_wait();
             }
         }
@@ -776,15 +762,9 @@ fn echo_main(mut a: Args) -> i32 {
         libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
     }
     proc::install_stop_handler();
-    if let Err(e) = sys::pin_current_thread(cpu) {
-        eprintln!("ipc echo: warning: {e}");
+    for w in sys::enter_rt(Some(cpu), prio) {
+        eprintln!("ipc echo: warning: {w}");
     }
-    if let Some(p) = prio {
-        if let Err(e) = sys::set_fifo(p) {
-            eprintln!("ipc echo: warning: {e}");
-        }
-    }
-    let _ = sys::lock_memory();
     let code = match echo(&prefix, spin) {
         Ok(()) => 0,
         Err(e) => {

@@ -598,6 +598,50 @@ fn open_event(node: &Node<ipc::Service>, name: &Named) -> Result<EventFactory, I
         })
 }
 
+/// What [`ppoll_until`] saw.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PollWake {
+    /// The descriptor is readable (a wake-up is pending).
+    Readable,
+    /// The deadline passed (or had passed already).
+    Deadline,
+    /// A signal arrived (EINTR).
+    Interrupted,
+    /// `ppoll` failed otherwise.
+    Error,
+}
+
+/// Waits until `fd` is readable or the absolute `CLOCK_MONOTONIC` time
+/// `deadline_ns` passes, with `ppoll`: its timeout is an hrtimer (exact, no
+/// slack for a SCHED_FIFO thread), unlike a socket's `SO_RCVTIMEO`, which is
+/// counted in jiffies. The mechanism of [`Ports::wait_until`], for callers
+/// that hold a raw iceoryx2 listener (the IPC benchmark's bare peer).
+pub fn ppoll_until(fd: i32, deadline_ns: u64) -> PollWake {
+    let now = monotonic_ns();
+    if now >= deadline_ns {
+        return PollWake::Deadline;
+    }
+    let rem = deadline_ns - now;
+    let ts = libc::timespec {
+        tv_sec: (rem / 1_000_000_000) as libc::time_t,
+        tv_nsec: (rem % 1_000_000_000) as libc::c_long,
+    };
+    let mut pfd = libc::pollfd {
+        fd,
+        events: libc::POLLIN,
+        revents: 0,
+    };
+    // SAFETY: one valid pollfd, a valid timespec, no signal mask.
+    match unsafe { libc::ppoll(&mut pfd, 1, &ts, core::ptr::null()) } {
+        0 => PollWake::Deadline,
+        rc if rc > 0 => PollWake::Readable,
+        _ if std::io::Error::last_os_error().raw_os_error() == Some(libc::EINTR) => {
+            PollWake::Interrupted
+        }
+        _ => PollWake::Error,
+    }
+}
+
 /// What [`Ports::publish`] did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Sent {
@@ -878,32 +922,17 @@ impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
             if self.try_wait()? {
                 return Ok(true);
             }
-            let now = monotonic_ns();
-            if now >= deadline_ns {
-                return Ok(false);
+            match ppoll_until(self.listener_fd, deadline_ns) {
+                PollWake::Deadline => return self.try_wait(),
+                PollWake::Interrupted => {
+                    return Err(IpcError::Interrupted {
+                        service: self.rx_ready.clone(),
+                    })
+                }
+                // Readable: consumed at the top. A descriptor error is
+                // reported by try_wait at the top; the deadline bounds the loop.
+                PollWake::Readable | PollWake::Error => {}
             }
-            let rem = deadline_ns - now;
-            let ts = libc::timespec {
-                tv_sec: (rem / 1_000_000_000) as libc::time_t,
-                tv_nsec: (rem % 1_000_000_000) as libc::c_long,
-            };
-            let mut pfd = libc::pollfd {
-                fd: self.listener_fd,
-                events: libc::POLLIN,
-                revents: 0,
-            };
-            // SAFETY: one valid pollfd, a valid timespec, no signal mask.
-            let rc = unsafe { libc::ppoll(&mut pfd, 1, &ts, core::ptr::null()) };
-            if rc == 0 {
-                return self.try_wait();
-            }
-            if rc < 0 && std::io::Error::last_os_error().raw_os_error() == Some(libc::EINTR) {
-                return Err(IpcError::Interrupted {
-                    service: self.rx_ready.clone(),
-                });
-            }
-            // rc > 0: readable, consumed at the top; another error is reported
-            // by try_wait at the top; the deadline bounds the loop.
         }
     }
 

@@ -30,7 +30,8 @@ pub struct HistSet {
     pub end_ns: u64,
 }
 
-fn histogram() -> Histogram<u64> {
+/// An empty histogram with the bounds every latency histogram uses.
+pub fn histogram() -> Histogram<u64> {
     Histogram::new_with_bounds(1, HIGHEST_NS, 3).expect("static histogram bounds are valid")
 }
 
@@ -119,6 +120,34 @@ impl Percentiles {
             p9999: us(h.value_at_quantile(0.9999)),
             max: us(h.max()),
         }
+    }
+
+    /// `[min, p50, p99, p99.9, p99.99, max]`, the order of every table.
+    pub fn values(&self) -> [f64; 6] {
+        [
+            self.min, self.p50, self.p99, self.p999, self.p9999, self.max,
+        ]
+    }
+
+    /// `self / other` per column (`None` where `other` is 0).
+    pub fn ratio(&self, other: &Percentiles) -> [Option<f64>; 6] {
+        let a = self.values();
+        let b = other.values();
+        std::array::from_fn(|i| (b[i] > 0.0).then(|| a[i] / b[i]))
+    }
+
+    /// Reads back what [`Self::to_json`] wrote (µs).
+    pub fn from_json(v: &serde_json::Value) -> Option<Self> {
+        let f = |k: &str| v.get(k).and_then(|x| x.as_f64());
+        Some(Self {
+            count: v.get("count").and_then(|x| x.as_u64())?,
+            min: f("min")?,
+            p50: f("p50")?,
+            p99: f("p99")?,
+            p999: f("p999")?,
+            p9999: f("p9999")?,
+            max: f("max")?,
+        })
     }
 
     pub fn to_json(self) -> serde_json::Value {
