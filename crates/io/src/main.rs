@@ -17,7 +17,6 @@ mod backend;
 mod cli;
 mod run;
 mod say;
-mod signals;
 mod sim;
 
 use std::io::Write;
@@ -67,7 +66,7 @@ fn real_main() -> i32 {
         say.always(format_args!("{e}"));
         return 2;
     }
-    if let Err(e) = signals::install_termination() {
+    if let Err(e) = motion_rt::termination::install() {
         say.always(format_args!("error: {e}"));
         return 1;
     }

@@ -22,7 +22,7 @@ use motion_frames::{monotonic_ns, FeedbackFrame, IoPorts, IpcError};
 
 use crate::backend::Backend;
 use crate::say::{Once, Say};
-use crate::signals;
+use motion_rt::termination as signals;
 
 /// Tick period while nothing is under command (before the first command,
 /// after the watchdog stop): the status heartbeat and the exit checks.
@@ -141,7 +141,7 @@ impl Loop<'_> {
 
     fn run(&mut self) -> Outcome {
         loop {
-            if signals::requested() {
+            if signals::received().is_some() {
                 self.stop_on_signal();
                 return Outcome::Signal;
             }
@@ -377,7 +377,7 @@ impl Loop<'_> {
         let say = self.say();
         say.info(format_args!(
             "{} received after {} commands: stopping every axis",
-            signals::name().unwrap_or("signal"),
+            signals::received_name().unwrap_or("signal"),
             self.commands
         ));
         let dt = self.dt_s();

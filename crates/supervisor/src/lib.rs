@@ -17,5 +17,4 @@ pub mod report;
 pub mod rt_thread;
 pub mod session;
 pub mod shared;
-pub mod signals;
 pub mod stats;

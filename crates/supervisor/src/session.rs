@@ -7,9 +7,9 @@
 use crate::io_child::IoChild;
 use crate::rt_thread::{self, RtOutcome, RtSettings};
 use crate::shared::{Control, Phase, Shared, Snapshot};
-use crate::signals;
 use crate::stats::HistSet;
 use motion_config::{IoMode, MachineConfig};
+use motion_rt::termination as signals;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
@@ -77,7 +77,7 @@ fn io_placement(m: &MachineConfig) -> Vec<String> {
 
 impl Session {
     pub fn start(machine: MachineConfig, opts: &SessionOptions) -> Result<Session, String> {
-        signals::install();
+        signals::install()?;
         let mut warnings = Vec::new();
         let idle_latency = match machine.supervisor.cpu_dma_latency_us {
             us if us >= 0 => match motion_rt::hold_cpu_dma_latency(us) {

@@ -3,7 +3,7 @@ use crate::cli::Common;
 use crate::report::{self, Row};
 use crate::session::Session;
 use crate::shared::{AxisSnap, Control};
-use crate::signals;
+use motion_rt::termination as signals;
 use std::time::{Duration, Instant};
 
 /// `home`: the commissioning run of interface.md.

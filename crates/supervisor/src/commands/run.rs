@@ -1,6 +1,6 @@
 use super::{load, rt_json, rt_lines, start};
 use crate::cli::Common;
-use crate::signals;
+use motion_rt::termination as signals;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
