@@ -79,15 +79,7 @@ pub fn config(tag: &str, supervisor_extra: &str, axes: &str) -> TempConfig {
 
 /// Files of this prefix's iceoryx2 domain in /dev/shm.
 pub fn shm_leftovers(prefix: &str) -> Vec<String> {
-    let want = format!("iox2_{prefix}_");
-    std::fs::read_dir("/dev/shm")
-        .map(|d| {
-            d.filter_map(|e| e.ok())
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.starts_with(&want))
-                .collect()
-        })
-        .unwrap_or_default()
+    motion_frames::IpcConfig::new(prefix).shm_files()
 }
 
 /// Asserts that the domain left nothing behind (waits briefly: a process

@@ -158,6 +158,27 @@ fn parse_opts() -> Result<Option<Opts>, String> {
     Ok(Some(o))
 }
 
+/// A `[u8; N]` topic with the frames' QoS (the same settings as
+/// `motion_frames::ipc`'s ports, so the bare peer differs only in payload type).
+fn open_topic<const N: usize>(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> Result<
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [u8; N], ()>,
+    String,
+> {
+    node.service_builder(&service(name)?)
+        .publish_subscribe::<[u8; N]>()
+        .enable_safe_overflow(true)
+        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+        .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
+        .history_size(HISTORY)
+        .max_publishers(MAX_PUBLISHERS)
+        .max_subscribers(MAX_SUBSCRIBERS)
+        .open_or_create()
+        .map_err(|x| format!("open topic {name}: {x:?}"))
+}
+
 /// Result of one mode.
 struct Measured {
     hist: Histogram<u64>,
@@ -240,7 +261,7 @@ fn bench_main() -> i32 {
         if let Some(e) = report.error {
             leftovers.push(format!("{prefix}: {e}"));
         }
-        let left = shm_entries(&prefix);
+        let left = IpcConfig::new(prefix.clone()).shm_files();
         if !left.is_empty() {
             leftovers.push(format!("{prefix}: {}", left.join(", ")));
         }
@@ -355,18 +376,6 @@ fn bench_main() -> i32 {
         }
         1
     }
-}
-
-fn shm_entries(prefix: &str) -> Vec<String> {
-    let fp = IpcConfig::new(prefix).file_prefix();
-    std::fs::read_dir("/dev/shm")
-        .map(|rd| {
-            rd.flatten()
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.starts_with(&fp))
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 /// Starts the peer, measures in a pinned SCHED_FIFO thread, stops the peer.
@@ -526,28 +535,8 @@ impl<const TX: usize, const RX: usize> BareSide<TX, RX> {
     /// Publishes on `{prefix}/{tx}` (+ `_ready` event), subscribes to
     /// `{prefix}/{rx}` (+ `_ready`), with the frames' QoS.
     fn create(node: &Node<ipc::Service>, prefix: &str, tx: &str, rx: &str) -> Result<Self, String> {
-        let topic_tx = node
-            .service_builder(&service(&format!("{prefix}/{tx}"))?)
-            .publish_subscribe::<[u8; TX]>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(HISTORY)
-            .max_publishers(MAX_PUBLISHERS)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open_or_create()
-            .map_err(|x| format!("open topic: {x:?}"))?;
-        let topic_rx = node
-            .service_builder(&service(&format!("{prefix}/{rx}"))?)
-            .publish_subscribe::<[u8; RX]>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(HISTORY)
-            .max_publishers(MAX_PUBLISHERS)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open_or_create()
-            .map_err(|x| format!("open topic: {x:?}"))?;
+        let topic_tx = open_topic::<TX>(node, &format!("{prefix}/{tx}"))?;
+        let topic_rx = open_topic::<RX>(node, &format!("{prefix}/{rx}"))?;
         let event = |name: String| {
             node.service_builder(&service(&name)?)
                 .event()

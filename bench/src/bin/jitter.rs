@@ -928,15 +928,7 @@ fn last_lines(s: &str, n: usize) -> String {
 
 /// Shared memory the supervisor (or its motion-io) left behind.
 fn leftover_shm(prefix: &str, warnings: &mut BTreeSet<String>) {
-    let file_prefix = motion_frames::IpcConfig::new(prefix).file_prefix();
-    let left: Vec<String> = std::fs::read_dir("/dev/shm")
-        .map(|rd| {
-            rd.flatten()
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.starts_with(&file_prefix))
-                .collect()
-        })
-        .unwrap_or_default();
+    let left = motion_frames::IpcConfig::new(prefix).shm_files();
     if !left.is_empty() {
         warnings.insert(format!(
             "shared memory left in /dev/shm after a run: {}",

@@ -170,6 +170,23 @@ impl IpcConfig {
         format!("iox2_{clean}_")
     }
 
+    /// Names of this domain's files in `/dev/shm`, sorted: what
+    /// [`cleanup_domain`] must leave empty once every process has gone (and
+    /// what the tests check).
+    pub fn shm_files(&self) -> Vec<String> {
+        let prefix = self.file_prefix();
+        let mut v: Vec<String> = std::fs::read_dir("/dev/shm")
+            .map(|rd| {
+                rd.flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.starts_with(&prefix))
+                    .collect()
+            })
+            .unwrap_or_default();
+        v.sort();
+        v
+    }
+
     /// The service names of this prefix.
     pub fn service_names(&self) -> ServiceNames {
         service_names(&self.prefix)
@@ -1197,18 +1214,6 @@ mod tests {
         }
     }
 
-    fn shm_entries(cfg: &IpcConfig) -> Vec<String> {
-        let prefix = cfg.file_prefix();
-        std::fs::read_dir("/dev/shm")
-            .map(|rd| {
-                rd.flatten()
-                    .map(|e| e.file_name().to_string_lossy().into_owned())
-                    .filter(|n| n.starts_with(&prefix))
-                    .collect()
-            })
-            .unwrap_or_default()
-    }
-
     #[test]
     fn cleanup_domain_keeps_a_live_domain_and_removes_an_empty_one() {
         let env = TestEnv::new("cln");
@@ -1218,17 +1223,17 @@ mod tests {
             let r = cleanup_domain(&env.cfg);
             assert_eq!(r.alive, 1, "{r:?}");
             assert!(!r.removed_global_mgmt && !r.domain_gone(), "{r:?}");
-            assert!(!shm_entries(&env.cfg).is_empty());
+            assert!(!env.cfg.shm_files().is_empty());
         }
         let r = cleanup_domain(&env.cfg);
         println!("after drop: {r}");
         assert_eq!(r.alive, 0, "{r:?}");
         assert!(r.removed_global_mgmt && r.domain_gone(), "{r:?}");
-        assert_eq!(shm_entries(&env.cfg), Vec::<String>::new());
+        assert_eq!(env.cfg.shm_files(), Vec::<String>::new());
         // idempotent, and creates nothing
         let r = cleanup_domain(&env.cfg);
         assert!(!r.removed_global_mgmt && r.domain_gone(), "{r:?}");
-        assert_eq!(shm_entries(&env.cfg), Vec::<String>::new());
+        assert_eq!(env.cfg.shm_files(), Vec::<String>::new());
     }
 
     #[test]

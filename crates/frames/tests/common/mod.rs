@@ -38,7 +38,7 @@ impl TestEnv {
 
     /// Files in /dev/shm that belong to this domain.
     pub fn shm_files(&self) -> Vec<String> {
-        shm_files_with_prefix(&self.cfg.file_prefix())
+        self.cfg.shm_files()
     }
 
     /// Regular files (not directories) anywhere under the root directory.
@@ -100,19 +100,6 @@ impl Drop for TestEnv {
     fn drop(&mut self) {
         self.remove_domain();
     }
-}
-
-pub fn shm_files_with_prefix(prefix: &str) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir("/dev/shm")
-        .map(|rd| {
-            rd.filter_map(|e| e.ok())
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.starts_with(prefix))
-                .collect()
-        })
-        .unwrap_or_default();
-    v.sort();
-    v
 }
 
 fn collect_files(dir: &Path, out: &mut Vec<PathBuf>) {

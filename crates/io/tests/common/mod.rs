@@ -313,15 +313,7 @@ impl Sup {
 
 /// `/dev/shm` entries of the iceoryx2 domain of `prefix`.
 pub fn shm_entries(prefix: &str) -> Vec<String> {
-    let p = IpcConfig::new(prefix).file_prefix();
-    let mut v: Vec<String> = std::fs::read_dir("/dev/shm")
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with(&p))
-        .collect();
-    v.sort();
-    v
+    IpcConfig::new(prefix).shm_files()
 }
 
 /// After a test: the supervisor side is dropped first, then the domain is
