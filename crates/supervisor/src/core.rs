@@ -30,6 +30,12 @@ pub struct Core {
     frames_received: u64,
     frames_missing: u64,
     frames_rejected: u64,
+    /// Answers older than this many commands count as missing.
+    stale_cycles: u64,
+    /// Sequence of the last command frame published (0: none yet).
+    last_sent: u64,
+    /// Frames that arrived but answered a command too old to trust.
+    frames_late: u64,
     io_fresh: bool,
     cycle: u64,
 }
@@ -47,6 +53,9 @@ impl Core {
             frames_received: 0,
             frames_missing: 0,
             frames_rejected: 0,
+            stale_cycles: u64::from(m.supervisor.stale_cycles),
+            last_sent: 0,
+            frames_late: 0,
             io_fresh: false,
             cycle: 0,
         }
@@ -86,11 +95,21 @@ impl Core {
     }
 
     /// One cycle: `frame` is the fresh feedback frame, if one arrived.
+    ///
+    /// A frame is used only if it has this machine's axis count and answers
+    /// one of the last `stale_cycles` commands: a new frame that answers an
+    /// old command (a lagging I/O process, or `motion-io`'s watchdog frames,
+    /// which answer none) carries old positions and counts as missing.
     pub fn step(&mut self, now_ns: u64, frame: Option<&FeedbackFrame>) {
         self.cycle += 1;
-        let usable = frame.filter(|f| f.header.axis_count as usize == self.axes.len());
-        if frame.is_some() && usable.is_none() {
+        let right_shape = frame.filter(|f| f.header.axis_count as usize == self.axes.len());
+        if frame.is_some() && right_shape.is_none() {
             self.frames_rejected += 1;
+        }
+        let usable = right_shape
+            .filter(|f| self.last_sent.saturating_sub(f.answers_sequence) <= self.stale_cycles);
+        if right_shape.is_some() && usable.is_none() {
+            self.frames_late += 1;
         }
         self.io_fresh = usable.is_some();
         if usable.is_some() {
@@ -129,6 +148,11 @@ impl Core {
         for (i, cmd) in self.commands.iter().enumerate() {
             frame.axes[i] = command_to_axis(cmd, self.counts_per_unit[i]);
         }
+    }
+
+    /// The command frame with this sequence number was published.
+    pub fn sent(&mut self, sequence: u64) {
+        self.last_sent = sequence;
     }
 
     /// A frame the ports refused (wrong layout version, bad header).
@@ -172,6 +196,7 @@ impl Core {
         s.frames_received = self.frames_received;
         s.frames_missing = self.frames_missing;
         s.frames_rejected = self.frames_rejected;
+        s.frames_late = self.frames_late;
         s.io_fresh = self.io_fresh;
         s.all_at_rest = self.all_at_rest();
     }
@@ -222,6 +247,26 @@ mod tests {
             core.step(k * 1_000_000, Some(&fb));
         }
         assert!(core.exit_done());
+    }
+
+    #[test]
+    fn an_answer_to_an_old_command_is_no_feedback() {
+        let m = motion_config::parse(motion_config::DEMO_TOML).unwrap();
+        let stale = u64::from(m.supervisor.stale_cycles);
+        let mut core = Core::new(&m);
+        let mut fb = FeedbackFrame::default();
+        fb.header.axis_count = m.axes.len() as u32;
+        fb.answers_sequence = 100;
+        core.sent(100 + stale);
+        core.step(0, Some(&fb));
+        let mut snap = Snapshot::default();
+        core.snapshot(0, &mut snap);
+        assert!(snap.io_fresh, "{stale} commands old is still fresh");
+        core.sent(101 + stale);
+        core.step(1, Some(&fb));
+        core.snapshot(1, &mut snap);
+        assert!(!snap.io_fresh);
+        assert_eq!((snap.frames_late, snap.frames_received), (1, 1));
     }
 
     #[test]

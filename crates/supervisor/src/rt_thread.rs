@@ -181,6 +181,7 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
 
         let mut roundtrip = None;
         if let Ok(sent) = sent {
+            core.sent(sent.sequence);
             let budget_end = wake.deadline_ns + s.reply_budget_ns;
             // At most a few wake-ups per cycle (a stray one, then ours).
             for _ in 0..4 {

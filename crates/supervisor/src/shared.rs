@@ -62,6 +62,8 @@ pub struct Snapshot {
     pub io_fresh: bool,
     /// Frames rejected: wrong layout or axis count.
     pub frames_rejected: u64,
+    /// Frames that answered a command older than `stale_cycles` (not used).
+    pub frames_late: u64,
     /// Every axis is at rest with nothing in process.
     pub all_at_rest: bool,
 }
@@ -77,6 +79,7 @@ impl Default for Snapshot {
             frames_missing: 0,
             io_fresh: false,
             frames_rejected: 0,
+            frames_late: 0,
             all_at_rest: true,
         }
     }

@@ -96,8 +96,9 @@ fn rt_lines(f: &crate::session::Finished) -> Vec<String> {
     ));
     if let Some(s) = f.snapshot.as_deref() {
         out.push(format!(
-            "feedback frames: {} answered cycles, {} cycles without a fresh frame, {} refused",
-            s.frames_received, s.frames_missing, s.frames_rejected
+            "feedback frames: {} answered cycles, {} cycles without a fresh frame \
+             ({} answered a command too old to use), {} refused",
+            s.frames_received, s.frames_missing, s.frames_late, s.frames_rejected
         ));
     }
     let pct = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{:.1} %", v * 100.0));
@@ -130,6 +131,7 @@ fn rt_json(f: &crate::session::Finished) -> serde_json::Value {
             "received": s.frames_received,
             "missing": s.frames_missing,
             "refused": s.frames_rejected,
+            "too_old": s.frames_late,
         })),
     })
 }
