@@ -169,7 +169,7 @@ pub fn feedback_to_axis(fb: &Feedback, counts_per_unit: f64) -> AxisFeedback {
         marker_latched: u8::from(fb.marker_latch.latched),
         switch_latch_id: fb.switch_latch.id,
         switch_latched: u8::from(fb.switch_latch.latched),
-        reserved: [0; 2],
+        error_code: 0,
         marker_latch_position: units_to_counts(fb.marker_latch.position, counts_per_unit),
         switch_latch_position: units_to_counts(fb.switch_latch.position, counts_per_unit),
     }
@@ -375,7 +375,7 @@ mod tests {
         assert_eq!((w.switch_latch_id, w.switch_latched), (9, 0));
         assert_eq!(w.marker_latch_position, 2500);
         assert_eq!(w.switch_latch_position, 0);
-        assert_eq!(w.reserved, [0; 2]);
+        assert_eq!(w.error_code, 0);
     }
 
     #[test]
@@ -412,7 +412,7 @@ mod tests {
             marker_latched: 1,
             switch_latch_id: 2,
             switch_latched: 1,
-            reserved: [0; 2],
+            error_code: 0,
             marker_latch_position: 77,
             switch_latch_position: -77,
         };

@@ -32,7 +32,7 @@ use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
 /// iceoryx2 type names with `concat!` (the single source of the number).
 macro_rules! layout_version_literal {
     () => {
-        1
+        2
     };
 }
 
@@ -63,8 +63,14 @@ pub const CW_ENABLE: u16 = 1 << 0;
 pub const SW_ENABLED: u16 = 1 << 0;
 /// [`AxisFeedback::status_word`] bit 1: drive fault (following error, overload, ...);
 /// the drive no longer follows the command.
-/// Bits 2..=15 are reserved: sent as 0, ignored by the receiver.
 pub const SW_FAULT: u16 = 1 << 1;
+/// [`AxisFeedback::status_word`] bit 2: the I/O process has no fresh data for
+/// this axis this cycle (a fieldbus frame lost, a working-counter mismatch, a
+/// SubDevice out of OP). The rest of the entry is the last known state and
+/// must not be used as feedback: the supervisor counts the axis as missing
+/// feedback, and its loss rule decides.
+/// Bits 3..=15 are reserved: sent as 0, ignored by the receiver.
+pub const SW_NO_DATA: u16 = 1 << 2;
 
 /// [`AxisFeedback::digital_inputs`] bit 0: home switch contact closed (electrical level).
 pub const DI_HOME_SWITCH: u32 = 1 << 0;
@@ -210,8 +216,8 @@ pub struct AxisFeedback {
     /// [`DI_MARKER_PULSE`] (bit 3);
     /// bits 3..=31 reserved (0).
     pub digital_inputs: u32,
-    /// Status bits: [`SW_ENABLED`] (bit 0), [`SW_FAULT`] (bit 1); bits 2..=15
-    /// reserved (0).
+    /// Status bits: [`SW_ENABLED`] (bit 0), [`SW_FAULT`] (bit 1),
+    /// [`SW_NO_DATA`] (bit 2); bits 3..=15 reserved (0).
     pub status_word: u16,
     /// Id of the marker arm request this latch state belongs to (0 = disarmed).
     pub marker_latch_id: u8,
@@ -221,8 +227,9 @@ pub struct AxisFeedback {
     pub switch_latch_id: u8,
     /// 1 = the switch latch holds a position, 0 = not (yet) latched.
     pub switch_latched: u8,
-    /// Explicit padding to 8-byte alignment; always 0.
-    pub reserved: [u8; 2],
+    /// The drive's own error code while it reports a fault (CiA 402 object
+    /// 0x603F), kept for the operator; 0 = none or not known.
+    pub error_code: u16,
     /// Raw position of the latched marker edge, counts (valid when `marker_latched`).
     pub marker_latch_position: i64,
     /// Raw position of the latched switch edge, counts (valid when `switch_latched`).
@@ -258,7 +265,7 @@ impl AxisFeedback {
         marker_latched: 0,
         switch_latch_id: 0,
         switch_latched: 0,
-        reserved: [0; 2],
+        error_code: 0,
         marker_latch_position: 0,
         switch_latch_position: 0,
     };
@@ -402,7 +409,7 @@ const _: () = {
     use core::mem::{align_of, offset_of, size_of};
 
     assert!(
-        LAYOUT_VERSION == 1,
+        LAYOUT_VERSION == 2,
         "update the layout asserts together with LAYOUT_VERSION"
     );
 
@@ -440,7 +447,7 @@ const _: () = {
     assert!(offset_of!(AxisFeedback, marker_latched) == 27);
     assert!(offset_of!(AxisFeedback, switch_latch_id) == 28);
     assert!(offset_of!(AxisFeedback, switch_latched) == 29);
-    assert!(offset_of!(AxisFeedback, reserved) == 30);
+    assert!(offset_of!(AxisFeedback, error_code) == 30);
     assert!(offset_of!(AxisFeedback, marker_latch_position) == 32);
     assert!(offset_of!(AxisFeedback, switch_latch_position) == 40);
     assert!(8 + 8 + 4 + 4 + 2 + 1 + 1 + 1 + 1 + 2 + 8 + 8 == size_of::<AxisFeedback>());

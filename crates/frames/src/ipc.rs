@@ -1197,7 +1197,7 @@ mod tests {
     /// service name, another layout (and so another type name).
     #[repr(C)]
     #[derive(Clone, Copy, Debug, Default, ZeroCopySend, PlacementDefault)]
-    #[type_name("motion_frames::CommandFrame@layout2")]
+    #[type_name("motion_frames::CommandFrame@layout999")]
     struct CommandFrameV2 {
         header: FrameHeader,
         extra: u64,
@@ -1205,7 +1205,7 @@ mod tests {
 
     impl Frame for CommandFrameV2 {
         const NAME: &'static str = "command frame v2";
-        const TYPE_NAME: &'static str = "motion_frames::CommandFrame@layout2";
+        const TYPE_NAME: &'static str = "motion_frames::CommandFrame@layout999";
         fn header(&self) -> &FrameHeader {
             &self.header
         }

@@ -7,7 +7,7 @@
 
 use crate::shared::{AxisSnap, Control, Snapshot};
 use motion_config::MachineConfig;
-use motion_frames::{axis_to_feedback, command_to_axis, CommandFrame, FeedbackFrame};
+use motion_frames::{axis_to_feedback, command_to_axis, CommandFrame, FeedbackFrame, SW_NO_DATA};
 use motion_homing::{Axis, Command, Feedback, Phase, Request};
 
 /// The Home instruction's rung for one axis, driven by control requests.
@@ -119,8 +119,12 @@ impl Core {
         }
         let at_rest = self.exiting && self.all_at_rest();
         for i in 0..self.axes.len() {
-            self.feedback[i] =
-                usable.map(|f| axis_to_feedback(&f.axes[i], self.counts_per_unit[i]));
+            // An entry the I/O process marks as not fresh (bus frame lost,
+            // SubDevice out of OP) is missing feedback for that axis alone.
+            self.feedback[i] = usable
+                .map(|f| &f.axes[i])
+                .filter(|a| a.status_word & SW_NO_DATA == 0)
+                .map(|a| axis_to_feedback(a, self.counts_per_unit[i]));
             let rung = &mut self.rungs[i];
             if rung.pending_home {
                 rung.pending_home = false;
