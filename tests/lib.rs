@@ -64,10 +64,12 @@ impl Drop for TempConfig {
 pub fn config(tag: &str, supervisor_extra: &str, axes: &str) -> TempConfig {
     let prefix = unique_prefix(tag);
     let path = std::env::temp_dir().join(format!("{prefix}.toml"));
-    let stale = if supervisor_extra.contains("stale_cycles") {
+    let stale = if supervisor_extra.contains("stale_cycles")
+        || supervisor_extra.contains("feedback_timeout_ms")
+    {
         ""
     } else {
-        "stale_cycles = 20\n"
+        "feedback_timeout_ms = 20\n"
     };
     let text = format!(
         "[supervisor]\ncycle_us = 1000\ncpu = 1\npriority = 80\nio = \"sim\"\n\
@@ -77,9 +79,9 @@ pub fn config(tag: &str, supervisor_extra: &str, axes: &str) -> TempConfig {
     TempConfig { path, prefix }
 }
 
-/// Files of this prefix's iceoryx2 domain in /dev/shm.
+/// Files of every iceoryx2 domain of this prefix in /dev/shm.
 pub fn shm_leftovers(prefix: &str) -> Vec<String> {
-    motion_frames::IpcConfig::new(prefix).shm_files()
+    motion_frames::Domain::shm_files_of_prefix(prefix)
 }
 
 /// Asserts that the domain left nothing behind (waits briefly: a process

@@ -157,7 +157,9 @@ fn machine(n: usize) -> MachineConfig {
         .collect();
     MachineConfig {
         supervisor: d.supervisor.clone(),
+        ios: d.ios.clone(),
         axes,
+        warnings: Vec::new(),
     }
 }
 
@@ -175,14 +177,23 @@ fn homing_core(m: &MachineConfig) -> (Core, FeedbackFrame, CommandFrame, u64) {
     for (i, (a, p)) in m.axes.iter().zip(&plants).enumerate() {
         fb.axes[i] = feedback_to_axis(&p.feedback(), a.engine.counts_per_unit);
     }
+    fb.header.origin = 1;
     for k in 0..CYCLE_WARMUP {
         if k == 10 {
-            for i in 0..m.axes.len() {
-                core.control(Control::Home(i));
-            }
+            core.control(
+                Control::Home {
+                    id: 1,
+                    mask: u64::MAX >> (64 - m.axes.len()),
+                    parallel: true,
+                    timeout_ns: 0,
+                },
+                k * dt_ns,
+            );
         }
-        core.step(k * dt_ns, Some(&fb));
-        core.fill(&mut cmd);
+        core.step(k * dt_ns, &[(k > 0).then_some(&fb)]);
+        core.fill(0, &mut cmd);
+        core.sent(0, k + 1, k * dt_ns);
+        fb.answers_sequence = k + 1;
         for (i, (a, p)) in m.axes.iter().zip(plants.iter_mut()).enumerate() {
             let c = axis_to_command(&cmd.axes[i], a.engine.counts_per_unit);
             let f = p.step(&c, dt);
@@ -224,8 +235,8 @@ fn cycle(c: &mut Criterion) {
         // real work; the frame conversion runs for every axis.
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
-                core.step(black_box(now), Some(black_box(&fb)));
-                core.fill(black_box(&mut cmd));
+                core.step(black_box(now), &[Some(black_box(&fb))]);
+                core.fill(0, black_box(&mut cmd));
             })
         });
         let after = phases(&core);

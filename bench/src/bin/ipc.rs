@@ -21,11 +21,15 @@ use motion_bench::hist::{self, new_hist, thousands, us};
 use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc::{self, Running};
 use motion_bench::sys::{self, now_ns};
-use motion_frames::ipc::{
-    cleanup_domain, ppoll_until, PollWake, HISTORY, MAX_LISTENERS, MAX_NOTIFIERS, MAX_PUBLISHERS,
-    MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED,
+use motion_frames::ports::{
+    MAX_LISTENERS, MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED,
 };
-use motion_frames::{CommandFrame, FeedbackFrame, IpcConfig, SupervisorPorts};
+use motion_frames::wait::{ppoll_until, PollWake};
+use motion_frames::{cleanup_domain, Domain};
+const HISTORY: usize = 0;
+const MAX_NOTIFIERS: usize = 1;
+const MAX_PUBLISHERS: usize = 1;
+use motion_frames::{CommandFrame, FeedbackFrame, SupervisorPorts};
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -257,11 +261,7 @@ fn bench_main() -> i32 {
                 failures.push(format!("{}: {e}", mode.key()));
             }
         }
-        let report = cleanup_domain(&IpcConfig::new(prefix.clone()));
-        if let Some(e) = report.error {
-            leftovers.push(format!("{prefix}: {e}"));
-        }
-        let left = IpcConfig::new(prefix.clone()).shm_files();
+        let left = Domain::shm_files_of_prefix(&prefix);
         if !left.is_empty() {
             leftovers.push(format!("{prefix}: {}", left.join(", ")));
         }
@@ -421,6 +421,9 @@ fn run_mode(
             cmd.args(["--priority", &peer_prio]);
         }
     }
+    // This process plays the supervisor: it claims the prefix first, the
+    // peer joins through the session file.
+    let domain = Domain::establish(prefix, None).map_err(|e| e.to_string())?;
     let mut peer = Running::spawn(&mut cmd, mode.key(), true, false)?;
 
     let (count, period_ns, warmup, cpu, prio) = (
@@ -432,6 +435,7 @@ fn run_mode(
     );
     let prefix_owned = prefix.to_string();
     let bare = mode.bare();
+    let d = domain.clone();
     let worker = std::thread::Builder::new()
         .name("ipc-measure".into())
         .spawn(move || -> Result<Measured, String> {
@@ -439,14 +443,12 @@ fn run_mode(
             if !refused.is_empty() {
                 return Err(refused.join("; "));
             }
-            let ipc = IpcConfig::new(prefix_owned.clone());
-            let node = ipc.create_node("motion-bench").map_err(|e| e.to_string())?;
+            let node = d.create_node("motion-bench").map_err(|e| e.to_string())?;
             if bare {
                 let mut x = BareSide::<PING, PONG>::create(&node, &prefix_owned, "ping", "pong")?;
                 measure(&mut x, count, period_ns, warmup)
             } else {
-                let ports =
-                    SupervisorPorts::create(&node, &prefix_owned).map_err(|e| e.to_string())?;
+                let ports = SupervisorPorts::create(&node, &d, "io").map_err(|e| e.to_string())?;
                 let mut x = FrameSide {
                     ports,
                     axes,
@@ -459,6 +461,8 @@ fn run_mode(
     let result = worker
         .join()
         .unwrap_or_else(|_| Err("the measuring thread panicked".into()));
+    let _ = cleanup_domain(&domain);
+    domain.withdraw();
     let still_running = peer.running();
     let ended = peer.wait(Duration::ZERO, Duration::from_secs(3));
     if !still_running {
@@ -761,7 +765,6 @@ fn echo_main(mut a: Args) -> i32 {
             1
         }
     };
-    let _ = cleanup_domain(&IpcConfig::new(prefix));
     code
 }
 
@@ -769,9 +772,26 @@ fn echo_main(mut a: Args) -> i32 {
 /// SIGTERM/SIGINT. Event mode sleeps in `ppoll` on the listener's
 /// descriptor; spin mode polls the subscriber.
 fn echo(prefix: &str, spin: bool) -> Result<(), String> {
-    let ipc = IpcConfig::new(prefix);
-    let node = ipc.create_node("bench-echo").map_err(|e| e.to_string())?;
+    let until = std::time::Instant::now() + Duration::from_secs(10);
+    let domain = loop {
+        match Domain::join(prefix, None) {
+            Ok(d) => break d,
+            Err(e) if std::time::Instant::now() > until => return Err(e.to_string()),
+            Err(_) => std::thread::sleep(Duration::from_millis(20)),
+        }
+    };
+    let node = domain
+        .create_node("bench-echo")
+        .map_err(|e| e.to_string())?;
     let mut x = BareSide::<PONG, PING>::create(&node, prefix, "pong", "ping")?;
+    let r = echo_loop(&mut x, spin);
+    drop(x);
+    drop(node);
+    let _ = cleanup_domain(&domain);
+    r
+}
+
+fn echo_loop(x: &mut BareSide<PONG, PING>, spin: bool) -> Result<(), String> {
     while !proc::stop_requested() {
         if !spin {
             // bounded, so that the stop flag is seen even without pings

@@ -10,6 +10,7 @@ use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc::{self, Running};
 use motion_bench::svg::{self, Series};
 use motion_bench::sys;
+use motion_supervisor::stats::percentiles as pct_of;
 use serde_json::{json, Value};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -495,9 +496,9 @@ fn run(o: &Opts) -> Result<i32, String> {
         }
         p
     };
-    let w_ours = exact(Pct::of(&ours_wake), &|s| s.json_wakeup);
-    let c_ours = exact(Pct::of(&ours_compute), &|s| s.json_compute);
-    let r_ours = exact(Pct::of(&ours_rt), &|s| s.json_roundtrip);
+    let w_ours = exact(pct_of(&ours_wake), &|s| s.json_wakeup);
+    let c_ours = exact(pct_of(&ours_compute), &|s| s.json_compute);
+    let r_ours = exact(pct_of(&ours_rt), &|s| s.json_roundtrip);
     let cycles: u64 = ours.iter().map(|s| s.cycles).sum();
     let misses: u64 = ours.iter().map(|s| s.misses).sum();
     let late: u64 = ours.iter().map(|s| s.late).sum();
@@ -511,7 +512,7 @@ fn run(o: &Opts) -> Result<i32, String> {
         ct_total.overflows += s.hist.overflows;
         ct_total.max_us = ct_total.max_us.max(s.hist.max_us);
     }
-    let w_ct = Pct::of(&ct_hdr);
+    let w_ct = pct_of(&ct_hdr);
     let ct_ge_period: u64 = ct
         .iter()
         .map(|s| s.hist.at_or_above(u64::from(o.period_us)))
@@ -773,16 +774,16 @@ fn run(o: &Opts) -> Result<i32, String> {
             "deadline_miss_ratio": miss_ratio,
             "late_replies": late,
             "hlog_samples": ours_wake.len(),
-            "wakeup_us": w_ours.to_json(),
-            "compute_us": c_ours.to_json(),
-            "io_roundtrip_us": r_ours.to_json(),
+            "wakeup_us": serde_json::to_value(w_ours).unwrap_or_default(),
+            "compute_us": serde_json::to_value(c_ours).unwrap_or_default(),
+            "io_roundtrip_us": serde_json::to_value(r_ours).unwrap_or_default(),
             "warnings": warnings.iter().cloned().collect::<Vec<_>>(),
         },
         "cyclictest": if have_ct { json!({
             "command": ct_command,
             "seconds": ct_secs,
             "slices": ct.len(),
-            "wakeup_us": w_ct.to_json(),
+            "wakeup_us": serde_json::to_value(w_ct).unwrap_or_default(),
             "deadline_misses": Value::Null,
             "deadline_misses_note": "not counted (cyclictest skips missed periods)",
             "samples_at_or_above_period": ct_ge_period,
@@ -846,26 +847,23 @@ fn our_slice(
     if !ended.success() {
         return Err(format!("{}{}", ended.describe(), tail()));
     }
-    let v: Value = ended
+    // The supervisor's own typed report (motion_report::RunReport).
+    let report: motion_report::RunReport = ended
         .stdout
         .lines()
         .rev()
         .find_map(|l| serde_json::from_str(l.trim()).ok())
-        .ok_or_else(|| format!("no JSON on its stdout{}", tail()))?;
-    let lat = v.get("latency").ok_or("no \"latency\" in its JSON")?;
-    let get = |k: &str| lat.get(k).and_then(Value::as_u64).unwrap_or(0);
-    let pct = |k: &str| lat.get(k).and_then(Pct::from_json).unwrap_or_default();
-    let mut warnings: Vec<String> = Vec::new();
-    if let Some(a) = v.get("warnings").and_then(Value::as_array) {
-        warnings.extend(a.iter().filter_map(|w| w.as_str().map(str::to_string)));
+        .ok_or_else(|| format!("no run report on its stdout{}", tail()))?;
+    let lat = report.latency;
+    let mut warnings: Vec<String> = report.warnings.clone();
+    if let Some(rt) = &report.rt {
+        warnings.extend(rt.warnings.iter().cloned());
     }
-    if let Some(a) = v.pointer("/rt/warnings").and_then(Value::as_array) {
-        warnings.extend(a.iter().filter_map(|w| w.as_str().map(str::to_string)));
-    }
-    if v.pointer("/rt/policy").and_then(Value::as_str) != Some("SCHED_FIFO") {
+    let policy = report.rt.as_ref().map(|r| r.policy.as_str());
+    if policy != Some("SCHED_FIFO") {
         warnings.push(format!(
-            "the cycle did not run SCHED_FIFO (rt: {})",
-            v.get("rt").map(Value::to_string).unwrap_or_default()
+            "the cycle did not run SCHED_FIFO (rt: {:?})",
+            report.rt
         ));
     }
     let intervals = hist::read_interval_log_file(hlog)?;
@@ -875,12 +873,12 @@ fn our_slice(
         wakeup: hist::sum_tag(&intervals, "wakeup"),
         compute: hist::sum_tag(&intervals, "compute"),
         roundtrip: hist::sum_tag(&intervals, "roundtrip"),
-        cycles: get("cycles"),
-        misses: get("deadline_misses"),
-        late: get("late_replies"),
-        json_wakeup: pct("wakeup_us"),
-        json_compute: pct("compute_us"),
-        json_roundtrip: pct("io_roundtrip_us"),
+        cycles: lat.cycles,
+        misses: lat.deadline_misses,
+        late: lat.late_replies,
+        json_wakeup: lat.wakeup_us,
+        json_compute: lat.compute_us,
+        json_roundtrip: lat.io_roundtrip_us,
     };
     if s.cycles == 0 {
         return Err(format!("it measured no cycles{}", tail()));
@@ -928,7 +926,7 @@ fn last_lines(s: &str, n: usize) -> String {
 
 /// Shared memory the supervisor (or its motion-io) left behind.
 fn leftover_shm(prefix: &str, warnings: &mut BTreeSet<String>) {
-    let left = motion_frames::IpcConfig::new(prefix).shm_files();
+    let left = motion_frames::Domain::shm_files_of_prefix(prefix);
     if !left.is_empty() {
         warnings.insert(format!(
             "shared memory left in /dev/shm after a run: {}",

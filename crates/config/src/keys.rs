@@ -59,6 +59,66 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// A number in `[lo, hi]`; anything else (NaN, ±inf, out of range) is a
+    /// problem naming the key and the range, and gives `default`.
+    pub fn f64_in(&mut self, key: &str, default: f64, lo: f64, hi: f64, unit: &str) -> f64 {
+        let present = self.table.contains_key(key);
+        let x = self.f64(key, default);
+        if present && !(x.is_finite() && x >= lo && x <= hi) {
+            let what = if x.is_finite() {
+                "is outside"
+            } else {
+                "is not a finite number; allowed:"
+            };
+            self.problem(
+                key,
+                format!("{} {what} {}..={} {unit}", num(x), num(lo), num(hi)),
+            );
+            return default;
+        }
+        x
+    }
+
+    /// `[lo, hi]` of two finite numbers within ±`bound`, `lo < hi`.
+    pub fn interval(&mut self, key: &str, bound: f64) -> Option<(f64, f64)> {
+        let (a, b) = self.pair(key)?;
+        if !(a.is_finite() && b.is_finite() && a.abs() <= bound && b.abs() <= bound) {
+            self.problem(
+                key,
+                format!(
+                    "[{}, {}]: both ends must be finite numbers within ±{}",
+                    num(a),
+                    num(b),
+                    num(bound)
+                ),
+            );
+            return None;
+        }
+        if a >= b {
+            self.problem(
+                key,
+                format!("[{}, {}]: low must be below high", num(a), num(b)),
+            );
+            return None;
+        }
+        Some((a, b))
+    }
+
+    /// A non-negative integer of at most `hi`.
+    pub fn u32_in(&mut self, key: &str, default: u32, lo: u32, hi: u32) -> u32 {
+        let present = self.table.contains_key(key);
+        let x = self.u32(key, default);
+        if present && !(lo..=hi).contains(&x) {
+            self.problem(key, format!("{x} is outside {lo}..={hi}"));
+            return default;
+        }
+        x
+    }
+
+    pub fn has(&self, key: &str) -> bool {
+        self.table.contains_key(key)
+    }
+
     pub fn u32(&mut self, key: &str, default: u32) -> u32 {
         match self.get(key) {
             None => default,
@@ -175,13 +235,13 @@ impl<'a> Reader<'a> {
                 for v in a {
                     match v {
                         toml::Value::Table(t) => out.push(t.clone()),
-                        other => self.wrong_type(key, "[[axis]] tables", other),
+                        other => self.wrong_type(key, &format!("[[{key}]] tables"), other),
                     }
                 }
                 out
             }
             Some(v) => {
-                self.wrong_type(key, "[[axis]] tables", v);
+                self.wrong_type(key, &format!("[[{key}]] tables"), v);
                 Vec::new()
             }
         }
@@ -198,5 +258,15 @@ impl<'a> Reader<'a> {
                 ));
             }
         }
+    }
+}
+
+/// A number as a person reads it: plain in the usual range, scientific
+/// beyond (`1e308`, not 309 digits).
+pub(crate) fn num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e10).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }

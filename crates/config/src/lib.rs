@@ -4,35 +4,59 @@
 //! Parsing walks the TOML table by hand instead of deriving serde types: a
 //! derive stops at the first wrong key, while a commissioning engineer fixing
 //! a config wants the whole list in one go. Engine-level rules (the CIP codes)
-//! come from [`motion_homing::validate`], so they are written only once.
+//! come from [`motion_homing::validate`], so they are written only once; the
+//! physical ranges every number must lie in are one table ([`limits`]).
 //!
 //! Keys and enum spellings are fixed by `interface.md`; the keys this project
 //! adds are listed in the README's configuration table.
 
+pub mod args;
+mod axis;
+pub mod file;
+mod io;
 mod keys;
+pub mod limits;
 pub mod names;
 mod problem;
+mod supervisor;
 
 use keys::Reader;
 pub use problem::Problem;
 
-use motion_homing::{validate, AxisConfig};
+use motion_homing::AxisConfig;
 use motion_plant::PlantConfig;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The built-in default machine (`deploy/demo.toml`).
 pub const DEMO_TOML: &str = include_str!("../../../deploy/demo.toml");
 
 /// Most axes one supervisor drives (the frame layout's fixed capacity).
 pub const MAX_AXES: usize = 64;
+/// Most I/O processes one supervisor serves.
+pub const MAX_IOS: usize = 16;
 
-/// Where the I/O process comes from.
+/// Name of the one I/O process of a config without `[[io]]` sections.
+pub const DEFAULT_IO_NAME: &str = "io";
+
+/// Who starts an I/O process.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum IoMode {
-    /// The supervisor spawns `motion-io --backend sim`.
+    /// The supervisor spawns `motion-io --backend sim --io NAME`.
     Sim,
-    /// An I/O process is started by someone else; the supervisor waits for it.
+    /// An I/O process is started by someone else (a systemd unit); the
+    /// supervisor waits for it to attach.
     External,
+}
+
+/// One drive-I/O process (`[[io]]`, or the implicit one named `io`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct IoConfig {
+    pub name: String,
+    pub spawn: IoMode,
+    /// CPU of a spawned one (`None`: another CPU than the cycle's).
+    pub cpu: Option<usize>,
+    /// SCHED_FIFO priority of a spawned one (0: normal scheduling).
+    pub priority: i32,
 }
 
 /// `[supervisor]`.
@@ -41,10 +65,15 @@ pub struct SupervisorConfig {
     pub cycle_us: u32,
     pub cpu: usize,
     pub priority: i32,
+    /// `io = "sim" | "external"`: the implicit I/O process of a config
+    /// without `[[io]]`.
     pub io: IoMode,
     pub service_prefix: String,
-    /// Missing-feedback cycles tolerated during homing (engine `stale_limit`).
-    pub stale_cycles: u32,
+    /// Feedback-loss rule: the leaky bucket trips at this many ms of missing
+    /// feedback (see the engine's docs).
+    pub feedback_timeout_ms: f64,
+    /// Share of the elapsed time a fresh cycle drains from the bucket.
+    pub feedback_loss_drain: f64,
     /// Missing-command cycles after which `motion-io` stops every axis.
     pub io_watchdog_cycles: u32,
     /// `mlockall` the process (default true).
@@ -58,11 +87,19 @@ pub struct SupervisorConfig {
     /// Hold `/dev/cpu_dma_latency` at this many µs while running (default 0,
     /// as cyclictest does); negative: leave the idle states alone.
     pub cpu_dma_latency_us: i32,
+    /// Where the supervisor publishes how to reach it (its session file) and
+    /// keeps iceoryx2's files; `None`: the default (`/run/motion` for root).
+    pub runtime_dir: Option<PathBuf>,
 }
 
 impl SupervisorConfig {
     pub fn cycle_ns(&self) -> u64 {
         u64::from(self.cycle_us) * 1000
+    }
+
+    /// The feedback-loss time bound in ns.
+    pub fn feedback_timeout_ns(&self) -> u64 {
+        (self.feedback_timeout_ms * 1e6) as u64
     }
 }
 
@@ -70,6 +107,12 @@ impl SupervisorConfig {
 #[derive(Clone, Debug, PartialEq)]
 pub struct AxisEntry {
     pub name: String,
+    /// Index into [`MachineConfig::ios`] of the I/O process driving it.
+    pub io: usize,
+    /// `home_order`: home-all homes order 0, then 1, ...; equal orders in
+    /// parallel. `None`: see interface.md (config order when no axis has
+    /// one; only when named when some have one).
+    pub home_order: Option<u32>,
     pub engine: AxisConfig,
     pub sim: PlantConfig,
 }
@@ -77,13 +120,37 @@ pub struct AxisEntry {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MachineConfig {
     pub supervisor: SupervisorConfig,
+    /// Every I/O process; at least one.
+    pub ios: Vec<IoConfig>,
     pub axes: Vec<AxisEntry>,
+    /// Things that are accepted but probably not meant (printed at start).
+    pub warnings: Vec<String>,
 }
 
 impl MachineConfig {
     /// Index of the axis called `name`.
     pub fn axis_index(&self, name: &str) -> Option<usize> {
         self.axes.iter().position(|a| a.name == name)
+    }
+
+    /// Index of the I/O process called `name`.
+    pub fn io_index(&self, name: &str) -> Option<usize> {
+        self.ios.iter().position(|i| i.name == name)
+    }
+
+    /// Indices of the axes I/O process `io` drives, in config order: axis
+    /// `k` of its frames is `axes_of(io)[k]`.
+    pub fn axes_of(&self, io: usize) -> Vec<usize> {
+        (0..self.axes.len())
+            .filter(|&i| self.axes[i].io == io)
+            .collect()
+    }
+
+    /// Only the axes of I/O process `io` (what `motion-io --io NAME` serves).
+    pub fn only_io(&self, io: usize) -> MachineConfig {
+        let mut m = self.clone();
+        m.axes.retain(|a| a.io == io);
+        m
     }
 }
 
@@ -94,26 +161,29 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
         Err(e) => return Err(vec![Problem::syntax(text, &e)]),
     };
     let mut problems = Vec::new();
+    let mut warnings = Vec::new();
     let mut top = Reader::new(&table, None, "", &mut problems);
     let sup_table = top.table("supervisor");
+    let io_tables = top.array_of_tables("io");
     let axis_tables = top.array_of_tables("axis");
     top.finish();
 
-    let supervisor = parse_supervisor(sup_table.as_ref(), &mut problems);
+    let supervisor = supervisor::parse(sup_table.as_ref(), &mut problems, &mut warnings);
+    let ios = io::parse(&io_tables, &supervisor, &mut problems, &mut warnings);
     let mut axes = Vec::new();
     for (i, t) in axis_tables.iter().enumerate() {
-        if let Some(a) = parse_axis(i, t, &supervisor, &mut problems) {
+        if let Some(a) = axis::parse(i, t, &supervisor, &ios, &mut problems) {
             axes.push(a);
         }
     }
     if axis_tables.is_empty() {
         problems.push(Problem::new(None, "axis", "no [[axis]] configured"));
     }
-    if axes.len() > MAX_AXES {
+    if axis_tables.len() > MAX_AXES {
         problems.push(Problem::new(
             None,
             "axis",
-            format!("{} axes configured, at most {MAX_AXES}", axes.len()),
+            format!("{} axes configured, at most {MAX_AXES}", axis_tables.len()),
         ));
     }
     for (i, a) in axes.iter().enumerate() {
@@ -125,214 +195,65 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
             ));
         }
     }
+    for (k, io) in ios.iter().enumerate() {
+        if !axes.iter().any(|a| a.io == k) && problems.is_empty() {
+            warnings.push(format!("I/O process {} drives no axis", io.name));
+        }
+    }
     if problems.is_empty() {
-        Ok(MachineConfig { supervisor, axes })
+        Ok(MachineConfig {
+            supervisor,
+            ios,
+            axes,
+            warnings,
+        })
     } else {
         Err(problems)
     }
 }
 
 /// Reads `path`, or the built-in default machine when `None`. Returns the
-/// config and a label for messages ("deploy/demo.toml (built in)").
+/// config and a label for messages ("deploy/demo.toml (built in)"). Only a
+/// regular file of at most [`file::MAX_CONFIG_BYTES`] is read.
 pub fn load(path: Option<&Path>) -> Result<(MachineConfig, String), Vec<Problem>> {
     match path {
         None => parse(DEMO_TOML).map(|c| (c, "deploy/demo.toml (built in)".to_string())),
         Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| {
-                vec![Problem::new(
-                    None,
-                    "file",
-                    format!("cannot read {}: {e}", p.display()),
-                )]
-            })?;
+            let text =
+                file::read_config_file(p).map_err(|e| vec![Problem::new(None, "file", e)])?;
             parse(&text).map(|c| (c, p.display().to_string()))
         }
     }
 }
 
-fn parse_supervisor(t: Option<&toml::Table>, problems: &mut Vec<Problem>) -> SupervisorConfig {
-    let empty = toml::Table::new();
-    let mut r = Reader::new(t.unwrap_or(&empty), None, "supervisor.", problems);
-    let cycle_us = r.u32("cycle_us", 1000);
-    let cpu = r.u32("cpu", 1) as usize;
-    let priority = r.u32("priority", 80) as i32;
-    let io = match r.string("io", "sim").as_str() {
-        "sim" => IoMode::Sim,
-        "external" => IoMode::External,
-        other => {
-            r.problem(
-                "io",
-                format!("\"{other}\" is not one of \"sim\", \"external\""),
-            );
-            IoMode::Sim
+/// CPUs this machine has online (`/sys/devices/system/cpu/online`, e.g.
+/// `0-3,6`); `None` if unknown.
+pub fn online_cpus() -> Option<Vec<usize>> {
+    let text = std::fs::read_to_string("/sys/devices/system/cpu/online").ok()?;
+    let mut cpus = Vec::new();
+    for part in text.trim().split(',').filter(|p| !p.is_empty()) {
+        match part.split_once('-') {
+            Some((a, b)) => cpus.extend(a.parse::<usize>().ok()?..=b.parse::<usize>().ok()?),
+            None => cpus.push(part.parse().ok()?),
         }
-    };
-    let service_prefix = r.string("service_prefix", "motion");
-    let stale_cycles = r.u32("stale_cycles", 3);
-    let io_watchdog_cycles = r.u32("io_watchdog_cycles", 50);
-    let lock_memory = r.bool("lock_memory", true);
-    let cpu_dma_latency_us = r.i32("cpu_dma_latency_us", 0);
-    let io_priority = r.i32("io_priority", (priority - 10).max(1));
-    let io_cpu = match r.i32("io_cpu", -1) {
-        c if c >= 0 => Some(c as usize),
-        _ => None,
-    };
-    if !(0..=99).contains(&io_priority) {
-        r.problem(
-            "io_priority",
-            format!("{io_priority} is outside 0..=99 (0: normal scheduling)"),
-        );
     }
-    if !(20..=100_000).contains(&cycle_us) {
-        r.problem("cycle_us", format!("{cycle_us} µs is outside 20..=100000"));
-    }
-    if !(1..=99).contains(&priority) {
-        r.problem(
-            "priority",
-            format!("{priority} is outside SCHED_FIFO's 1..=99"),
-        );
-    }
-    if service_prefix.is_empty()
-        || service_prefix.len() > 64
-        || !service_prefix
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-    {
-        r.problem(
-            "service_prefix",
-            format!("\"{service_prefix}\" must be 1..=64 characters of [A-Za-z0-9_-]"),
-        );
-    }
-    if io_watchdog_cycles == 0 {
-        r.problem("io_watchdog_cycles", "must be at least 1".into());
-    }
-    r.finish();
-    SupervisorConfig {
-        cycle_us,
-        cpu,
-        priority,
-        io,
-        service_prefix,
-        stale_cycles,
-        io_watchdog_cycles,
-        lock_memory,
-        io_priority,
-        io_cpu,
-        cpu_dma_latency_us,
-    }
+    Some(cpus)
 }
 
-fn parse_axis(
-    index: usize,
-    t: &toml::Table,
-    sup: &SupervisorConfig,
-    problems: &mut Vec<Problem>,
-) -> Option<AxisEntry> {
-    let name = match t.get("name").and_then(|v| v.as_str()) {
-        Some(n) if !n.is_empty() && n.len() <= 32 && !n.contains(char::is_whitespace) => {
-            n.to_string()
-        }
-        Some(n) => {
-            problems.push(Problem::new(
-                Some(&format!("#{}", index + 1)),
-                "name",
-                format!("\"{n}\" must be 1..=32 characters without spaces"),
-            ));
-            format!("#{}", index + 1)
-        }
-        None => {
-            problems.push(Problem::new(
-                Some(&format!("#{}", index + 1)),
-                "name",
-                "missing".to_string(),
-            ));
-            format!("#{}", index + 1)
-        }
-    };
-    let before = problems.len();
-    let mut r = Reader::new(t, Some(&name), "", problems);
-    r.mark_used("name");
-    let d = AxisConfig::default();
-    use motion_homing::{
-        AxisConfiguration as AC, ControlMode as CM, HomeDirection as HD, HomeMode as HM,
-        HomeSequence as HS, TravelMode as TM,
-    };
-    let engine = AxisConfig {
-        configuration: r.choice("configuration", names::CONFIGURATIONS, AC::Servo),
-        control_mode: r.choice("control_mode", names::CONTROL_MODES, CM::Position),
-        travel: r.choice("travel", names::TRAVEL_MODES, TM::Linear),
-        unwind: r.f64("unwind", 0.0),
-        counts_per_unit: r.f64("counts_per_unit", 1.0),
-        marker: r.bool("marker", false),
-        marker_latch: r.bool("marker_latch", true),
-        registration: r.bool("registration", false),
-        travel_limits: r.pair("travel_limits"),
-        home_mode: r.choice("home_mode", names::HOME_MODES, HM::Active),
-        home_direction: r.choice(
-            "home_direction",
-            names::HOME_DIRECTIONS,
-            HD::BidirectionalForward,
-        ),
-        home_sequence: r.choice("home_sequence", names::HOME_SEQUENCES, HS::Immediate),
-        home_switch_normally_closed: r.bool("home_switch_normally_closed", false),
-        home_position: r.f64("home_position", 0.0),
-        home_offset: r.f64("home_offset", 0.0),
-        home_speed: r.f64("home_speed", 0.0),
-        home_return_speed: r.f64("home_return_speed", 0.0),
-        home_acceleration: r.f64("home_acceleration", 0.0),
-        home_deceleration: r.f64("home_deceleration", 0.0),
-        home_torque_level: r.f64("home_torque_level", 0.0),
-        home_torque_threshold: r.f64("home_torque_threshold", 0.0),
-        home_torque_time: r.f64("home_torque_time", 0.0),
-        home_timeout: r.f64("home_timeout", 0.0),
-        home_creep_speed: r.f64("home_creep_speed", 0.0),
-        search_limit: r.f64("search_limit", 0.0),
-        torque_limit: r.f64("torque_limit", d.torque_limit),
-        position_error_tolerance: r.f64("position_error_tolerance", 0.0),
-        velocity_error_tolerance: r.f64("velocity_error_tolerance", 0.0),
-        enable_timeout: r.f64("enable_timeout", d.enable_timeout),
-        stale_limit: sup.stale_cycles,
-        max_position: r.f64("max_position", d.max_position),
-    };
-    let sim_table = r.table("sim");
-    r.finish();
-    let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
-    for e in validate(&engine) {
-        problems.push(Problem::from_engine(&name, &e));
+/// Checks that `cpu` exists on this machine; the message names the CPUs that do.
+pub(crate) fn check_cpu(cpu: i64) -> Result<(), String> {
+    match online_cpus() {
+        Some(cpus) if cpu >= 0 && cpus.contains(&(cpu as usize)) => Ok(()),
+        Some(cpus) => Err(format!(
+            "CPU {cpu} does not exist here (online: {})",
+            cpus.iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(",")
+        )),
+        None if (0..1024).contains(&cpu) => Ok(()),
+        None => Err(format!("CPU {cpu} is outside 0..1024")),
     }
-    (problems.len() == before).then_some(AxisEntry { name, engine, sim })
-}
-
-fn parse_sim(
-    axis: &str,
-    t: Option<&toml::Table>,
-    engine: &AxisConfig,
-    problems: &mut Vec<Problem>,
-) -> PlantConfig {
-    let empty = toml::Table::new();
-    let mut r = Reader::new(t.unwrap_or(&empty), Some(axis), "sim.", problems);
-    let d = PlantConfig::default();
-    let sim = PlantConfig {
-        start: r.f64("start", d.start),
-        switch: r.pair("switch"),
-        // The sim wires the switch as the axis says.
-        switch_normally_closed: engine.home_switch_normally_closed,
-        marker_every: r.f64("marker_every", 0.0),
-        marker_at: r.f64("marker_at", 0.0),
-        hard_stop: r.pair("hard_stop"),
-        overtravel: r.pair("overtravel"),
-        external_speed: r.f64("external_speed", 0.0),
-        push_gain: r.f64("push_gain", d.push_gain),
-        inertia_gain: r.f64("inertia_gain", d.inertia_gain),
-        friction: r.f64("friction", d.friction),
-        enable_delay_cycles: r.u32("enable_delay_cycles", d.enable_delay_cycles),
-        torque_spike: None,
-    };
-    if sim.marker_every < 0.0 {
-        r.problem("marker_every", "must not be negative".into());
-    }
-    r.finish();
-    sim
 }
 
 #[cfg(test)]

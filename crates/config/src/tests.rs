@@ -8,7 +8,9 @@ fn demo_parses() {
     let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["U", "X", "C", "Z"]);
     assert_eq!(m.axes[1].sim.switch, Some((0.0, 5.0)));
-    assert_eq!(m.axes[0].engine.stale_limit, 10);
+    assert_eq!(m.supervisor.feedback_timeout_ms, 10.0);
+    assert_eq!(m.ios.len(), 1);
+    assert_eq!(m.ios[0].name, "io");
 }
 
 #[test]
@@ -39,7 +41,7 @@ counts_per_unit = "many"
     let problems = parse(text).unwrap_err();
     let lines: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
     let want = [
-        "supervisor.cycle_us: 0 µs",
+        "supervisor.cycle_us: 0 is outside 50..=100000",
         "supervisor.io: \"carrier-pigeon\"",
         "supervisor.colour: unknown key",
         "axis X: home_sped: unknown key",
@@ -122,4 +124,165 @@ fn demo_homes_in_simulation() {
         }
         eprintln!("{name}: homed in {:.3} s", k as f64 * dt);
     }
+}
+
+fn problems_of(text: &str) -> Vec<String> {
+    parse(text)
+        .map(|_| Vec::new())
+        .unwrap_or_else(|p| p.iter().map(|p| p.to_string()).collect())
+}
+
+fn has(lines: &[String], want: &str) {
+    assert!(
+        lines.iter().any(|l| l.contains(want)),
+        "missing {want:?} in\n{}",
+        lines.join("\n")
+    );
+}
+
+const ONE_AXIS: &str = "[[axis]]\nname = \"X\"\n";
+
+/// Issue 8's configuration attacks: every one is a problem naming the key.
+#[test]
+fn hostile_numbers_are_refused_by_key() {
+    let text = r#"
+[supervisor]
+cpu = 4294967295
+io_cpu = 99
+stale_cycles = 4294967295
+io_watchdog_cycles = 4294967295
+
+[[axis]]
+name = "X"
+home_sequence = "switch"
+home_speed = 1e308
+home_return_speed = 1.0
+home_acceleration = 1e308
+home_deceleration = 100.0
+home_position = 1e308
+counts_per_unit = 1e-300
+max_position = 1e308
+
+[axis.sim]
+start = nan
+switch = [inf, -inf]
+marker_every = nan
+push_gain = nan
+"#;
+    let p = problems_of(text);
+    for want in [
+        "supervisor.cpu: CPU 4294967295 does not exist",
+        "supervisor.io_cpu: CPU 99 does not exist",
+        "supervisor.stale_cycles: 4294967295 cycles",
+        "supervisor.io_watchdog_cycles: 4294967295 is outside 1..=1000",
+        "axis X: home_speed: 1e308 is outside",
+        "axis X: home_acceleration: 1e308 is outside",
+        "axis X: home_position: 1e308 is outside",
+        "axis X: counts_per_unit: 1e-300 is outside",
+        "axis X: max_position: 1e308 is outside",
+        "axis X: sim.start: NaN is not a finite number",
+        "axis X: sim.switch: [inf, -inf]: both ends must be finite",
+        "axis X: sim.marker_every: NaN is not a finite number",
+        "axis X: sim.push_gain: NaN is not a finite number",
+    ] {
+        has(&p, want);
+    }
+}
+
+#[test]
+fn counts_must_stay_exact() {
+    let p = problems_of(&format!(
+        "{ONE_AXIS}counts_per_unit = 1e9\nmax_position = 1e8\n"
+    ));
+    has(
+        &p,
+        "axis X: max_position: max_position 100000000 × counts_per_unit",
+    );
+}
+
+#[test]
+fn names_are_printable_and_bounded() {
+    // TOML escapes: the name holds a real ESC / zero-width character.
+    for bad in ["X\\u001b[31m", "a\\u200bb", "x y", "nul\\u0000"] {
+        let p = problems_of(&format!("[[axis]]\nname = \"{bad}\"\n"));
+        has(&p, "name: ");
+        assert!(p
+            .iter()
+            .all(|l| !l.contains('\u{1b}') && !l.contains('\u{200b}')));
+    }
+    let long = "n".repeat(100_000);
+    let p = problems_of(&format!("[[axis]]\nname = \"{long}\"\n"));
+    assert!(
+        p.iter().all(|l| l.len() < 300),
+        "a name is never echoed in full"
+    );
+    let p = problems_of(&format!(
+        "[supervisor]\nservice_prefix = \"a/b\"\n{ONE_AXIS}"
+    ));
+    has(&p, "supervisor.service_prefix: service prefix \"a/b\"");
+}
+
+#[test]
+fn several_io_processes() {
+    let text = r#"
+[[io]]
+name = "bus0"
+spawn = "sim"
+cpu = 0
+priority = 70
+
+[[io]]
+name = "bus1"
+spawn = "external"
+
+[[axis]]
+name = "X"
+io = "bus0"
+
+[[axis]]
+name = "Y"
+io = "bus1"
+
+[[axis]]
+name = "Z"
+io = "bus0"
+"#;
+    let m = parse(text).unwrap_or_else(|p| panic!("{p:#?}"));
+    assert_eq!(m.ios.len(), 2);
+    assert_eq!(
+        (m.ios[0].spawn, m.ios[1].spawn),
+        (IoMode::Sim, IoMode::External)
+    );
+    assert_eq!((m.ios[0].cpu, m.ios[0].priority), (Some(0), 70));
+    assert_eq!(m.axes_of(0), vec![0, 2]);
+    assert_eq!(m.axes_of(1), vec![1]);
+    assert_eq!(m.only_io(1).axes.len(), 1);
+
+    let p = problems_of(
+        "[[io]]\nname = \"a\"\n[[io]]\nname = \"b\"\n[[axis]]\nname = \"X\"\n[[axis]]\nname = \"Y\"\nio = \"c\"\n",
+    );
+    has(&p, "axis X: io: missing");
+    has(&p, "axis Y: io: no I/O process \"c\" (configured: a, b)");
+    let p = problems_of("[[io]]\nname = \"a.b\"\n[[io]]\nname = \"x\"\n[[io]]\nname = \"x\"\n[[axis]]\nname = \"X\"\nio = \"x\"\n");
+    has(&p, "io.name: io #1: \"a.b\"");
+    has(&p, "io.name: I/O process name \"x\" used twice");
+}
+
+#[test]
+fn one_implicit_io_process_without_io_sections() {
+    let m = parse(&format!("[supervisor]\nio = \"external\"\n{ONE_AXIS}")).unwrap();
+    assert_eq!(m.ios.len(), 1);
+    assert_eq!(m.ios[0].name, DEFAULT_IO_NAME);
+    assert_eq!(m.ios[0].spawn, IoMode::External);
+    assert_eq!(m.axes[0].io, 0);
+}
+
+#[test]
+fn stale_cycles_is_read_in_milliseconds() {
+    let m = parse(&format!(
+        "[supervisor]\ncycle_us = 500\nstale_cycles = 8\n{ONE_AXIS}"
+    ))
+    .unwrap();
+    assert_eq!(m.supervisor.feedback_timeout_ms, 4.0);
+    assert!(m.warnings.iter().any(|w| w.contains("stale_cycles")));
 }

@@ -32,7 +32,7 @@ use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
 /// iceoryx2 type names with `concat!` (the single source of the number).
 macro_rules! layout_version_literal {
     () => {
-        2
+        3
     };
 }
 
@@ -103,6 +103,14 @@ pub struct FrameHeader {
     /// sent. `CLOCK_MONOTONIC` is system-wide on Linux, so the receiver can
     /// compare it with its own clock (see [`crate::monotonic_ns`]).
     pub timestamp_ns: u64,
+    /// Random per process start of the sender: a new value means the peer
+    /// was restarted (its sequence numbers start again at 1, and the
+    /// supervisor treats a restarted I/O process as a reconnection).
+    pub origin: u64,
+    /// The session key of the supervisor this frame belongs to (128 random
+    /// bits, per supervisor start, handed over in the owner-only session
+    /// file). Both sides refuse frames without it.
+    pub key: [u64; 2],
 }
 
 /// Why a received frame header is not acceptable.
@@ -148,6 +156,8 @@ impl FrameHeader {
         axis_count: 0,
         sequence: 0,
         timestamp_ns: 0,
+        origin: 0,
+        key: [0; 2],
     };
 
     /// Checks the layout version and the axis count of a received frame.
@@ -409,16 +419,18 @@ const _: () = {
     use core::mem::{align_of, offset_of, size_of};
 
     assert!(
-        LAYOUT_VERSION == 2,
+        LAYOUT_VERSION == 3,
         "update the layout asserts together with LAYOUT_VERSION"
     );
 
-    assert!(size_of::<FrameHeader>() == 24);
+    assert!(size_of::<FrameHeader>() == 48);
     assert!(align_of::<FrameHeader>() == 8);
     assert!(offset_of!(FrameHeader, layout_version) == 0);
     assert!(offset_of!(FrameHeader, axis_count) == 4);
     assert!(offset_of!(FrameHeader, sequence) == 8);
     assert!(offset_of!(FrameHeader, timestamp_ns) == 16);
+    assert!(offset_of!(FrameHeader, origin) == 24);
+    assert!(offset_of!(FrameHeader, key) == 32);
 
     assert!(size_of::<AxisCommand>() == 48);
     assert!(align_of::<AxisCommand>() == 8);
@@ -452,19 +464,19 @@ const _: () = {
     assert!(offset_of!(AxisFeedback, switch_latch_position) == 40);
     assert!(8 + 8 + 4 + 4 + 2 + 1 + 1 + 1 + 1 + 2 + 8 + 8 == size_of::<AxisFeedback>());
 
-    assert!(size_of::<CommandFrame>() == 24 + MAX_AXES * 48);
-    assert!(size_of::<CommandFrame>() == 3096);
+    assert!(size_of::<CommandFrame>() == 48 + MAX_AXES * 48);
+    assert!(size_of::<CommandFrame>() == 3120);
     assert!(align_of::<CommandFrame>() == 8);
     assert!(offset_of!(CommandFrame, header) == 0);
-    assert!(offset_of!(CommandFrame, axes) == 24);
+    assert!(offset_of!(CommandFrame, axes) == 48);
 
-    assert!(size_of::<FeedbackFrame>() == 24 + 8 + 8 + MAX_AXES * 48);
-    assert!(size_of::<FeedbackFrame>() == 3112);
+    assert!(size_of::<FeedbackFrame>() == 48 + 8 + 8 + MAX_AXES * 48);
+    assert!(size_of::<FeedbackFrame>() == 3136);
     assert!(align_of::<FeedbackFrame>() == 8);
     assert!(offset_of!(FeedbackFrame, header) == 0);
-    assert!(offset_of!(FeedbackFrame, answers_sequence) == 24);
-    assert!(offset_of!(FeedbackFrame, io_received_ns) == 32);
-    assert!(offset_of!(FeedbackFrame, axes) == 40);
+    assert!(offset_of!(FeedbackFrame, answers_sequence) == 48);
+    assert!(offset_of!(FeedbackFrame, io_received_ns) == 56);
+    assert!(offset_of!(FeedbackFrame, axes) == 64);
 };
 
 #[cfg(test)]

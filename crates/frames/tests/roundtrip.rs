@@ -134,10 +134,10 @@ fn io_answer(cmd: &CommandFrame) -> Feedback {
 fn thousand_round_trips_in_one_process_and_nothing_left_behind() {
     let env = TestEnv::new("rt");
     {
-        let sup_node = env.cfg.create_node("motion-supervisor").unwrap();
-        let io_node = env.cfg.create_node("motion-io").unwrap();
-        let mut sup = SupervisorPorts::create(&sup_node, &env.cfg.prefix).unwrap();
-        let mut io = IoPorts::create(&io_node, &env.cfg.prefix).unwrap();
+        let sup_node = env.domain.create_node("motion-supervisor").unwrap();
+        let io_node = env.domain.create_node("motion-io").unwrap();
+        let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
+        let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
         sup.update_connections().unwrap();
         io.update_connections().unwrap();
 
@@ -210,10 +210,10 @@ fn thousand_round_trips_in_one_process_and_nothing_left_behind() {
 fn heap_allocations_per_operation() {
     let env = TestEnv::new("al");
     {
-        let sup_node = env.cfg.create_node("motion-supervisor").unwrap();
-        let io_node = env.cfg.create_node("motion-io").unwrap();
-        let mut sup = SupervisorPorts::create(&sup_node, &env.cfg.prefix).unwrap();
-        let mut io = IoPorts::create(&io_node, &env.cfg.prefix).unwrap();
+        let sup_node = env.domain.create_node("motion-supervisor").unwrap();
+        let io_node = env.domain.create_node("motion-io").unwrap();
+        let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
+        let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
         sup.update_connections().unwrap();
         io.update_connections().unwrap();
 
@@ -343,9 +343,9 @@ fn heap_allocations_per_operation() {
 fn heap_allocations_per_raw_iceoryx2_call() {
     let env = TestEnv::new("raw");
     {
-        let node = env.cfg.create_node("probe").unwrap();
+        let node = env.domain.create_node("probe").unwrap();
         let topic = node
-            .service_builder(&ServiceName::new(&format!("{}/probe", env.cfg.prefix)).unwrap())
+            .service_builder(&ServiceName::new(&format!("{}/probe", env.domain.prefix)).unwrap())
             .publish_subscribe::<CommandFrame>()
             .enable_safe_overflow(true)
             .subscriber_max_buffer_size(2)
@@ -355,7 +355,9 @@ fn heap_allocations_per_raw_iceoryx2_call() {
             .open_or_create()
             .unwrap();
         let event = node
-            .service_builder(&ServiceName::new(&format!("{}/probe_ready", env.cfg.prefix)).unwrap())
+            .service_builder(
+                &ServiceName::new(&format!("{}/probe_ready", env.domain.prefix)).unwrap(),
+            )
             .event()
             .open_or_create()
             .unwrap();

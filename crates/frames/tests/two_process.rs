@@ -35,8 +35,8 @@ fn child_io_peer() {
         std::env::var(PREFIX_VAR).unwrap(),
         PathBuf::from(std::env::var(ROOT_VAR).unwrap()),
     );
-    let node = env.cfg.create_node("motion-io").unwrap();
-    let mut io = IoPorts::create(&node, &env.cfg.prefix).unwrap();
+    let node = env.domain.create_node("motion-io").unwrap();
+    let mut io = IoPorts::open(&node, &env.domain, "io").unwrap();
     println!("READY"); // libtest may put "test child_io_peer ... " in front
     let mut idle_since = Instant::now();
     loop {
@@ -101,6 +101,9 @@ impl Drop for ChildGuard {
 #[test]
 fn supervisor_with_io_child_survives_sigkill_and_cleans_up() {
     let env = TestEnv::new("2p");
+    // The supervisor creates the services (exclusively); the peer opens them.
+    let node = env.domain.create_node("motion-supervisor").unwrap();
+    let mut sup = SupervisorPorts::create(&node, &env.domain, "io").unwrap();
     let mut child = ChildGuard(Some(
         Command::new(std::env::current_exe().unwrap())
             .args([
@@ -110,7 +113,7 @@ fn supervisor_with_io_child_survives_sigkill_and_cleans_up() {
                 "--test-threads=1",
             ])
             .env(ROLE_VAR, "io")
-            .env(PREFIX_VAR, &env.cfg.prefix)
+            .env(PREFIX_VAR, &env.domain.prefix)
             .env(ROOT_VAR, &env.root)
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
@@ -118,7 +121,7 @@ fn supervisor_with_io_child_survives_sigkill_and_cleans_up() {
             .unwrap(),
     ));
 
-    // child first: wait until its ports (and so the services) exist
+    // wait until the child's ports exist
     let stdout = child.0.as_mut().unwrap().stdout.take().unwrap();
     let mut lines = BufReader::new(stdout).lines();
     loop {
@@ -131,8 +134,6 @@ fn supervisor_with_io_child_survives_sigkill_and_cleans_up() {
     let drain = std::thread::spawn(move || for _ in lines {});
 
     {
-        let node = env.cfg.create_node("motion-supervisor").unwrap();
-        let mut sup = SupervisorPorts::create(&node, &env.cfg.prefix).unwrap();
         sup.update_connections().unwrap();
 
         // ---- round trips -------------------------------------------------
@@ -239,7 +240,7 @@ fn supervisor_with_io_child_survives_sigkill_and_cleans_up() {
         assert!(worst_notify < Duration::from_millis(100));
 
         // ---- dead node detection and cleanup ------------------------------
-        let icfg = env.cfg.iceoryx2_config().unwrap();
+        let icfg = env.domain.iceoryx2_config().unwrap();
         let mut dead = 0;
         while killed_at.elapsed() < Duration::from_secs(10) {
             dead = 0;
@@ -275,6 +276,8 @@ fn supervisor_with_io_child_survives_sigkill_and_cleans_up() {
         assert_eq!(sup.notify().unwrap(), 0);
         assert!(!sup.wait(Duration::from_millis(5)).unwrap());
     }
+    drop(sup);
+    drop(node);
     drain.join().unwrap();
     env.assert_clean_and_remove();
 }

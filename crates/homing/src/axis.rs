@@ -229,6 +229,40 @@ impl Axis {
         self.output(now_ns)
     }
 
+    /// EXERR of the first configuration problem (ERR 41), if any: what a
+    /// Home request would be refused with. No allocation.
+    pub fn config_error(&self) -> Option<u16> {
+        self.config_error
+    }
+
+    /// Operator's "unhome": clears HomedStatus. Refused (`false`) while
+    /// homing is in process — stop first.
+    pub fn clear_homed(&mut self) -> bool {
+        if self.status.ip {
+            return false;
+        }
+        self.status.homed = false;
+        true
+    }
+
+    /// The drive connection was re-established (its I/O process restarted
+    /// or re-attached): HomedStatus is cleared (CIP: reconnection clears it),
+    /// samples from before are forgotten, and homing in process is aborted
+    /// with ERR 12 / EXERR 40 — the feedback it relied on was interrupted.
+    pub fn reconnected(&mut self, now_ns: u64) {
+        self.prev = None;
+        self.last = None;
+        self.status.homed = false;
+        if self.status.ip {
+            self.fail(
+                now_ns,
+                ERR_SERVO_MESSAGE,
+                EX_FEEDBACK_LOST,
+                Abort::Controlled,
+            );
+        }
+    }
+
     // ------------------------------------------------------------------
     // Inputs
     // ------------------------------------------------------------------

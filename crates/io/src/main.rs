@@ -19,61 +19,94 @@ mod run;
 mod say;
 mod sim;
 
-use std::io::Write;
+use std::path::Path;
+use std::time::{Duration, Instant};
 
-use motion_frames::ipc::cleanup_domain;
-use motion_frames::{IoPorts, IpcConfig};
+use clap::Parser;
+use motion_frames::{cleanup_domain, Domain, IoPorts, IpcError};
 use motion_rt::{enter_realtime, RtConfig};
 
 use crate::backend::Backend;
-use crate::cli::{BackendKind, Options, Parsed, USAGE};
+use crate::cli::{BackendKind, Options};
 use crate::say::Say;
 use crate::sim::SimBackend;
+
+/// How long a spawned motion-io (`--exit-with-supervisor`) waits for its
+/// supervisor before it gives up.
+const SUPERVISOR_WAIT: Duration = Duration::from_secs(10);
 
 fn main() {
     std::process::exit(real_main());
 }
 
 fn real_main() -> i32 {
-    let opts = match cli::parse(std::env::args().skip(1)) {
-        Ok(Parsed::Run(o)) => o,
-        Ok(Parsed::Help) => {
-            let _ = writeln!(std::io::stdout(), "{USAGE}");
-            return 0;
-        }
+    motion_rt::logging::init("motion-io");
+    let opts = match Options::try_parse() {
+        Ok(o) => o,
         Err(e) => {
-            say::line(format_args!("{e}\n{USAGE}"));
-            return 2;
+            let code = match e.kind() {
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => 0,
+                _ => 2,
+            };
+            let _ = e.print();
+            return code;
         }
     };
     let say = Say { quiet: opts.quiet };
+    if opts.quiet {
+        log::set_max_level(log::LevelFilter::Warn);
+    }
 
     let (cfg, label) = match motion_config::load(opts.config.as_deref()) {
         Ok(c) => c,
         Err(problems) => {
             for p in &problems {
-                say::line(format_args!("config: {p}"));
+                log::error!("config: {p}");
             }
             return 2;
         }
     };
+    let io = match (&opts.io, cfg.ios.len()) {
+        (Some(name), _) => match cfg.io_index(name) {
+            Some(k) => k,
+            None => {
+                let known: Vec<&str> = cfg.ios.iter().map(|i| i.name.as_str()).collect();
+                log::error!(
+                    "--io {name}: the config has no such I/O process (configured: {})",
+                    known.join(", ")
+                );
+                return 2;
+            }
+        },
+        (None, 1) => 0,
+        (None, _) => {
+            let known: Vec<&str> = cfg.ios.iter().map(|i| i.name.as_str()).collect();
+            log::error!(
+                "the config has several I/O processes ({}): say which one with --io NAME",
+                known.join(", ")
+            );
+            return 2;
+        }
+    };
+    let io_name = cfg.ios[io].name.clone();
     let prefix = opts
         .service_prefix
         .clone()
         .unwrap_or_else(|| cfg.supervisor.service_prefix.clone());
-    let ipc = IpcConfig::new(prefix);
-    if let Err(e) = ipc.iceoryx2_config() {
-        say.always(format_args!("{e}"));
-        return 2;
-    }
+    let runtime_dir = motion_frames::domain::runtime_dir_or_default(
+        opts.runtime_dir
+            .as_deref()
+            .or(cfg.supervisor.runtime_dir.as_deref()),
+    );
     if let Err(e) = motion_rt::termination::install() {
         say.always(format_args!("error: {e}"));
         return 1;
     }
     apply_rt(&opts, say);
 
+    let mine = cfg.only_io(io);
     let mut backend: Box<dyn Backend> = match opts.backend {
-        BackendKind::Sim => Box::new(SimBackend::new(&cfg)),
+        BackendKind::Sim => Box::new(SimBackend::new(&mine)),
     };
     let settings = run::Settings {
         cycle_ns: cfg.supervisor.cycle_ns(),
@@ -81,42 +114,101 @@ fn real_main() -> i32 {
         spin: opts.spin,
         exit_with_supervisor: opts.exit_with_supervisor,
         say,
+        prefix: prefix.clone(),
+        runtime_dir: runtime_dir.clone(),
     };
-
-    let code = serve(&ipc, backend.as_mut(), &settings, &label);
-
-    // node and ports are gone: tidy the domain (dead peers, and the
-    // node-counter segment if nobody is left)
-    let report = cleanup_domain(&ipc);
-    match &report.error {
-        Some(e) => say.always(format_args!("cleanup: {e}")),
-        None => say.info(format_args!("iceoryx2 domain on exit: {report}")),
+    loop {
+        let domain = match wait_for_supervisor(&settings, &runtime_dir) {
+            Ok(d) => d,
+            Err(code) => return code,
+        };
+        let outcome = serve(&domain, &io_name, backend.as_mut(), &settings, &label);
+        // node and ports are gone: tidy the domain (dead peers)
+        let report = cleanup_domain(&domain);
+        if let Some(e) = &report.error {
+            say.always(format_args!("cleanup: {e}"));
+        }
+        match outcome {
+            Ok(run::Outcome::Rejoin) => continue,
+            Ok(o) => return o.exit_code(),
+            Err(code) => return code,
+        }
     }
-    code
 }
 
-/// Creates node and ports, runs the loop, drops them again. Returns the
-/// exit code.
-fn serve(ipc: &IpcConfig, backend: &mut dyn Backend, s: &run::Settings, label: &str) -> i32 {
+/// Joins the domain of the supervisor running under the prefix, waiting
+/// for one to appear (with `--exit-with-supervisor`, at most 10 s).
+fn wait_for_supervisor(s: &run::Settings, runtime_dir: &Path) -> Result<Domain, i32> {
+    let start = Instant::now();
+    let mut said = false;
+    loop {
+        match Domain::join(&s.prefix, Some(runtime_dir)) {
+            Ok(d) => return Ok(d),
+            Err(IpcError::NoSupervisor(why)) => {
+                if !said {
+                    s.say
+                        .info(format_args!("waiting for the supervisor: {why}"));
+                    said = true;
+                }
+                if s.exit_with_supervisor && start.elapsed() > SUPERVISOR_WAIT {
+                    s.say.always(format_args!(
+                        "error: no supervisor within {} s: {why}; exiting",
+                        SUPERVISOR_WAIT.as_secs()
+                    ));
+                    return Err(1);
+                }
+            }
+            Err(e) => {
+                // An unsafe or malformed session file is never trusted.
+                s.say.always(format_args!("error: {e}"));
+                return Err(1);
+            }
+        }
+        if motion_rt::termination::received().is_some() {
+            return Err(0);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// Creates node and ports in `domain`, runs the loop, drops them again.
+fn serve(
+    domain: &Domain,
+    io_name: &str,
+    backend: &mut dyn Backend,
+    s: &run::Settings,
+    label: &str,
+) -> Result<run::Outcome, i32> {
     let say = s.say;
-    let node = match ipc.create_node("motion-io") {
+    let node = match domain.create_node("motion-io") {
         Ok(n) => n,
         Err(e) => {
             say.always(format_args!("error: {e}"));
-            return 1;
+            return Err(1);
         }
     };
-    let mut ports = match IoPorts::create(&node, &ipc.prefix) {
-        Ok(p) => p,
-        Err(e) => {
-            say.always(format_args!("error: {e}"));
-            return 1;
+    // The session file may appear a moment before the services.
+    let until = Instant::now() + SUPERVISOR_WAIT;
+    let mut ports = loop {
+        match IoPorts::open(&node, domain, io_name) {
+            Ok(p) => break p,
+            Err(e) if e.is_no_supervisor() && Instant::now() < until => {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            Err(e) => {
+                say.always(format_args!("error: I/O process {io_name}: {e}"));
+                return if e.is_no_supervisor() {
+                    Ok(run::Outcome::Rejoin)
+                } else {
+                    Err(1)
+                };
+            }
         }
     };
     let names = backend.axis_names();
     say.info(format_args!(
-        "backend {}, {} {} ({}), service prefix {:?}, cycle {} us, watchdog {} cycles, {}, \
-         config {label}",
+        "I/O process {io_name}: backend {}, {} {} ({}), supervisor pid {} (prefix {:?}), \
+         cycle {} us, watchdog {} cycles, {}, config {label}",
         backend.name(),
         backend.axis_count(),
         if backend.axis_count() == 1 {
@@ -125,7 +217,8 @@ fn serve(ipc: &IpcConfig, backend: &mut dyn Backend, s: &run::Settings, label: &
             "axes"
         },
         names.join(", "),
-        ipc.prefix,
+        domain.pid,
+        domain.prefix,
         s.cycle_ns / 1000,
         s.watchdog_cycles,
         if s.spin {
@@ -134,10 +227,10 @@ fn serve(ipc: &IpcConfig, backend: &mut dyn Backend, s: &run::Settings, label: &
             "event wake-up"
         },
     ));
-    let outcome = run::run(&mut ports, backend, s);
+    let outcome = run::run(&mut ports, backend, s, &domain.id);
     drop(ports);
     drop(node);
-    outcome.exit_code()
+    Ok(outcome)
 }
 
 /// `--cpu` / `--priority`: optional, never fatal.

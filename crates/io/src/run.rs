@@ -18,7 +18,7 @@
 
 use std::time::Duration;
 
-use motion_frames::{monotonic_ns, FeedbackFrame, IoPorts, IpcError};
+use motion_frames::{monotonic_ns, Domain, FeedbackFrame, IoPorts, IpcError};
 
 use crate::backend::Backend;
 use crate::say::{Once, Say};
@@ -43,6 +43,9 @@ pub struct Settings {
     pub spin: bool,
     pub exit_with_supervisor: bool,
     pub say: Say,
+    /// Where the supervisor's session file is, to notice a new session.
+    pub prefix: String,
+    pub runtime_dir: std::path::PathBuf,
 }
 
 /// Why the loop ended.
@@ -55,12 +58,14 @@ pub enum Outcome {
     SupervisorGone,
     /// `--exit-with-supervisor`: no command ever arrived. Exit 1.
     NoSupervisor,
+    /// The supervisor was restarted (a new session): join it.
+    Rejoin,
 }
 
 impl Outcome {
     pub fn exit_code(self) -> i32 {
         match self {
-            Outcome::Signal | Outcome::SupervisorGone => 0,
+            Outcome::Signal | Outcome::SupervisorGone | Outcome::Rejoin => 0,
             Outcome::NoSupervisor => 1,
         }
     }
@@ -81,6 +86,7 @@ enum Phase {
 /// Failures reported once per episode.
 #[derive(Default)]
 struct Faults {
+    forged: Once,
     wait: Once,
     receive: Once,
     bad_frame: Once,
@@ -91,6 +97,8 @@ struct Faults {
 }
 
 struct Loop<'a> {
+    /// Id of the session joined.
+    session_id: String,
     ports: &'a mut IoPorts,
     backend: &'a mut dyn Backend,
     s: &'a Settings,
@@ -108,9 +116,15 @@ struct Loop<'a> {
 /// Runs until a signal arrives or (with `--exit-with-supervisor`) the
 /// supervisor is gone. Never panics on bad frames or IPC failures: they are
 /// reported once and the loop carries on.
-pub fn run(ports: &mut IoPorts, backend: &mut dyn Backend, s: &Settings) -> Outcome {
+pub fn run(
+    ports: &mut IoPorts,
+    backend: &mut dyn Backend,
+    s: &Settings,
+    session_id: &str,
+) -> Outcome {
     let now = monotonic_ns();
     let mut l = Loop {
+        session_id: session_id.to_string(),
         ports,
         backend,
         s,
@@ -182,6 +196,17 @@ impl Loop<'_> {
                 self.faults.receive.clear();
                 return;
             }
+            Err(e @ IpcError::Forged { .. }) => {
+                self.faults.receive.clear();
+                self.faults.forged.fail(
+                    &say,
+                    format_args!(
+                        "{e}; refused {} so far, never applied",
+                        self.ports.refused()
+                    ),
+                );
+                return;
+            }
             Err(e @ IpcError::Layout { .. }) => {
                 self.faults.receive.clear();
                 self.faults.bad_frame.fail(
@@ -197,6 +222,7 @@ impl Loop<'_> {
         };
         let taken = monotonic_ns();
         self.faults.receive.clear();
+        self.faults.forged.clear();
         if self.faults.bad_frame.clear() {
             say.info(format_args!("good command frames again"));
         }
@@ -293,10 +319,25 @@ impl Loop<'_> {
         result
     }
 
+    /// A supervisor with another session runs now under our prefix.
+    fn new_session(&self) -> bool {
+        matches!(
+            Domain::read_session(&self.s.runtime_dir, &self.s.prefix),
+            Ok(d) if d.id != self.session_id
+        )
+    }
+
     /// Everything that happens without a command.
     fn tick(&mut self, now: u64) -> Option<Outcome> {
         let say = self.say();
         let cycle = self.s.cycle_ns;
+        if matches!(self.phase, Phase::Waiting | Phase::Stopped { .. }) && self.new_session() {
+            say.info(format_args!(
+                "a new supervisor session started under prefix {:?}: joining it",
+                self.s.prefix
+            ));
+            return Some(Outcome::Rejoin);
+        }
         match self.phase {
             Phase::Waiting => {
                 if self.s.exit_with_supervisor
@@ -383,7 +424,7 @@ impl Loop<'_> {
         let dt = self.dt_s();
         let controlled = self.publish_unsolicited(|b, f| b.shutdown(dt, f));
         if controlled {
-            say.always(format_args!("signal: every axis stopped"));
+            say.info(format_args!("signal: every axis stopped"));
         } else {
             say.always(format_args!(
                 "signal: every axis stopped (some could not be ramped down in time and \

@@ -1,17 +1,10 @@
-//! Messages on stderr, every one prefixed `motion-io:`. `--quiet` drops the
-//! informational ones; errors and watchdog messages always show.
+//! Messages through the `log` facade (journald-friendly, see
+//! `motion_rt::logging`). `--quiet` drops the informational ones; errors and
+//! watchdog messages always show.
 
 use std::fmt;
-use std::io::Write;
 
-/// Writes one `motion-io: ...` line to stderr. Never panics: `eprintln!`
-/// would, if stderr is a pipe whose reader is gone (e.g. a killed
-/// supervisor's), and a failed message must not keep the axes from stopping.
-pub fn line(args: fmt::Arguments<'_>) {
-    let _ = writeln!(std::io::stderr().lock(), "motion-io: {args}");
-}
-
-/// Where messages go (stderr) and whether informational ones are shown.
+/// Whether informational messages are shown.
 #[derive(Clone, Copy, Debug)]
 pub struct Say {
     pub quiet: bool,
@@ -21,13 +14,18 @@ impl Say {
     /// Informational: suppressed by `--quiet`.
     pub fn info(&self, args: fmt::Arguments<'_>) {
         if !self.quiet {
-            line(args);
+            log::info!("{args}");
         }
     }
 
-    /// Errors, warnings and watchdog messages: always shown.
+    /// Errors, warnings and watchdog messages: always shown (a message that
+    /// starts with `error: ` at error level, the rest as warnings).
     pub fn always(&self, args: fmt::Arguments<'_>) {
-        line(args);
+        let text = args.to_string();
+        match text.strip_prefix("error: ") {
+            Some(rest) => log::error!("{rest}"),
+            None => log::warn!("{text}"),
+        }
     }
 }
 

@@ -44,14 +44,14 @@ fn config_with_several_mistakes_exits_2_and_prints_every_one() {
     assert_eq!(st.code(), Some(2), "{}", io.stderr());
     let err = io.stderr();
     for p in &expected {
-        let line = format!("motion-io: config: {p}");
+        let line = format!("motion-io: error: config: {p}");
         assert!(
             io.lines.iter().any(|(_, l)| *l == line),
             "missing {line:?} in\n{err}"
         );
     }
     assert_eq!(
-        io.count("motion-io: config: "),
+        io.count("motion-io: error: config: "),
         expected.len(),
         "one line per problem:\n{err}"
     );
@@ -67,7 +67,7 @@ fn unreadable_config_file_exits_2() {
     let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
     assert_eq!(st.code(), Some(2));
     assert!(
-        io.find("motion-io: config: file: cannot read /nonexistent/motion-io.toml")
+        io.find("motion-io: error: config: file: cannot read /nonexistent/motion-io.toml")
             .is_some(),
         "{}",
         io.stderr()
@@ -77,18 +77,22 @@ fn unreadable_config_file_exits_2() {
 #[test]
 fn command_line_mistakes_exit_2_with_usage() {
     for (args, needle) in [
-        (&["--backend", "ethercat"][..], "unknown backend"),
-        (&["--cpu"][..], "--cpu needs a value"),
+        (
+            &["--backend", "ethercab"][..],
+            "invalid value 'ethercab' for '--backend",
+        ),
+        (&["--cpu"][..], "a value is required for '--cpu <N>'"),
         (&["--priority", "0"][..], "1..=99"),
-        (&["--frobnicate"][..], "unknown option \"--frobnicate\""),
-        (&["stray"][..], "unexpected argument"),
+        (&["--frobnicate"][..], "unexpected argument '--frobnicate'"),
+        (&["stray"][..], "unexpected argument 'stray'"),
+        (&["--service-prefix", "../../tmp/x"][..], "service prefix"),
     ] {
         let mut io = Io::spawn(args);
         let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
         assert_eq!(st.code(), Some(2), "{args:?}");
         let err = io.stderr();
         assert!(err.contains(needle), "{args:?}: {err}");
-        assert!(err.contains("usage: motion-io"), "{args:?}: {err}");
+        assert!(err.contains("--help"), "{args:?}: {err}");
     }
     // --help is not a mistake
     let st = std::process::Command::new(BIN)

@@ -39,6 +39,9 @@ fn round_trip(spin: bool) {
     }
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let mut io = Io::spawn(&args);
+    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
+        .expect("waiting line");
+    let mut sup = Sup::new(&prefix);
     let start = io
         .wait_line("backend sim", Duration::from_secs(10))
         .expect("start line");
@@ -46,7 +49,6 @@ fn round_trip(spin: bool) {
     assert!(start.1.contains(&format!("{prefix:?}")), "{}", start.1);
     assert!(start.1.contains("cycle 1000 us"), "{}", start.1);
 
-    let mut sup = Sup::new(&prefix);
     let first = sup.connect(1);
     assert_eq!(first.fb.header.axis_count, 1);
     assert_eq!(first.fb.axes[0].position, 0);
@@ -165,7 +167,7 @@ fn wrong_axis_count_and_bad_frames_are_ignored() {
     let _guard = DomainGuard(prefix.clone());
     let cfg = TempConfig::new("bad", &one_axis_toml("iotest_unused", 50));
     let mut io = Io::spawn(&["--config", &cfg.arg(), "--service-prefix", &prefix]);
-    io.wait_line("backend sim", Duration::from_secs(10))
+    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
         .expect("start line");
     let mut sup = Sup::new(&prefix);
     sup.connect(1);
@@ -190,7 +192,7 @@ fn wrong_axis_count_and_bad_frames_are_ignored() {
         assert_eq!(a.fb.axes[0].position, 0);
         assert_eq!(a.fb.axes[0].status_word, 0);
     }
-    let line = "motion-io: command frame has 2 axes, config has 1: ignoring commands \
+    let line = "command frame has 2 axes, config has 1: ignoring commands \
                 (are both processes using the same config?)";
     assert!(io.wait_line(line, Duration::from_secs(2)).is_some());
     assert_eq!(io.count("command frame has 2 axes"), 1, "printed once");

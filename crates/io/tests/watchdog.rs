@@ -12,8 +12,8 @@ use nix::sys::signal::Signal;
 
 const WATCHDOG_CYCLES: u32 = 20;
 const STEP: i64 = 30; // counts per cycle = 30 units/s
-const WATCHDOG_LINE: &str = "motion-io: watchdog: no command for ";
-const STOPPED_LINE: &str = "motion-io: watchdog: every axis stopped and disabled";
+const WATCHDOG_LINE: &str = "motion-io: warning: watchdog: no command for ";
+const STOPPED_LINE: &str = "motion-io: warning: watchdog: every axis stopped and disabled";
 
 fn moving(pos: i64) -> impl FnOnce(&mut motion_frames::CommandFrame) {
     move |f| {
@@ -188,7 +188,7 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
     let _guard = DomainGuard(prefix.clone());
     let cfg = TempConfig::new("wdr", &one_axis_toml("iotest_unused", WATCHDOG_CYCLES));
     let mut io = Io::spawn(&["--config", &cfg.arg(), "--service-prefix", &prefix]);
-    io.wait_line("backend sim", Duration::from_secs(10))
+    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
         .expect("start line");
     let mut sup = Sup::new(&prefix);
     sup.connect(1);
@@ -229,7 +229,10 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
     assert_eq!(a.fb.axes[0].status_word, SW_FAULT);
     assert_eq!(a.fb.axes[0].position, at);
     assert!(io
-        .wait_line("motion-io: commands resumed", Duration::from_secs(2))
+        .wait_line(
+            "motion-io: warning: commands resumed",
+            Duration::from_secs(2)
+        )
         .is_some());
     // false -> true resets the fault; enabled after the enable delay
     let a = sup.exchange(hold(false), t).expect("answer");
@@ -270,8 +273,7 @@ fn exit_with_supervisor_but_no_supervisor_exits_1_after_10_s() {
     assert_eq!(st.code(), Some(1), "{}", io.stderr());
     assert!(took >= Duration::from_secs(10), "{took:?}");
     assert!(
-        io.find("error: no command from the supervisor within 10 s")
-            .is_some(),
+        io.find("error: no supervisor within 10 s").is_some(),
         "{}",
         io.stderr()
     );

@@ -62,6 +62,7 @@ mod allocator;
 pub mod clock;
 pub mod counting;
 pub mod environment;
+pub mod logging;
 pub mod pm_qos;
 mod pool;
 mod remote_free;

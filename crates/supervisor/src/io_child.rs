@@ -1,10 +1,13 @@
-//! The `motion-io` process the supervisor spawns (`io = "sim"`).
+//! The `motion-io` processes the supervisor spawns (`spawn = "sim"`), one
+//! per such I/O process of the config.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 pub struct IoChild {
+    /// The I/O process's name (`--io NAME`).
+    pub name: String,
     child: Child,
     started: Instant,
     exit: Option<ExitStatus>,
@@ -25,19 +28,27 @@ pub fn io_binary() -> PathBuf {
 }
 
 impl IoChild {
-    /// Starts `motion-io --backend sim` on the same config and service prefix.
-    /// Its stdout is discarded (ours may carry JSON); its stderr is shared.
+    /// Starts `motion-io --backend sim --io NAME` on the same config, service
+    /// prefix and runtime directory; it joins the supervisor's domain through
+    /// the session file. Its stdout is discarded (ours may carry JSON); its
+    /// stderr is shared.
     pub fn spawn(
+        name: &str,
         config: Option<&Path>,
         service_prefix: &str,
+        runtime_dir: &Path,
         extra: &[String],
     ) -> Result<Self, String> {
         let bin = io_binary();
         let mut cmd = Command::new(&bin);
         cmd.arg("--backend")
             .arg("sim")
+            .arg("--io")
+            .arg(name)
             .arg("--service-prefix")
             .arg(service_prefix)
+            .arg("--runtime-dir")
+            .arg(runtime_dir)
             .arg("--exit-with-supervisor")
             .arg("--quiet")
             .args(extra)
@@ -49,8 +60,9 @@ impl IoChild {
         }
         let child = cmd
             .spawn()
-            .map_err(|e| format!("cannot start the I/O process {}: {e}", bin.display()))?;
+            .map_err(|e| format!("cannot start I/O process {name} ({}): {e}", bin.display()))?;
         Ok(Self {
+            name: name.to_string(),
             child,
             started: Instant::now(),
             exit: None,

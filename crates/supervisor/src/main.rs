@@ -1,3 +1,4 @@
+use clap::Parser;
 use motion_supervisor::{cli, commands};
 
 /// Every allocation of the process goes through the real-time aware
@@ -6,17 +7,10 @@ use motion_supervisor::{cli, commands};
 static ALLOCATOR: motion_rt::RtAllocator = motion_rt::RtAllocator;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let code = match cli::parse(&args) {
-        Ok(cli::Cli::Help) => {
-            print!("{}", cli::USAGE);
-            0
-        }
+    motion_rt::logging::init("motion-supervisor");
+    let code = match cli::Cli::try_parse() {
         Ok(c) => commands::run(c),
-        Err(e) => {
-            eprintln!("motion-supervisor: {e}\n\n{}", cli::USAGE);
-            2
-        }
+        Err(e) => commands::argument_error(e),
     };
     std::process::exit(code);
 }

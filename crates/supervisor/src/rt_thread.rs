@@ -3,14 +3,20 @@
 //!
 //! One cycle:
 //! 1. sleep to the absolute deadline (`clock_nanosleep`, TIMER_ABSTIME);
-//! 2. take control requests (lock-free queue);
-//! 3. take the newest feedback frame (zero-copy sample);
-//! 4. step every axis's homing engine; publish the command frame and notify;
-//! 5. wait — at most until half the period — for the I/O process's answer to
-//!    *this* command: that is the I/O round trip, and the answer is the
-//!    feedback of the next cycle;
-//! 6. record wake-up latency, compute time and round trip; now and then hand
-//!    a histogram set and a status snapshot to the reporting thread.
+//! 2. take control requests (lock-free queue), answer them (lock-free queue);
+//! 3. take the newest feedback frame of every I/O process — the answer to
+//!    the previous cycle's command, which arrived while we slept;
+//! 4. step every axis's homing engine and the home sequences;
+//! 5. publish one command frame per I/O process and notify each;
+//! 6. record wake-up latency and compute time (and the I/O round trip, from
+//!    the answer's own timestamp: command published → answer published);
+//!    now and then hand a histogram set and a status snapshot over.
+//!
+//! Nothing waits for an answer: a cycle does its bounded work and goes back
+//! to sleep, so a slow I/O process can never push the next wake-up late (it
+//! shows as a gap in its answers instead, which the feedback-loss rule
+//! judges). This is how fieldbus masters run: outputs at the start of the
+//! cycle, inputs collected at the start of the next.
 //!
 //! No formatting, no locks, no system-allocator calls in the loop: what
 //! iceoryx2 allocates (one `Rc` per loaned sample) comes from this thread's
@@ -18,10 +24,10 @@
 //! for the no-allocation test.
 
 use crate::core::Core;
-use crate::shared::{Phase, Shared};
+use crate::shared::{Phase, Shared, MAX_IOS};
 use crate::stats::HistSet;
 use motion_config::MachineConfig;
-use motion_frames::{FeedbackFrame, IpcConfig, SupervisorPorts};
+use motion_frames::{Domain, FeedbackFrame, IpcError, SupervisorPorts};
 use motion_rt::{counting, enter_realtime, now_ns, rt_pool, PeriodicTimer, RtConfig, RtReport};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
@@ -29,23 +35,24 @@ use std::thread::JoinHandle;
 
 pub struct RtSettings {
     pub machine: MachineConfig,
-    pub service_prefix: String,
+    pub domain: Domain,
     pub rt: RtConfig,
     /// Bytes of the thread's allocation pool.
     pub pool_bytes: usize,
-    /// Answered cycles after which measuring starts (connection set-up,
-    /// first-time mappings are excluded from histograms and allocation counts).
-    pub warmup_frames: u64,
+    /// Cycles with every I/O process attached after which measuring starts
+    /// (connection set-up and first-time mappings are excluded from the
+    /// histograms and the allocation counts).
+    pub warmup_cycles: u64,
+    /// Cycles after which measuring starts anyway (I/O processes missing).
+    pub warmup_limit: u64,
     /// Cycles per histogram hand-off.
     pub stats_every: u64,
     /// Cycles per status snapshot.
     pub snapshot_every: u64,
-    /// How long after the deadline the cycle waits for the I/O answer.
-    pub reply_budget_ns: u64,
 }
 
 impl RtSettings {
-    pub fn new(machine: MachineConfig, service_prefix: String) -> Self {
+    pub fn new(machine: MachineConfig, domain: Domain) -> Self {
         let sup = &machine.supervisor;
         let period = sup.cycle_ns();
         let rt = RtConfig {
@@ -54,14 +61,15 @@ impl RtSettings {
             lock_memory: sup.lock_memory,
             ..RtConfig::default()
         };
+        let per_s = (1_000_000_000 / period).max(1);
         Self {
             rt,
-            service_prefix,
+            domain,
             pool_bytes: 4 << 20,
-            warmup_frames: 100,
-            stats_every: (1_000_000_000 / period).max(1),
+            warmup_cycles: 100,
+            warmup_limit: 2 * per_s,
+            stats_every: per_s,
             snapshot_every: (10_000_000 / period).max(1),
-            reply_budget_ns: period / 2,
             machine,
         }
     }
@@ -101,6 +109,8 @@ fn block_signals() {
     let _ = pthread_sigmask(SigmaskHow::SIG_BLOCK, Some(&set), None);
 }
 
+type FeedbackSample = iceoryx2::sample::Sample<iceoryx2::service::ipc::Service, FeedbackFrame, ()>;
+
 fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
     block_signals();
     let report = enter_realtime(&s.rt);
@@ -110,26 +120,30 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
         cycles: 0,
         pool: None,
     };
-    let ipc = IpcConfig::new(s.service_prefix.clone());
-    let node = match ipc.create_node("motion-supervisor") {
+    let node = match s.domain.create_node("motion-supervisor") {
         Ok(n) => n,
         Err(e) => {
             out.error = Some(e.to_string());
             return out;
         }
     };
-    let mut ports = match SupervisorPorts::create(&node, &s.service_prefix) {
-        Ok(p) => p,
-        Err(e) => {
-            out.error = Some(e.to_string());
-            return out;
+    let mut ports: Vec<SupervisorPorts> = Vec::with_capacity(s.machine.ios.len());
+    for io in &s.machine.ios {
+        match SupervisorPorts::create(&node, &s.domain, &io.name) {
+            Ok(p) => ports.push(p),
+            Err(e) => {
+                out.error = Some(format!("I/O process {}: {e}", io.name));
+                return out;
+            }
         }
-    };
+    }
+    let n_io = ports.len().min(MAX_IOS);
     let mut core = Core::new(&s.machine);
     let mut hist = shared
         .stats_free
         .pop()
         .unwrap_or_else(|| Box::new(HistSet::new()));
+    let mut pending: Vec<Option<FeedbackSample>> = (0..n_io).map(|_| None).collect();
     if let Err(e) = rt_pool::enter(s.pool_bytes) {
         out.error = Some(format!("real-time allocation pool: {e:?}"));
         return out;
@@ -138,11 +152,7 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
 
     let period = s.machine.supervisor.cycle_ns();
     let mut timer = PeriodicTimer::new(period);
-    let mut pending: Option<
-        iceoryx2::sample::Sample<iceoryx2::service::ipc::Service, FeedbackFrame, ()>,
-    > = None;
-    let mut pending_fresh = false;
-    let mut answered: u64 = 0;
+    let mut attached_cycles: u64 = 0;
     let mut baseline: Option<(u64, u64)> = None;
     let mut cycle: u64 = 0;
 
@@ -152,68 +162,57 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
 
         // Bounded: the queue holds at most 256 requests.
         while let Some(c) = shared.control.pop() {
-            core.control(c);
-        }
-
-        match ports.receive_latest() {
-            Ok(Some(sample)) => {
-                pending = Some(sample);
-                pending_fresh = true;
+            if let Some(ack) = core.control(c, wake.deadline_ns) {
+                // The answering side drains this queue every few ms; if it
+                // is full the requester times out and says so.
+                let _ = shared.acks.push(ack);
             }
-            Ok(None) => {}
-            Err(_) => core.note_rejected(),
         }
-        let fresh = if pending_fresh {
-            pending.as_ref().map(|p| p.payload())
-        } else {
-            None
-        };
-        core.step(wake.deadline_ns, fresh);
-        pending_fresh = false;
 
-        // Wake-ups left over from an answer that came after last cycle's
-        // budget would end the wait below at once: clear them first.
-        let _ = ports.try_wait();
-        let t_send = now_ns();
-        let sent = ports.publish(|f| core.fill(f));
-        let _ = ports.notify();
-        let t_published = now_ns();
-
-        let mut roundtrip = None;
-        if let Ok(sent) = sent {
-            core.sent(sent.sequence);
-            let budget_end = wake.deadline_ns + s.reply_budget_ns;
-            // At most a few wake-ups per cycle (a stray one, then ours).
-            for _ in 0..4 {
-                match ports.wait_until(budget_end) {
-                    Ok(true) | Err(_) => {
-                        if let Ok(Some(sample)) = ports.receive_latest() {
-                            let answers = sample.payload().answers_sequence;
-                            pending = Some(sample);
-                            pending_fresh = true;
-                            if answers == sent.sequence {
-                                roundtrip = Some(now_ns() - t_send);
-                                break;
-                            }
-                        }
-                    }
-                    Ok(false) => break,
+        let mut frames: [Option<&FeedbackFrame>; MAX_IOS] = [None; MAX_IOS];
+        for k in 0..n_io {
+            pending[k] = match ports[k].receive_latest() {
+                Ok(sample) => sample,
+                Err(IpcError::Forged { .. } | IpcError::Layout { .. }) => {
+                    core.note_refused(k);
+                    None
                 }
-            }
+                Err(_) => None,
+            };
         }
-        if roundtrip.is_some() {
-            answered += 1;
+        for (slot, p) in frames.iter_mut().zip(&pending) {
+            *slot = p.as_ref().map(|s| s.payload());
+        }
+        let info = core.step(wake.deadline_ns, &frames[..n_io]);
+        // Release the shared-memory samples before the next receive.
+        for p in pending.iter_mut() {
+            *p = None;
         }
 
-        let measuring = baseline.is_some();
-        if measuring {
+        for (k, port) in ports.iter_mut().enumerate() {
+            if let Ok(sent) = port.publish(|f| core.fill(k, f)) {
+                core.sent(k, sent.sequence, now_ns());
+            }
+            let _ = port.notify();
+        }
+        let t_published = now_ns();
+        if let Some(r) = core.trace_record() {
+            if shared.trace.push(r).is_err() {
+                shared.trace_dropped.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+
+        if core.all_attached() {
+            attached_cycles += 1;
+        }
+        if baseline.is_some() {
             hist.wakeup.saturating_record(wake.latency_ns.max(1));
             hist.compute
-                .saturating_record((t_published - wake.woke_ns).max(1));
-            match roundtrip {
-                Some(rt) => hist.roundtrip.saturating_record(rt.max(1)),
-                None => hist.late_replies += 1,
+                .saturating_record(t_published.saturating_sub(wake.woke_ns).max(1));
+            if let Some(rt) = info.roundtrip_ns {
+                hist.roundtrip.saturating_record(rt.max(1));
             }
+            hist.late_replies += u64::from(info.late_replies);
             if wake.missed > 0 || t_published > wake.deadline_ns + period {
                 hist.deadline_misses += 1;
             }
@@ -222,7 +221,7 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
             }
             hist.end_ns = wake.deadline_ns;
             hist.cycles += 1;
-        } else if answered >= s.warmup_frames {
+        } else if attached_cycles >= s.warmup_cycles || cycle >= s.warmup_limit {
             baseline = Some((
                 counting::system_calls_on_this_thread(),
                 rt_pool::thread_stats().map_or(0, |p| p.pool_allocs),

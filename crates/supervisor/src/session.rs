@@ -1,17 +1,24 @@
 //! Start-up and shut-down around the real-time thread, shared by `run` and
-//! `home`: spawn the cycle, spawn (or wait for) the I/O process, follow the
-//! snapshots and statistics, and leave cleanly — axes stopped, drives
-//! disabled, ports and node dropped, the I/O process ended, no shared memory
-//! left behind.
+//! `home`: claim the domain, start the cycle and the control thread, spawn
+//! (or wait for) the I/O processes, and leave cleanly — axes stopped, drives
+//! disabled, ports and nodes dropped, the spawned I/O processes ended, no
+//! shared memory and no session file left behind.
+//!
+//! A `Session` that is dropped without [`Session::finish`] (an early return,
+//! a panic unwinding through a command) still does all of that: nothing is
+//! left moving and nothing is left in `/dev/shm`.
 
+use crate::control_thread::{self, ControlSettings, Ready};
+use crate::hub::SharedHub;
 use crate::io_child::IoChild;
 use crate::rt_thread::{self, RtOutcome, RtSettings};
 use crate::shared::{Control, Phase, Shared, Snapshot};
-use crate::stats::HistSet;
 use motion_config::{IoMode, MachineConfig};
+use motion_frames::Domain;
+use motion_report::{IoReport, Latency};
 use motion_rt::termination as signals;
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -19,23 +26,39 @@ use std::time::{Duration, Instant};
 pub struct SessionOptions {
     pub config_path: Option<PathBuf>,
     pub service_prefix: String,
-    /// Extra arguments for a spawned motion-io (e.g. `--spin --cpu 0`).
+    /// Overrides `[supervisor] runtime_dir`.
+    pub runtime_dir: Option<PathBuf>,
+    /// Extra arguments for every spawned motion-io (e.g. `--spin`).
     pub io_args: Vec<String>,
+    /// `run --hlog FILE`.
+    pub hlog_file: Option<PathBuf>,
+}
+
+/// A spawned I/O process and when it may be restarted.
+struct Spawned {
+    io: usize,
+    child: Option<IoChild>,
+    restart_at: Option<Instant>,
+    restarts: u32,
 }
 
 pub struct Session {
     pub machine: MachineConfig,
+    pub domain: Domain,
     pub shared: Arc<Shared>,
+    pub hub: SharedHub,
     rt: Option<JoinHandle<RtOutcome>>,
-    pub io: Option<IoChild>,
-    pub snapshot: Option<Box<Snapshot>>,
-    pub totals: HistSet,
+    control: Option<JoinHandle<()>>,
+    control_stop: Arc<AtomicBool>,
+    spawned: Vec<Spawned>,
+    opts_config: Option<PathBuf>,
+    io_args: Vec<String>,
     started: Instant,
-    prefix: String,
     /// PM QoS request held for the session (dropped at the end).
     _idle_latency: Option<motion_rt::DmaLatencyGuard>,
-    /// Warnings about the environment, printed once.
+    /// Warnings about the environment and the config, printed once.
     pub warnings: Vec<String>,
+    finished: bool,
 }
 
 /// What is left after [`Session::finish`].
@@ -43,34 +66,35 @@ pub struct Finished {
     pub warnings: Vec<String>,
     pub machine: MachineConfig,
     pub outcome: Option<RtOutcome>,
-    pub totals: HistSet,
+    pub latency: Latency,
+    pub io: Vec<IoReport>,
     pub snapshot: Option<Box<Snapshot>>,
     pub supervisor_cpu: Option<f64>,
-    pub io_cpu: Option<f64>,
+    pub io_cpu: Vec<(String, Option<f64>)>,
     pub system_calls_in_cycle: u64,
     pub pool_allocs_in_cycle: u64,
-    pub io_exit: Option<String>,
+    pub io_exit: Vec<String>,
     pub wall_s: f64,
 }
 
 /// Where a spawned `motion-io` runs: pinned to another CPU than the cycle
 /// (it must not wake up on the real-time core) and SCHED_FIFO below the
-/// cycle, as a fieldbus master would be. A starved I/O process shows up as
-/// stale feedback, and the engines abort homing on that.
-fn io_placement(m: &MachineConfig) -> Vec<String> {
+/// cycle, as a fieldbus master would be.
+fn io_placement(m: &MachineConfig, io: usize) -> Vec<String> {
     let sup = &m.supervisor;
+    let cfg = &m.ios[io];
     let mut args = Vec::new();
     let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let cpu = sup
-        .io_cpu
+    let cpu = cfg
+        .cpu
         .or_else(|| (cpus > 1).then_some(if sup.cpu == 0 { 1 } else { 0 }));
     if let Some(c) = cpu {
         args.push("--cpu".to_string());
         args.push(c.to_string());
     }
-    if sup.io_priority > 0 {
+    if cfg.priority > 0 {
         args.push("--priority".to_string());
-        args.push(sup.io_priority.to_string());
+        args.push(cfg.priority.to_string());
     }
     args
 }
@@ -78,7 +102,13 @@ fn io_placement(m: &MachineConfig) -> Vec<String> {
 impl Session {
     pub fn start(machine: MachineConfig, opts: &SessionOptions) -> Result<Session, String> {
         signals::install()?;
-        let mut warnings = Vec::new();
+        let runtime_dir = opts
+            .runtime_dir
+            .clone()
+            .or_else(|| machine.supervisor.runtime_dir.clone());
+        let domain = Domain::establish(&opts.service_prefix, runtime_dir.as_deref())
+            .map_err(|e| e.to_string())?;
+        let mut warnings = machine.warnings.clone();
         let idle_latency = match machine.supervisor.cpu_dma_latency_us {
             us if us >= 0 => match motion_rt::hold_cpu_dma_latency(us) {
                 Ok(g) => Some(g),
@@ -90,22 +120,29 @@ impl Session {
             _ => None,
         };
         let shared = Arc::new(Shared::new(4, 8));
-        let settings = RtSettings::new(machine.clone(), opts.service_prefix.clone());
-        let rt = rt_thread::spawn(settings, shared.clone())
-            .map_err(|e| format!("cannot start the real-time thread: {e}"))?;
+        let hub = SharedHub::default();
         let mut s = Session {
-            machine,
-            shared,
-            rt: Some(rt),
-            io: None,
-            snapshot: None,
-            totals: HistSet::new(),
+            machine: machine.clone(),
+            domain: domain.clone(),
+            shared: shared.clone(),
+            hub: hub.clone(),
+            rt: None,
+            control: None,
+            control_stop: Arc::new(AtomicBool::new(false)),
+            spawned: Vec::new(),
+            opts_config: opts.config_path.clone(),
+            io_args: opts.io_args.clone(),
             started: Instant::now(),
-            prefix: opts.service_prefix.clone(),
             _idle_latency: idle_latency,
             warnings,
+            finished: false,
         };
-        // The thread creates the ports before it says Running.
+        let settings = RtSettings::new(machine.clone(), domain.clone());
+        s.rt = Some(
+            rt_thread::spawn(settings, shared.clone())
+                .map_err(|e| format!("cannot start the real-time thread: {e}"))?,
+        );
+        // The thread creates the frame services before it says Running.
         let until = Instant::now() + Duration::from_secs(10);
         loop {
             match s.shared.phase() {
@@ -117,76 +154,160 @@ impl Session {
                 Phase::Starting => std::thread::sleep(Duration::from_millis(5)),
             }
         }
-        if s.machine.supervisor.io == IoMode::Sim {
-            // Options given by the caller come last and win.
-            let mut args = io_placement(&s.machine);
-            args.extend(opts.io_args.iter().cloned());
-            let io = IoChild::spawn(opts.config_path.as_deref(), &opts.service_prefix, &args);
-            match io {
-                Ok(io) => s.io = Some(io),
-                Err(e) => {
-                    s.shutdown_rt();
-                    return Err(e);
-                }
+        let ready = Arc::new(Ready::default());
+        s.control = Some(
+            control_thread::spawn(
+                ControlSettings {
+                    machine: machine.clone(),
+                    domain: domain.clone(),
+                    hlog_file: opts.hlog_file.clone(),
+                },
+                shared,
+                hub,
+                s.control_stop.clone(),
+                ready.clone(),
+            )
+            .map_err(|e| format!("cannot start the control thread: {e}"))?,
+        );
+        let until = Instant::now() + Duration::from_secs(10);
+        while !ready.ready.load(Ordering::Acquire) {
+            if ready.failed.load(Ordering::Acquire) || Instant::now() > until {
+                let e = s
+                    .hub
+                    .lock()
+                    .control_error
+                    .clone()
+                    .unwrap_or_else(|| "the control thread did not start within 10 s".into());
+                return Err(e);
             }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        for (k, io) in machine.ios.iter().enumerate() {
+            if io.spawn == IoMode::Sim {
+                s.spawned.push(Spawned {
+                    io: k,
+                    child: None,
+                    restart_at: None,
+                    restarts: 0,
+                });
+            }
+        }
+        for i in 0..s.spawned.len() {
+            s.spawn_io(i)?;
         }
         Ok(s)
     }
 
-    /// Collects what the real-time thread handed over.
-    pub fn poll(&mut self) {
-        self.shared.latest_snapshot(&mut self.snapshot);
-        self.shared.collect_stats(&mut self.totals);
+    fn spawn_io(&mut self, i: usize) -> Result<(), String> {
+        let k = self.spawned[i].io;
+        let mut args = io_placement(&self.machine, k);
+        // Options given by the caller come last and win.
+        args.extend(self.io_args.iter().cloned());
+        let child = IoChild::spawn(
+            &self.machine.ios[k].name,
+            self.opts_config.as_deref(),
+            &self.domain.prefix,
+            &self.domain.runtime_dir,
+            &args,
+        )?;
+        self.spawned[i].child = Some(child);
+        self.spawned[i].restart_at = None;
+        Ok(())
     }
 
-    /// Waits until the I/O process answers every cycle and warm-up is over.
+    /// Collects what the control thread gathered: the newest snapshot.
+    pub fn snapshot(&self) -> Option<Box<Snapshot>> {
+        self.hub.lock().snapshot.clone()
+    }
+
+    /// Waits until every I/O process answers and warm-up is over.
     pub fn wait_io(&mut self, timeout: Duration) -> Result<(), String> {
         let until = Instant::now() + timeout;
         loop {
-            self.poll();
-            if self.shared.measuring.load(Ordering::Acquire)
-                && self.snapshot.as_ref().is_some_and(|s| s.io_fresh)
-            {
+            let attached = self.snapshot().is_some_and(|s| s.all_attached());
+            if self.shared.measuring.load(Ordering::Acquire) && attached {
                 return Ok(());
             }
             if let Some(e) = self.check_alive() {
                 return Err(e);
             }
+            if let Some(e) = self.poll_children(false).into_iter().next() {
+                return Err(e);
+            }
             if let Some(sig) = signals::received() {
-                return Err(format!("signal {sig} while waiting for the I/O process"));
+                return Err(format!("signal {sig} while waiting for the I/O processes"));
             }
             if Instant::now() > until {
-                let how = match self.machine.supervisor.io {
-                    IoMode::Sim => "the motion-io process it started",
-                    IoMode::External => "an external I/O process (io = \"external\")",
-                };
+                let snap = self.snapshot();
+                let missing: Vec<String> = self
+                    .machine
+                    .ios
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| !snap.as_ref().is_some_and(|s| s.ios[*k].attached))
+                    .map(|(_, io)| match io.spawn {
+                        IoMode::Sim => format!("{} (spawned by the supervisor)", io.name),
+                        IoMode::External => format!(
+                            "{} (external: start `motion-io --io {} --service-prefix {}`)",
+                            io.name, io.name, self.domain.prefix
+                        ),
+                    })
+                    .collect();
                 return Err(format!(
-                    "no answer on iceoryx2 service '{}/feedback' within {} s from {how}",
-                    self.prefix,
-                    timeout.as_secs()
+                    "no answer within {} s from I/O process {}",
+                    timeout.as_secs(),
+                    missing.join(", ")
                 ));
             }
             std::thread::sleep(Duration::from_millis(10));
         }
     }
 
-    /// `Some(reason)` if the real-time thread or the I/O process died.
+    /// `Some(reason)` if the real-time thread died.
     pub fn check_alive(&mut self) -> Option<String> {
         match self.shared.phase() {
-            Phase::Failed => return Some(self.rt_error()),
-            Phase::Exited => return Some("the real-time thread ended".into()),
-            _ => {}
+            Phase::Failed => Some(self.rt_error()),
+            Phase::Exited => Some("the real-time thread ended".into()),
+            _ => None,
         }
-        if let Some(io) = &mut self.io {
-            if let Some(status) = io.exited() {
-                return Some(format!("motion-io (pid {}) ended: {status}", io.pid()));
+    }
+
+    /// Spawned I/O processes that ended since the last call, in words; with
+    /// `respawn`, each is started again a second later (the daemon keeps its
+    /// simulators; the axes of a restarted one are unhomed, as on real buses).
+    pub fn poll_children(&mut self, respawn: bool) -> Vec<String> {
+        let mut events = Vec::new();
+        for i in 0..self.spawned.len() {
+            let sp = &mut self.spawned[i];
+            if let Some(c) = sp.child.as_mut() {
+                if let Some(status) = c.exited() {
+                    events.push(format!(
+                        "I/O process {} (motion-io pid {}) ended: {status}",
+                        c.name,
+                        c.pid()
+                    ));
+                    sp.child = None;
+                    if respawn {
+                        sp.restart_at = Some(Instant::now() + Duration::from_secs(1));
+                    }
+                }
+            } else if sp.restart_at.is_some_and(|t| Instant::now() >= t) {
+                sp.restarts += 1;
+                let name = self.machine.ios[sp.io].name.clone();
+                match self.spawn_io(i) {
+                    Ok(()) => log::info!("I/O process {name} restarted"),
+                    Err(e) => {
+                        log::error!("{e}");
+                        self.spawned[i].restart_at = Some(Instant::now() + Duration::from_secs(5));
+                    }
+                }
             }
         }
-        None
+        events
     }
 
     /// Queues a request for the cycle; false if the cycle has not taken
-    /// requests for a second (it drains the 256-entry queue every period).
+    /// requests for a second.
     pub fn send(&self, c: Control) -> bool {
         let until = Instant::now() + Duration::from_secs(1);
         while !self.shared.send(c) {
@@ -230,35 +351,34 @@ impl Session {
     }
 
     /// Stops every axis and disables the drives (Control::Exit), ends the
-    /// real-time thread, then the I/O process; cleans up shared memory.
-    pub fn finish(self) -> Finished {
-        self.finish_with(|_| {})
-    }
-
-    /// [`Self::finish`], showing each histogram interval handed over during
-    /// shut-down to `each` (the interval log must not lose the last one).
-    pub fn finish_with(mut self, each: impl FnMut(&HistSet)) -> Finished {
-        let io_cpu = self.io.as_mut().and_then(|io| io.cpu_share());
+    /// real-time and control threads, then the I/O processes; cleans up
+    /// shared memory and the session file.
+    pub fn finish(mut self) -> Finished {
+        let mut io_cpu = Vec::new();
+        for sp in &mut self.spawned {
+            if let Some(c) = sp.child.as_mut() {
+                io_cpu.push((c.name.clone(), c.cpu_share()));
+            }
+        }
         let supervisor_cpu = crate::cpu::process_cpu_seconds(std::process::id())
             .map(|s| s / self.started.elapsed().as_secs_f64());
         let outcome = self.shutdown_rt();
-        self.shared.collect_intervals(&mut self.totals, each);
-        self.shared.latest_snapshot(&mut self.snapshot);
-        let io_exit = self
-            .io
-            .as_mut()
-            .map(|io| match io.terminate(Duration::from_secs(3)) {
-                Some(s) => s.to_string(),
-                None => "still running".into(),
-            });
-        let _ =
-            motion_frames::ipc::cleanup_domain(&motion_frames::IpcConfig::new(self.prefix.clone()));
+        let io_exit = self.stop_rest();
+        let hub = self.hub.lock();
+        let snapshot = hub.snapshot.clone();
+        let latency = hub.since_start.summary();
+        let io = snapshot
+            .as_deref()
+            .map(|s| control_thread::io_reports(&self.machine, s))
+            .unwrap_or_default();
+        drop(hub);
         Finished {
             warnings: std::mem::take(&mut self.warnings),
             machine: self.machine.clone(),
             outcome,
-            totals: std::mem::take(&mut self.totals),
-            snapshot: self.snapshot.take(),
+            latency,
+            io,
+            snapshot,
             supervisor_cpu,
             io_cpu,
             system_calls_in_cycle: self.shared.system_calls_in_cycle.load(Ordering::Acquire),
@@ -266,5 +386,44 @@ impl Session {
             io_exit,
             wall_s: self.started.elapsed().as_secs_f64(),
         }
+    }
+
+    /// Everything after the real-time thread: the control thread, the
+    /// spawned I/O processes, shared memory, the session file.
+    fn stop_rest(&mut self) -> Vec<String> {
+        self.finished = true;
+        self.control_stop.store(true, Ordering::Release);
+        if let Some(h) = self.control.take() {
+            let _ = h.join();
+        }
+        let mut io_exit = Vec::new();
+        for sp in &mut self.spawned {
+            if let Some(c) = sp.child.as_mut() {
+                let how = match c.terminate(Duration::from_secs(3)) {
+                    Some(s) => s.to_string(),
+                    None => "still running".into(),
+                };
+                io_exit.push(format!("{}: {how}", c.name));
+            }
+            sp.child = None;
+        }
+        let report = motion_frames::cleanup_domain(&self.domain);
+        if !report.domain_gone() {
+            log::debug!("iceoryx2 domain on exit: {report}");
+        }
+        self.domain.withdraw();
+        io_exit
+    }
+}
+
+impl Drop for Session {
+    /// A session left without `finish` (an error path, a panic unwinding):
+    /// stop the axes, end the threads and children, clean up.
+    fn drop(&mut self) {
+        if self.finished {
+            return;
+        }
+        let _ = self.shutdown_rt();
+        let _ = self.stop_rest();
     }
 }

@@ -4,41 +4,140 @@
 //! both directions. A crossbeam *channel* would be simpler, but a sender may
 //! have to lock the channel's waker list to wake a blocked receiver, and that
 //! lock could be held by a preempted normal-priority thread. Here nobody ever
-//! blocks on a queue: the reporting side polls.
+//! blocks on a queue: the other side polls.
 //!
 //! Large objects (histogram sets, snapshots) travel as `Box`es that circulate
 //! between a `full` and a `free` queue, so the real-time thread moves a pointer
-//! and never allocates or frees.
+//! and never allocates or frees. Small ones (requests, acknowledgements,
+//! trace records) travel by value.
 
 use crate::stats::HistSet;
 use crossbeam::queue::ArrayQueue;
 use motion_frames::MAX_AXES;
 use motion_homing::Status;
+use motion_report::GapCounts;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 
-/// Requests to the real-time thread.
+/// Most I/O processes (the config's limit).
+pub const MAX_IOS: usize = 16;
+
+/// Requests to the real-time thread. `mask` bit `i` = axis `i`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Control {
-    /// Rising edge of the Home instruction of axis `i`.
-    Home(usize),
-    /// Stop (MAS) axis `i`.
-    Stop(usize),
+    /// Home the axes of `mask`: in home order (config order one at a time
+    /// when no axis has one), or all at once with `parallel`. `timeout_ns`
+    /// (0 = none) stops what is still homing after that long.
+    Home {
+        id: u32,
+        mask: u64,
+        parallel: bool,
+        timeout_ns: u64,
+    },
+    /// Stop (MAS) the axes of `mask`.
+    Stop { id: u32, mask: u64 },
+    /// Clear HomedStatus of the axes of `mask`.
+    Unhome { id: u32, mask: u64 },
+    /// Record every cycle of the next homing of axis `axis`.
+    Trace { id: u32, axis: usize },
     /// Stop every axis, disable the drives once at rest, then leave the loop.
     Exit,
 }
 
-/// One axis as the reporting thread sees it.
+/// The answer for one axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AxisAck {
+    pub accepted: bool,
+    /// `motion_control::REASON_*`.
+    pub reason: u8,
+    pub err: u16,
+    pub exerr: u16,
+}
+
+/// The real-time thread's answer to a request with an id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ack {
+    pub id: u32,
+    /// The cycle that applied the request.
+    pub cycle: u64,
+    pub axes: [AxisAck; MAX_AXES],
+}
+
+impl Ack {
+    pub fn new(id: u32) -> Self {
+        Self {
+            id,
+            cycle: 0,
+            axes: [AxisAck::default(); MAX_AXES],
+        }
+    }
+}
+
+/// One cycle of a traced homing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TraceRecord {
+    /// Axis traced.
+    pub axis: u8,
+    /// Homing phase number (`motion_homing::Phase as u8`).
+    pub phase: u8,
+    /// Home switch actuated (logical) / a marker passed or latched this
+    /// cycle / fresh feedback this cycle.
+    pub switch: bool,
+    pub marker: bool,
+    pub fresh: bool,
+    /// The home event was found in this cycle.
+    pub event: bool,
+    /// The homing ended in this cycle (the last record).
+    pub end: bool,
+    /// Time since the homing started, ns.
+    pub t_ns: u64,
+    /// Command and actual (raw) position, units; velocities units/s;
+    /// torque % rated.
+    pub cmd_position: f64,
+    pub cmd_velocity: f64,
+    pub position: f64,
+    pub velocity: f64,
+    pub torque: f64,
+    /// Raw position of the event (valid with `event`).
+    pub event_raw: f64,
+    pub err: u16,
+    pub exerr: u16,
+}
+
+/// One axis as the reporting side sees it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AxisSnap {
     pub status: motion_homing::Status,
     /// Raw and axis position from the newest valid feedback.
     pub raw: Option<f64>,
     pub axis: Option<f64>,
+    /// From the newest valid feedback.
+    pub velocity: f64,
+    pub torque: f64,
+    pub switch: bool,
+    pub marker: bool,
+    pub enabled: bool,
+    pub fault: bool,
+    pub drive_error_code: u16,
+    /// Fresh feedback this cycle.
+    pub fresh: bool,
     pub cmd_position: f64,
     pub cmd_velocity: f64,
     pub enable: bool,
     /// Home requests the engine has been given (rising edges applied).
     pub homes_started: u32,
+    /// The home sequence this axis was part of was aborted because this
+    /// axis (index) failed.
+    pub aborted_by: Option<u8>,
+    /// The sequence's `timeout_ns` ran out and the axis was stopped.
+    pub timed_out: bool,
+    /// A sequence has started, or will start, this axis.
+    pub in_sequence: bool,
+    /// A trace of this axis's next homing is armed or recording.
+    pub traced: bool,
+    /// HomedStatus was lost after the last homing succeeded: when (ns), and
+    /// why (`motion_control::SX_LOST_*`, 0 = not known).
+    pub lost_homed_ns: Option<u64>,
+    pub lost_cause: u8,
 }
 
 impl AxisSnap {
@@ -49,21 +148,33 @@ impl AxisSnap {
     }
 }
 
+/// One I/O process as the reporting side sees it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IoSnap {
+    pub attached: bool,
+    /// Cycles with a fresh, accepted frame / without one.
+    pub frames_received: u64,
+    pub frames_missing: u64,
+    /// Refused: layout, axis count, key, answer from the future.
+    pub frames_refused: u64,
+    /// Answered a command outside the accepted window.
+    pub frames_too_old: u64,
+    pub attachments: u64,
+    /// Times a new incarnation (restart) of the process was seen.
+    pub restarts: u64,
+    pub gaps: GapCounts,
+    /// Current gap, cycles.
+    pub gap_cycles: u64,
+}
+
 #[derive(Clone, Debug)]
 pub struct Snapshot {
     pub cycle: u64,
     pub now_ns: u64,
     pub axis_count: usize,
     pub axes: [AxisSnap; MAX_AXES],
-    /// Feedback frames received / cycles without a fresh frame (total).
-    pub frames_received: u64,
-    pub frames_missing: u64,
-    /// The last feedback frame arrived in this cycle (the I/O process answers).
-    pub io_fresh: bool,
-    /// Frames rejected: wrong layout or axis count.
-    pub frames_rejected: u64,
-    /// Frames that answered a command older than `stale_cycles` (not used).
-    pub frames_late: u64,
+    pub io_count: usize,
+    pub ios: [IoSnap; MAX_IOS],
     /// Every axis is at rest with nothing in process.
     pub all_at_rest: bool,
 }
@@ -75,13 +186,17 @@ impl Default for Snapshot {
             now_ns: 0,
             axis_count: 0,
             axes: [AxisSnap::default(); MAX_AXES],
-            frames_received: 0,
-            frames_missing: 0,
-            io_fresh: false,
-            frames_rejected: 0,
-            frames_late: 0,
+            io_count: 0,
+            ios: [IoSnap::default(); MAX_IOS],
             all_at_rest: true,
         }
+    }
+}
+
+impl Snapshot {
+    /// Every I/O process is attached.
+    pub fn all_attached(&self) -> bool {
+        self.ios[..self.io_count].iter().all(|i| i.attached)
     }
 }
 
@@ -98,17 +213,21 @@ pub enum Phase {
 /// Everything the threads share.
 pub struct Shared {
     pub control: ArrayQueue<Control>,
+    pub acks: ArrayQueue<Ack>,
+    pub trace: ArrayQueue<TraceRecord>,
     pub stats_full: ArrayQueue<Box<HistSet>>,
     pub stats_free: ArrayQueue<Box<HistSet>>,
     pub snap_full: ArrayQueue<Box<Snapshot>>,
     pub snap_free: ArrayQueue<Box<Snapshot>>,
     phase: AtomicU8,
-    /// Warm-up is over: the I/O process answers and the cycle is measured.
+    /// Warm-up is over: every I/O process answers and the cycle is measured.
     pub measuring: AtomicBool,
     /// System-allocator calls made by the RT thread after warm-up.
     pub system_calls_in_cycle: AtomicU64,
     /// Allocations its pool served after warm-up (iceoryx2's per-sample Rc).
     pub pool_allocs_in_cycle: AtomicU64,
+    /// Trace records dropped because the queue was full.
+    pub trace_dropped: AtomicU64,
 }
 
 impl Shared {
@@ -116,6 +235,8 @@ impl Shared {
     pub fn new(spare_stats: usize, spare_snaps: usize) -> Self {
         let s = Self {
             control: ArrayQueue::new(256),
+            acks: ArrayQueue::new(64),
+            trace: ArrayQueue::new(16_384),
             stats_full: ArrayQueue::new(spare_stats + 1),
             stats_free: ArrayQueue::new(spare_stats + 1),
             snap_full: ArrayQueue::new(spare_snaps + 1),
@@ -124,6 +245,7 @@ impl Shared {
             measuring: AtomicBool::new(false),
             system_calls_in_cycle: AtomicU64::new(0),
             pool_allocs_in_cycle: AtomicU64::new(0),
+            trace_dropped: AtomicU64::new(0),
         };
         for _ in 0..spare_stats {
             let _ = s.stats_free.push(Box::new(HistSet::new()));
@@ -161,17 +283,11 @@ impl Shared {
         }
     }
 
-    /// Reporting side: merges every full histogram set into `total`.
-    pub fn collect_stats(&self, total: &mut HistSet) {
-        self.collect_intervals(total, |_| {});
-    }
-
-    /// As [`Self::collect_stats`], showing each interval to `each` first
-    /// (for interval logs).
-    pub fn collect_intervals(&self, total: &mut HistSet, mut each: impl FnMut(&HistSet)) {
+    /// Reporting side: every full histogram set, shown to `each`, then
+    /// recycled.
+    pub fn collect_intervals(&self, mut each: impl FnMut(&HistSet)) {
         while let Some(mut h) = self.stats_full.pop() {
             each(&h);
-            total.merge(&h);
             h.reset();
             let _ = self.stats_free.push(h);
         }

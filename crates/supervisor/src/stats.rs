@@ -7,6 +7,7 @@
 //! there; see [`crate::shared`].
 
 use hdrhistogram::Histogram;
+pub use motion_report::{Latency, Percentiles};
 
 /// Highest value a histogram holds, ns (larger values saturate).
 pub const HIGHEST_NS: u64 = 10_000_000_000;
@@ -81,130 +82,33 @@ impl HistSet {
         self.end_ns = self.end_ns.max(other.end_ns);
     }
 
-    pub fn summary(&self) -> LatencySummary {
-        LatencySummary {
+    /// Percentiles in µs (the `latency` object of the reports).
+    pub fn summary(&self) -> Latency {
+        Latency {
             cycles: self.cycles,
             deadline_misses: self.deadline_misses,
             late_replies: self.late_replies,
-            wakeup: Percentiles::of(&self.wakeup),
-            compute: Percentiles::of(&self.compute),
-            roundtrip: Percentiles::of(&self.roundtrip),
+            wakeup_us: percentiles(&self.wakeup).rounded(),
+            compute_us: percentiles(&self.compute).rounded(),
+            io_roundtrip_us: percentiles(&self.roundtrip).rounded(),
         }
     }
 }
 
-/// Distribution of one histogram, in µs.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Percentiles {
-    pub count: u64,
-    pub min: f64,
-    pub p50: f64,
-    pub p99: f64,
-    pub p999: f64,
-    pub p9999: f64,
-    pub max: f64,
-}
-
-impl Percentiles {
-    pub fn of(h: &Histogram<u64>) -> Self {
-        if h.is_empty() {
-            return Self::default();
-        }
-        let us = |ns: u64| ns as f64 / 1000.0;
-        Self {
-            count: h.len(),
-            min: us(h.min()),
-            p50: us(h.value_at_quantile(0.50)),
-            p99: us(h.value_at_quantile(0.99)),
-            p999: us(h.value_at_quantile(0.999)),
-            p9999: us(h.value_at_quantile(0.9999)),
-            max: us(h.max()),
-        }
+/// Distribution of one histogram of ns, in µs.
+pub fn percentiles(h: &Histogram<u64>) -> Percentiles {
+    if h.is_empty() {
+        return Percentiles::default();
     }
-
-    /// `[min, p50, p99, p99.9, p99.99, max]`, the order of every table.
-    pub fn values(&self) -> [f64; 6] {
-        [
-            self.min, self.p50, self.p99, self.p999, self.p9999, self.max,
-        ]
-    }
-
-    /// `self / other` per column (`None` where `other` is 0).
-    pub fn ratio(&self, other: &Percentiles) -> [Option<f64>; 6] {
-        let a = self.values();
-        let b = other.values();
-        std::array::from_fn(|i| (b[i] > 0.0).then(|| a[i] / b[i]))
-    }
-
-    /// Reads back what [`Self::to_json`] wrote (µs).
-    pub fn from_json(v: &serde_json::Value) -> Option<Self> {
-        let f = |k: &str| v.get(k).and_then(|x| x.as_f64());
-        Some(Self {
-            count: v.get("count").and_then(|x| x.as_u64())?,
-            min: f("min")?,
-            p50: f("p50")?,
-            p99: f("p99")?,
-            p999: f("p999")?,
-            p9999: f("p9999")?,
-            max: f("max")?,
-        })
-    }
-
-    pub fn to_json(self) -> serde_json::Value {
-        let r = |x: f64| (x * 10.0).round() / 10.0;
-        serde_json::json!({
-            "min": r(self.min), "p50": r(self.p50), "p99": r(self.p99),
-            "p999": r(self.p999), "p9999": r(self.p9999), "max": r(self.max),
-            "count": self.count,
-        })
-    }
-}
-
-/// What the `home` and `run` commands print.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct LatencySummary {
-    pub cycles: u64,
-    pub deadline_misses: u64,
-    pub late_replies: u64,
-    pub wakeup: Percentiles,
-    pub compute: Percentiles,
-    pub roundtrip: Percentiles,
-}
-
-impl LatencySummary {
-    /// The `latency` object of `home --json` (interface.md).
-    pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
-            "cycles": self.cycles,
-            "deadline_misses": self.deadline_misses,
-            "late_replies": self.late_replies,
-            "wakeup_us": self.wakeup.to_json(),
-            "compute_us": self.compute.to_json(),
-            "io_roundtrip_us": self.roundtrip.to_json(),
-        })
-    }
-
-    /// A small fixed-width table.
-    pub fn table(&self) -> String {
-        let mut s = format!(
-            "{:<16}{:>9}{:>9}{:>9}{:>9}{:>10}{:>10}\n",
-            "latency (µs)", "min", "p50", "p99", "p99.9", "p99.99", "max"
-        );
-        for (name, p) in [
-            ("wake-up", self.wakeup),
-            ("compute", self.compute),
-            ("I/O round trip", self.roundtrip),
-        ] {
-            s += &format!(
-                "{:<16}{:>9.1}{:>9.1}{:>9.1}{:>9.1}{:>10.1}{:>10.1}\n",
-                name, p.min, p.p50, p.p99, p.p999, p.p9999, p.max
-            );
-        }
-        s += &format!(
-            "cycles {}, deadline misses {}, late I/O replies {}\n",
-            self.cycles, self.deadline_misses, self.late_replies
-        );
-        s
+    let us = |ns: u64| ns as f64 / 1000.0;
+    Percentiles {
+        count: h.len(),
+        min: us(h.min()),
+        p50: us(h.value_at_quantile(0.50)),
+        p99: us(h.value_at_quantile(0.99)),
+        p999: us(h.value_at_quantile(0.999)),
+        p9999: us(h.value_at_quantile(0.9999)),
+        max: us(h.max()),
     }
 }
 
@@ -227,9 +131,9 @@ mod tests {
         let s = a.summary();
         assert_eq!(s.cycles, 1001);
         assert_eq!(s.deadline_misses, 1);
-        assert!((s.wakeup.p50 - 501.0).abs() < 1.0, "{}", s.wakeup.p50);
-        assert!(s.wakeup.max >= 9_990_000.0);
-        assert_eq!(s.compute, Percentiles::default());
+        assert!((s.wakeup_us.p50 - 501.0).abs() < 1.0, "{}", s.wakeup_us.p50);
+        assert!(s.wakeup_us.max >= 9_990_000.0);
+        assert_eq!(s.compute_us, Percentiles::default());
         assert!(s.table().contains("wake-up"));
     }
 }

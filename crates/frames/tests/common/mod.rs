@@ -1,57 +1,56 @@
-//! Helpers shared by the integration tests: an isolated iceoryx2 domain per
-//! test (unique service prefix AND unique root directory) and leftover checks.
+//! Helpers shared by the integration tests: a private domain per test (unique
+//! service prefix AND runtime directory) and leftover checks.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
 
-use iceoryx2::prelude::ipc;
-use motion_frames::IpcConfig;
+use motion_frames::Domain;
 
 static COUNTER: AtomicU32 = AtomicU32::new(0);
 
 pub struct TestEnv {
-    pub cfg: IpcConfig,
+    pub domain: Domain,
     pub root: PathBuf,
 }
 
 impl TestEnv {
-    /// Fresh domain: prefix `mf{tag}{pid}x{n}`, root `$TMPDIR/mf-{tag}-{pid}-{n}`.
+    /// Fresh domain: prefix `mf{tag}{pid}x{n}`, runtime dir `/tmp/mf{pid}_{n}`
+    /// (short: iceoryx2's socket paths below it are limited).
     pub fn new(tag: &str) -> Self {
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let pid = std::process::id();
-        let root = std::env::temp_dir().join(format!("mf-{tag}-{pid}-{n}"));
-        std::fs::create_dir_all(&root).unwrap();
-        Self {
-            cfg: IpcConfig::new(format!("mf{tag}{pid}x{n}")).with_root(&root),
-            root,
-        }
+        let root = PathBuf::from(format!("/tmp/mf{}_{n}", pid % 1_000_000));
+        let _ = std::fs::remove_dir_all(&root);
+        let domain = Domain::establish(&format!("mf{tag}{pid}x{n}"), Some(&root)).unwrap();
+        Self { domain, root }
     }
 
     /// Same domain as another process announced through the environment.
     pub fn from_parts(prefix: String, root: PathBuf) -> Self {
         Self {
-            cfg: IpcConfig::new(prefix).with_root(&root),
+            domain: Domain::read_session(&root, &prefix).unwrap(),
             root,
         }
     }
 
     /// Files in /dev/shm that belong to this domain.
     pub fn shm_files(&self) -> Vec<String> {
-        self.cfg.shm_files()
+        self.domain.shm_files()
     }
 
-    /// Regular files (not directories) anywhere under the root directory.
+    /// Regular files (not directories) under the runtime directory, except
+    /// the session file.
     pub fn root_files(&self) -> Vec<PathBuf> {
         let mut out = Vec::new();
         collect_files(&self.root, &mut out);
+        out.retain(|p| p.extension().is_none_or(|e| e != "session"));
         out
     }
 
     /// Checks that dropping every port and node left nothing behind except
-    /// iceoryx2's persistent per-domain node counter (`*.global_mgmt`, created
-    /// by design on the first node of a domain and never removed by iceoryx2),
-    /// then removes that one segment and the root directory.
+    /// iceoryx2's persistent per-domain node counter (`*.global_mgmt`), then
+    /// removes that one with `cleanup_domain` (which must leave nothing).
     ///
     /// Must only be called when no process uses the domain any more.
     pub fn assert_clean_and_remove(&self) {
@@ -70,26 +69,15 @@ impl TestEnv {
             "iceoryx2 left files under {}: {files:?}",
             self.root.display()
         );
-        println!(
-            "cleanup check: /dev/shm entries of {:?} after drop: {:?} (only the persistent \
-             node-counter segment is expected); files under root: {}",
-            self.cfg.file_prefix(),
-            shm,
-            files.len()
-        );
-        self.remove_domain();
+        let report = motion_frames::cleanup_domain(&self.domain);
+        assert!(report.domain_gone(), "{report}");
         let left = self.shm_files();
         assert!(left.is_empty(), "still in /dev/shm: {left:?}");
     }
 
-    /// Best-effort removal of the domain's persistent segment and root directory.
     fn remove_domain(&self) {
-        if let Ok(icfg) = self.cfg.iceoryx2_config() {
-            // SAFETY: only called when no process uses this test-private domain.
-            unsafe {
-                let _ = iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&icfg);
-            }
-        }
+        let _ = motion_frames::cleanup_domain(&self.domain);
+        self.domain.withdraw();
         let _ = std::fs::remove_dir_all(&self.root);
     }
 }

@@ -12,9 +12,10 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
 use iceoryx2::prelude::ipc;
-use motion_frames::ipc::cleanup_domain;
+use motion_frames::cleanup::cleanup_stale_domains;
 use motion_frames::{
-    monotonic_ns, AxisCommand, CommandFrame, FeedbackFrame, IpcConfig, Sent, SupervisorPorts,
+    cleanup_domain, monotonic_ns, AxisCommand, CommandFrame, Domain, FeedbackFrame, Sent,
+    SupervisorPorts,
 };
 use nix::sys::signal::{kill, Signal};
 use nix::unistd::Pid;
@@ -227,11 +228,18 @@ impl Drop for Io {
     }
 }
 
-/// The supervisor's side, played by the test.
+/// The supervisor's side, played by the test: it claims the prefix (the
+/// session file motion-io joins through) and creates the services.
 pub struct Sup {
     pub ports: SupervisorPorts,
     pub node: Node<ipc::Service>,
-    pub cfg: IpcConfig,
+    pub domain: Domain,
+}
+
+impl Drop for Sup {
+    fn drop(&mut self) {
+        self.domain.withdraw();
+    }
 }
 
 /// One answered command.
@@ -245,10 +253,14 @@ pub struct Answer {
 
 impl Sup {
     pub fn new(prefix: &str) -> Self {
-        let cfg = IpcConfig::new(prefix);
-        let node = cfg.create_node("test-supervisor").unwrap();
-        let ports = SupervisorPorts::create(&node, prefix).unwrap();
-        Self { ports, node, cfg }
+        let domain = Domain::establish(prefix, None).unwrap();
+        let node = domain.create_node("test-supervisor").unwrap();
+        let ports = SupervisorPorts::create(&node, &domain, "io").unwrap();
+        Self {
+            ports,
+            node,
+            domain,
+        }
     }
 
     /// Sends one command frame and waits for the feedback answering it.
@@ -311,22 +323,29 @@ impl Sup {
     }
 }
 
-/// `/dev/shm` entries of the iceoryx2 domain of `prefix`.
+/// `/dev/shm` entries of the iceoryx2 domains of `prefix`.
 pub fn shm_entries(prefix: &str) -> Vec<String> {
-    IpcConfig::new(prefix).shm_files()
+    Domain::shm_files_of_prefix(prefix)
 }
 
 /// After a test: the supervisor side is dropped first, then the domain is
 /// cleaned with the same helper the processes use; nothing may remain.
 pub fn finish(sup: Option<Sup>, prefix: &str) {
+    let domain = sup.as_ref().map(|s| s.domain.clone());
     drop(sup);
-    let cfg = IpcConfig::new(prefix);
     // a killed peer shows as dead only after a moment: retry briefly
     let deadline = Instant::now() + Duration::from_secs(5);
     loop {
-        let r = cleanup_domain(&cfg);
-        println!("cleanup_domain({prefix}): {r}");
-        if r.domain_gone() || Instant::now() >= deadline {
+        let gone = match &domain {
+            Some(d) => {
+                let r = cleanup_domain(d);
+                println!("cleanup_domain({prefix}): {r}");
+                r.domain_gone()
+            }
+            None => true,
+        };
+        cleanup_stale_domains(prefix, &motion_frames::domain::default_runtime_dir());
+        if (gone && shm_entries(prefix).is_empty()) || Instant::now() >= deadline {
             break;
         }
         std::thread::sleep(Duration::from_millis(50));
@@ -345,9 +364,10 @@ impl Drop for DomainGuard {
         if !std::thread::panicking() {
             return;
         }
-        let cfg = IpcConfig::new(self.0.as_str());
+        let dir = motion_frames::domain::default_runtime_dir();
         let deadline = Instant::now() + Duration::from_secs(2);
-        while !cleanup_domain(&cfg).domain_gone() && Instant::now() < deadline {
+        while !shm_entries(&self.0).is_empty() && Instant::now() < deadline {
+            cleanup_stale_domains(&self.0, &dir);
             std::thread::sleep(Duration::from_millis(50));
         }
     }

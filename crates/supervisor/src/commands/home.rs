@@ -1,164 +1,144 @@
-use super::{load, rt_json, rt_lines, start};
-use crate::cli::Common;
-use crate::report::{self, Row};
+use super::{allocations, cpu, fail, load, options, rt_info, rt_lines};
+use crate::cli::HomeArgs;
 use crate::session::Session;
-use crate::shared::{AxisSnap, Control};
+use motion_control::homing::{home_and_follow, HomeOutcome, HomeRequest};
+use motion_control::progress::Progress;
+use motion_control::Client;
+use motion_report::{print_json, table, ErrorEntry, HomeReport};
 use motion_rt::termination as signals;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-/// `home`: the commissioning run of interface.md.
-pub fn home(common: &Common, names: &[String], json: bool, parallel: bool, timeout_s: f64) -> i32 {
-    let Some((m, source)) = load(common) else {
-        return 2;
+/// `home`: the commissioning run of interface.md. It starts the daemon's
+/// machinery in this process and homes through the control service, as
+/// `motionctl home` does against a running daemon.
+pub fn home(a: &HomeArgs) -> i32 {
+    let (m, source) = match load(&a.common, a.json) {
+        Ok(x) => x,
+        Err(code) => return code,
     };
-    let mut order = Vec::new();
-    for n in names {
-        match m.axis_index(n) {
-            Some(i) => order.push(i),
-            None => {
-                let known: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
-                eprintln!(
-                    "motion-supervisor: no axis '{n}' in {source} (axes: {})",
-                    known.join(", ")
-                );
-                return 2;
-            }
+    for n in &a.axes {
+        if m.axis_index(n).is_none() {
+            let known: Vec<&str> = m.axes.iter().map(|x| x.name.as_str()).collect();
+            return fail(
+                a.json,
+                vec![ErrorEntry {
+                    axis: Some(n.clone()),
+                    key: Some("axis".into()),
+                    message: format!("no axis {n} in {source} (axes: {})", known.join(", ")),
+                    ..ErrorEntry::default()
+                }],
+                2,
+            );
         }
     }
-    if order.is_empty() {
-        order = (0..m.axes.len()).collect();
-    }
-    let Some(mut session) = start(common, m, &[]) else {
-        return 1;
+    let opts = options(&a.common, &m);
+    let mut session = match Session::start(m, &opts) {
+        Ok(s) => s,
+        Err(e) => return fail(a.json, vec![ErrorEntry::message(e)], 1),
     };
-    eprintln!(
-        "motion-supervisor: homing {} axis(es) of {source}{}",
-        order.len(),
-        if parallel {
+    if let Err(e) = session.wait_io(Duration::from_secs(10)) {
+        drop(session);
+        return fail(a.json, vec![ErrorEntry::message(e)], 1);
+    }
+    log::info!(
+        "homing {} of {source}{}",
+        if a.axes.is_empty() {
+            "every axis".to_string()
+        } else {
+            a.axes.join(", ")
+        },
+        if a.parallel {
             " in parallel"
         } else {
-            " in config order"
+            " in home order"
         }
     );
-
-    let mut notes: Vec<Option<String>> = vec![None; session.machine.axes.len()];
-    let mut interrupted = None;
-    let batches: Vec<Vec<usize>> = if parallel {
-        vec![order.clone()]
-    } else {
-        order.iter().map(|&i| vec![i]).collect()
-    };
-    'batches: for batch in &batches {
-        session.poll();
-        let started_before: Vec<u32> = batch
-            .iter()
-            .map(|&i| snap_of(&session, i).homes_started)
-            .collect();
-        for &i in batch {
-            let _ = session.send(Control::Home(i));
-        }
-        let deadline = Instant::now() + Duration::from_secs_f64(timeout_s);
-        let mut stopped = false;
-        loop {
-            std::thread::sleep(Duration::from_millis(10));
-            session.poll();
-            let done = batch.iter().zip(&started_before).all(|(&i, &before)| {
-                let s = snap_of(&session, i);
-                s.homes_started > before && s.settled()
-            });
-            if done {
-                break;
-            }
-            if let Some(sig) = signals::received() {
-                interrupted = Some(sig);
-                break 'batches;
-            }
-            if !stopped && Instant::now() > deadline {
-                for &i in batch {
-                    notes[i] = Some(format!("no result within --timeout {timeout_s} s: stopped"));
-                    let _ = session.send(Control::Stop(i));
+    let mut errors = Vec::new();
+    let mut rows = Vec::new();
+    match Client::connect(&session.domain.prefix, Some(&session.domain.runtime_dir)) {
+        Err(e) => errors.push(ErrorEntry::message(format!("control service: {e}"))),
+        Ok(mut client) => {
+            let mut progress = Progress::new();
+            let said = std::cell::Cell::new(false);
+            let req = HomeRequest {
+                axes: a.axes.clone(),
+                parallel: a.parallel,
+                timeout_s: a.timeout,
+            };
+            match home_and_follow(
+                &mut client,
+                &req,
+                |st, members| progress.show(st, members),
+                || match signals::received() {
+                    Some(sig) => {
+                        if !said.replace(true) {
+                            log::info!("signal {sig}: stopping every axis");
+                        }
+                        true
+                    }
+                    None => false,
+                },
+            ) {
+                Ok(HomeOutcome::Done(r, _)) => rows = r,
+                Ok(HomeOutcome::Refused(resp)) => {
+                    errors.push(ErrorEntry::message(format!(
+                        "home refused: {}",
+                        resp.message_text()
+                    )));
+                    for ans in resp.answers() {
+                        if ans.accepted == 0 && ans.err != 0 {
+                            errors.push(ErrorEntry {
+                                axis: Some(motion_control::get_str(&ans.name)),
+                                key: None,
+                                err: Some(ans.err),
+                                exerr: Some(ans.exerr),
+                                message: motion_control::reason_text(ans.reason).into(),
+                            });
+                        }
+                    }
                 }
-                stopped = true;
-            }
-            if let Some(e) = session.check_alive() {
-                // The engines notice the silence themselves (ERR 12/40) and
-                // stop; keep following them until they have.
-                if session.io.as_mut().is_some_and(|io| io.exited().is_some()) {
-                    continue;
-                }
-                eprintln!("motion-supervisor: {e}");
-                break 'batches;
+                Err(e) => errors.push(ErrorEntry::message(e.to_string())),
             }
         }
     }
-    if let Some(sig) = interrupted {
-        eprintln!("motion-supervisor: signal {sig}: stopping every axis");
-        // Stop what is in process and let it come to rest, so the result
-        // shows how homing ended (ERR 12 / EXERR 1) before leaving.
-        for &i in &order {
-            let _ = session.send(Control::Stop(i));
-        }
-        let until = Instant::now() + Duration::from_secs(10);
-        while Instant::now() < until {
-            std::thread::sleep(Duration::from_millis(10));
-            session.poll();
-            let busy = order.iter().any(|&i| {
-                let s = snap_of(&session, i);
-                s.status.ip || s.status.stopping || s.cmd_velocity != 0.0
-            });
-            if !busy {
-                break;
-            }
-        }
+    for e in session.poll_children(false) {
+        log::warn!("{e}");
     }
-    if let Some(e) = session.check_alive() {
-        eprintln!("motion-supervisor: {e}");
+    if let Some(sig) = signals::received() {
+        errors.push(ErrorEntry::message(format!(
+            "signal {sig}: every axis was stopped"
+        )));
     }
-
-    // The result is the state when homing ended: leaving disables the drives
-    // (a shutdown), which clears HomedStatus.
-    session.poll();
-    let result = session.snapshot.clone();
     let f = session.finish();
-    let snap = result.as_deref().or(f.snapshot.as_deref());
-    let rows: Vec<Row> = order
-        .iter()
-        .map(|&i| {
-            let s = snap.map(|s| s.axes[i]).unwrap_or_default();
-            let note = notes[i].clone().or_else(|| {
-                (s.homes_started == 0).then(|| "not homed: the run ended before this axis".into())
-            });
-            Row::new(&f.machine.axes[i], s, note)
-        })
-        .collect();
-    let summary = f.totals.summary();
-    if json {
-        let mut v = rt_json(&f);
-        v["axes"] = rows.iter().map(Row::to_json).collect();
-        v["latency"] = summary.to_json();
-        println!("{v}");
+    let report = HomeReport {
+        axes: rows,
+        latency: f.latency,
+        io: f.io.clone(),
+        rt: rt_info(&f),
+        warnings: f.warnings.clone(),
+        allocations: allocations(&f),
+        cpu: cpu(&f),
+        errors: errors.clone(),
+    };
+    if a.json {
+        print_json(&report);
     } else {
-        print!("{}", report::table(&rows));
+        print!("{}", table::axis_results(&report.axes));
         println!();
-        print!("{}", summary.table());
+        print!("{}", report.latency.table());
         for l in rt_lines(&f) {
             println!("{l}");
         }
+        for e in &errors {
+            log::error!("{}", e.message);
+        }
     }
-    if let Some(sig) = interrupted {
+    if let Some(sig) = signals::received() {
         return 128 + sig;
     }
-    if rows.iter().all(|r| r.snap.status.pc) {
-        0
-    } else {
+    if !errors.is_empty() || report.axes.is_empty() || !report.axes.iter().all(|r| r.succeeded()) {
         1
+    } else {
+        0
     }
-}
-
-fn snap_of(session: &Session, i: usize) -> AxisSnap {
-    session
-        .snapshot
-        .as_ref()
-        .map(|s| s.axes[i])
-        .unwrap_or_default()
 }

@@ -1,88 +1,119 @@
-//! The three subcommands. Each returns the process exit code.
+//! The three subcommands. Each returns the process exit code:
+//! 0 success, 1 homing did not succeed or a run-time failure, 2 a bad
+//! configuration or argument, 128+N ended by signal N.
 
 mod check;
 mod home;
 mod run;
 
-use crate::cli::{Cli, Common};
-use crate::session::{Session, SessionOptions};
-use motion_config::MachineConfig;
+use crate::cli::{Cli, Command, Common};
+use crate::session::{Finished, SessionOptions};
+use motion_config::{MachineConfig, Problem};
+use motion_report::{print_json, Allocations, CpuUse, ErrorEntry, ErrorReport, RtInfo};
 
 pub fn run(c: Cli) -> i32 {
-    match c {
-        Cli::Check { common } => check::check(&common),
-        Cli::Home {
-            common,
-            axes,
-            json,
-            parallel,
-            timeout_s,
-        } => home::home(&common, &axes, json, parallel, timeout_s),
-        Cli::Run {
-            common,
-            duration_s,
-            json,
-            hlog,
-            io_args,
-        } => run::run(&common, duration_s, json, hlog.as_deref(), &io_args),
-        Cli::Help => 0,
+    match c.command {
+        Command::Check(a) => check::check(&a),
+        Command::Home(a) => home::home(&a),
+        Command::Run(a) => run::run(&a),
     }
 }
 
-/// Loads the machine; prints every problem and returns `None` on error.
-fn load(common: &Common) -> Option<(MachineConfig, String)> {
-    match motion_config::load(common.config.as_deref()) {
-        Ok(x) => Some(x),
-        Err(problems) => {
+/// A command line clap refused: its message (exit 2), or with `--json` in
+/// the arguments one JSON error object on stdout. `--help` / `--version`
+/// print and exit 0.
+pub fn argument_error(e: clap::Error) -> i32 {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            return 0;
+        }
+        _ => {}
+    }
+    if std::env::args().any(|a| a == "--json") {
+        let text = e.render().to_string();
+        let first = text
+            .lines()
+            .next()
+            .unwrap_or("bad argument")
+            .trim_start_matches("error: ")
+            .to_string();
+        print_json(&ErrorReport::message(first));
+    } else {
+        let _ = e.print();
+    }
+    2
+}
+
+/// Problems as the JSON error entries of interface.md.
+pub fn entries(problems: &[Problem]) -> Vec<ErrorEntry> {
+    problems
+        .iter()
+        .map(|p| ErrorEntry {
+            axis: p.axis.clone(),
+            key: Some(p.key.clone()),
+            err: p.code.map(|c| c.0),
+            exerr: p.code.map(|c| c.1),
+            message: p.message.clone(),
+        })
+        .collect()
+}
+
+/// Reports `errors` (one JSON object with `json`, else lines on stderr) and
+/// returns `code`.
+pub fn fail(json: bool, errors: Vec<ErrorEntry>, code: i32) -> i32 {
+    if json {
+        print_json(&ErrorReport { errors });
+    } else {
+        for e in &errors {
+            let code = match (e.err, e.exerr) {
+                (Some(err), Some(exerr)) => format!(" (ERR {err} EXERR {exerr})"),
+                _ => String::new(),
+            };
+            match (&e.axis, &e.key) {
+                (Some(a), Some(k)) => log::error!("axis {a}: {k}: {}{code}", e.message),
+                (None, Some(k)) => log::error!("{k}: {}{code}", e.message),
+                _ => log::error!("{}{code}", e.message),
+            }
+        }
+    }
+    code
+}
+
+/// Loads the machine; on error reports every problem and returns exit code 2.
+fn load(common: &Common, json: bool) -> Result<(MachineConfig, String), i32> {
+    motion_config::load(common.config.as_deref()).map_err(|problems| {
+        if !json {
             let source = common
                 .config
                 .as_ref()
                 .map_or("built-in config".to_string(), |p| p.display().to_string());
-            eprintln!(
-                "motion-supervisor: {} problem{} in {source}:",
+            log::error!(
+                "{} problem{} in {source}:",
                 problems.len(),
                 if problems.len() == 1 { "" } else { "s" }
             );
-            for p in problems {
-                eprintln!("  {p}");
-            }
-            None
         }
-    }
+        fail(json, entries(&problems), 2)
+    })
 }
 
-/// Starts the cycle and the I/O process and waits until it answers; prints
-/// why not and returns `None` on failure (everything started is stopped).
-fn start(common: &Common, m: MachineConfig, io_args: &[String]) -> Option<Session> {
-    let opts = SessionOptions {
+fn options(common: &Common, m: &MachineConfig) -> SessionOptions {
+    SessionOptions {
         config_path: common.config.clone(),
-        service_prefix: prefix(common, &m),
-        io_args: io_args.to_vec(),
-    };
-    let mut session = match Session::start(m, &opts) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("motion-supervisor: {e}");
-            return None;
-        }
-    };
-    if let Err(e) = session.wait_io(std::time::Duration::from_secs(10)) {
-        eprintln!("motion-supervisor: {e}");
-        session.finish();
-        return None;
+        service_prefix: common
+            .service_prefix
+            .clone()
+            .unwrap_or_else(|| m.supervisor.service_prefix.clone()),
+        runtime_dir: common.runtime_dir.clone(),
+        io_args: Vec::new(),
+        hlog_file: None,
     }
-    Some(session)
-}
-
-fn prefix(common: &Common, m: &MachineConfig) -> String {
-    common
-        .service_prefix
-        .clone()
-        .unwrap_or_else(|| m.supervisor.service_prefix.clone())
 }
 
 /// RT thread settings as the operator should read them.
-fn rt_lines(f: &crate::session::Finished) -> Vec<String> {
+fn rt_lines(f: &Finished) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(r) = f.outcome.as_ref().and_then(|o| o.report.as_ref()) {
         out.push(format!("real-time thread: {r}"));
@@ -94,44 +125,64 @@ fn rt_lines(f: &crate::session::Finished) -> Vec<String> {
         "allocations in the cycle after warm-up: {} system-allocator calls, {} served by the RT pool",
         f.system_calls_in_cycle, f.pool_allocs_in_cycle
     ));
-    if let Some(s) = f.snapshot.as_deref() {
+    for io in &f.io {
         out.push(format!(
-            "feedback frames: {} answered cycles, {} cycles without a fresh frame \
-             ({} answered a command too old to use), {} refused",
-            s.frames_received, s.frames_missing, s.frames_late, s.frames_rejected
+            "I/O process {}: {} answered cycles, {} without a fresh answer ({} too old, {} \
+             refused); gaps 1: {}, 2-3: {}, 4-10: {}, >10: {}, longest {:.1} ms; attached {} \
+             time(s)",
+            io.name,
+            io.frames_received,
+            io.frames_missing,
+            io.frames_too_old,
+            io.frames_refused,
+            io.gaps.one,
+            io.gaps.two_to_three,
+            io.gaps.four_to_ten,
+            io.gaps.over_ten,
+            io.longest_gap_ms,
+            io.attachments
         ));
     }
     let pct = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{:.1} %", v * 100.0));
+    let ios: Vec<String> = f
+        .io_cpu
+        .iter()
+        .map(|(n, c)| format!("motion-io {n} {}", pct(*c)))
+        .collect();
     out.push(format!(
-        "cpu: motion-supervisor {}, motion-io {} (of one core, over {:.1} s)",
+        "cpu: motion-supervisor {}{}{} (of one core, over {:.1} s)",
         pct(f.supervisor_cpu),
-        pct(f.io_cpu),
+        if ios.is_empty() { "" } else { ", " },
+        ios.join(", "),
         f.wall_s
     ));
     out
 }
 
-fn rt_json(f: &crate::session::Finished) -> serde_json::Value {
-    let r = f.outcome.as_ref().and_then(|o| o.report.as_ref());
-    serde_json::json!({
-        "rt": r.map(|r| serde_json::json!({
-            "cpu": r.cpu,
-            "policy": r.policy.to_string(),
-            "priority": r.priority,
-            "memory_locked": r.memory_locked,
-            "warnings": r.warnings,
-        })),
-        "warnings": f.warnings,
-        "allocations": {
-            "system_calls_in_cycle": f.system_calls_in_cycle,
-            "pool_allocs_in_cycle": f.pool_allocs_in_cycle,
-        },
-        "cpu": {"supervisor": f.supervisor_cpu, "io": f.io_cpu, "wall_s": f.wall_s},
-        "frames": f.snapshot.as_deref().map(|s| serde_json::json!({
-            "received": s.frames_received,
-            "missing": s.frames_missing,
-            "refused": s.frames_rejected,
-            "too_old": s.frames_late,
-        })),
-    })
+fn rt_info(f: &Finished) -> Option<RtInfo> {
+    f.outcome
+        .as_ref()
+        .and_then(|o| o.report.as_ref())
+        .map(|r| RtInfo {
+            cpu: r.cpu,
+            policy: r.policy.to_string(),
+            priority: r.priority,
+            memory_locked: r.memory_locked,
+            warnings: r.warnings.clone(),
+        })
+}
+
+fn allocations(f: &Finished) -> Allocations {
+    Allocations {
+        system_calls_in_cycle: f.system_calls_in_cycle,
+        pool_allocs_in_cycle: f.pool_allocs_in_cycle,
+    }
+}
+
+fn cpu(f: &Finished) -> CpuUse {
+    CpuUse {
+        supervisor: f.supervisor_cpu,
+        io: f.io_cpu.clone(),
+        wall_s: f.wall_s,
+    }
 }

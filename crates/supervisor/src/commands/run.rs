@@ -1,97 +1,91 @@
-use super::{load, rt_json, rt_lines, start};
-use crate::cli::Common;
+use super::{allocations, cpu, fail, load, options, rt_info, rt_lines};
+use crate::cli::RunArgs;
+use crate::session::Session;
+use motion_report::{print_json, ErrorEntry, RunReport};
 use motion_rt::termination as signals;
-use std::path::Path;
 use std::time::{Duration, Instant};
 
-pub fn run(
-    common: &Common,
-    duration_s: Option<f64>,
-    json: bool,
-    hlog: Option<&Path>,
-    io_args: &[String],
-) -> i32 {
-    let Some((m, source)) = load(common) else {
-        return 2;
+/// `run`: the daemon. Serves the control and status services until
+/// SIGINT/SIGTERM (or `--duration`); spawned I/O processes that end are
+/// started again; then every axis is stopped and the summary printed.
+pub fn run(a: &RunArgs) -> i32 {
+    let (m, source) = match load(&a.common, a.json) {
+        Ok(x) => x,
+        Err(code) => return code,
     };
-    let Some(mut session) = start(common, m, io_args) else {
-        return 1;
+    let mut opts = options(&a.common, &m);
+    opts.io_args = a.io_args.clone();
+    opts.hlog_file = a.hlog.clone();
+    let mut session = match Session::start(m, &opts) {
+        Ok(s) => s,
+        Err(e) => return fail(a.json, vec![ErrorEntry::message(e)], 1),
     };
-    if !json {
-        eprintln!(
-            "motion-supervisor: running {source} at {} µs; SIGINT/SIGTERM to stop",
-            session.machine.supervisor.cycle_us
-        );
+    log::info!(
+        "running {source} at {} µs, service prefix {:?}, session file {}; SIGINT/SIGTERM to stop",
+        session.machine.supervisor.cycle_us,
+        session.domain.prefix,
+        motion_frames::domain::session_path(&session.domain.runtime_dir, &session.domain.prefix)
+            .display()
+    );
+    for w in &session.warnings {
+        log::warn!("{w}");
     }
-    // The measured window starts now.
-    session.poll();
-    session.totals.reset();
-    let mut hlog_writer = match hlog.map(crate::hlog::HlogWriter::create).transpose() {
-        Ok(w) => w,
-        Err(e) => {
-            eprintln!("motion-supervisor: {e}");
-            session.finish();
-            return 1;
-        }
-    };
     let started = Instant::now();
     let mut last_line = Instant::now();
-    let mut io_reported = false;
-    let code = loop {
+    let mut errors = Vec::new();
+    loop {
         std::thread::sleep(Duration::from_millis(50));
-        session.shared.collect_intervals(&mut session.totals, |h| {
-            if let Some(w) = hlog_writer.as_mut() {
-                w.interval(h);
-            }
-        });
-        session.shared.latest_snapshot(&mut session.snapshot);
         if let Some(sig) = signals::received() {
-            if !json {
-                eprintln!("motion-supervisor: signal {sig}: stopping every axis");
-            }
-            break 0;
+            log::info!("signal {sig}: stopping every axis");
+            break;
         }
-        if duration_s.is_some_and(|d| started.elapsed().as_secs_f64() >= d) {
-            break 0;
+        if a.duration
+            .is_some_and(|d| started.elapsed().as_secs_f64() >= d)
+        {
+            break;
+        }
+        for e in session.poll_children(true) {
+            log::warn!("{e}; starting it again in 1 s");
         }
         if let Some(e) = session.check_alive() {
-            if session.io.as_mut().is_some_and(|io| io.exited().is_some()) {
-                if !io_reported {
-                    eprintln!("motion-supervisor: {e}; cycling on, feedback lost");
-                    io_reported = true;
-                }
-            } else {
-                eprintln!("motion-supervisor: {e}");
-                break 1;
-            }
+            log::error!("{e}");
+            errors.push(ErrorEntry::message(e));
+            break;
         }
-        if !json && last_line.elapsed() >= Duration::from_secs(10) {
+        if last_line.elapsed() >= Duration::from_secs(10) {
             last_line = Instant::now();
-            let s = session.totals.summary();
-            eprintln!(
-                "motion-supervisor: {} cycles, {} deadline misses, wake-up p99 {:.1} µs max {:.1} µs, round trip p99 {:.1} µs",
-                s.cycles, s.deadline_misses, s.wakeup.p99, s.wakeup.max, s.roundtrip.p99
+            let s = session.hub.lock().since_start.summary();
+            log::info!(
+                "{} cycles, {} deadline misses, wake-up p99 {:.1} µs max {:.1} µs, round trip p99 {:.1} µs",
+                s.cycles,
+                s.deadline_misses,
+                s.wakeup_us.p99,
+                s.wakeup_us.max,
+                s.io_roundtrip_us.p99
             );
         }
-    };
-    let f = session.finish_with(|h| {
-        if let Some(w) = hlog_writer.as_mut() {
-            w.interval(h);
-        }
-    });
-    if let Some(w) = hlog_writer.as_mut() {
-        w.finish();
     }
-    let summary = f.totals.summary();
-    if json {
-        let mut v = rt_json(&f);
-        v["latency"] = summary.to_json();
-        println!("{v}");
+    let f = session.finish();
+    let report = RunReport {
+        latency: f.latency,
+        io: f.io.clone(),
+        rt: rt_info(&f),
+        warnings: f.warnings.clone(),
+        allocations: allocations(&f),
+        cpu: cpu(&f),
+        errors: errors.clone(),
+    };
+    if a.json {
+        print_json(&report);
     } else {
-        print!("{}", summary.table());
+        print!("{}", report.latency.table());
         for l in rt_lines(&f) {
             println!("{l}");
         }
     }
-    code
+    if !errors.is_empty() {
+        1
+    } else {
+        0
+    }
 }

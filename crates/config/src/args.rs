@@ -1,0 +1,55 @@
+//! Command-line values, checked by the same rules as the config file (clap
+//! `value_parser`s shared by every binary).
+
+use crate::names;
+use std::path::PathBuf;
+
+/// `--service-prefix P`.
+pub fn service_prefix(s: &str) -> Result<String, String> {
+    names::check_service_prefix(s).map(|()| s.to_string())
+}
+
+/// An axis name.
+pub fn axis(s: &str) -> Result<String, String> {
+    names::check_name(s).map(|()| s.to_string())
+}
+
+/// An I/O process name.
+pub fn io(s: &str) -> Result<String, String> {
+    names::check_io_name(s).map(|()| s.to_string())
+}
+
+/// Seconds: a finite positive number of at most a day.
+pub fn seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 && x <= 86_400.0 => Ok(x),
+        _ => Err(format!(
+            "{} is not a number of seconds in (0, 86400]",
+            names::shown(s)
+        )),
+    }
+}
+
+/// `--runtime-dir DIR`: absolute, short, no `..` (the domain checks the
+/// directory itself: owner, mode, not a symlink).
+pub fn runtime_dir(s: &str) -> Result<PathBuf, String> {
+    if !s.starts_with('/') || s.contains("..") || s.len() > RUNTIME_DIR_MAX {
+        return Err(format!(
+            "{} must be an absolute path of at most {RUNTIME_DIR_MAX} characters without \"..\"",
+            names::shown(s)
+        ));
+    }
+    Ok(PathBuf::from(s))
+}
+
+/// A CPU that exists on this machine.
+pub fn cpu(s: &str) -> Result<usize, String> {
+    let n: i64 = s
+        .parse()
+        .map_err(|_| format!("{} is not a CPU number", names::shown(s)))?;
+    crate::check_cpu(n).map(|()| n as usize)
+}
+
+/// Longest runtime directory (iceoryx2's socket paths below it are limited;
+/// the same bound as `motion_frames::domain::RUNTIME_DIR_MAX`).
+pub const RUNTIME_DIR_MAX: usize = 19;

@@ -1,0 +1,196 @@
+//! Status frames in the reports' words: `status --json` and the rows of
+//! `home --json` are made from the status frame, by both the daemon and its
+//! clients, with one function each.
+
+use crate::message::*;
+use motion_report::{AxisResult, AxisStatus, GapCounts, IoStatus, StatusReport};
+
+/// Home Mode by CIP number (interface.md spellings).
+pub fn mode_name(n: u8) -> &'static str {
+    match n {
+        0 => "passive",
+        1 => "active",
+        2 => "absolute",
+        _ => "?",
+    }
+}
+
+/// Home Sequence by CIP number.
+pub fn sequence_name(n: u8) -> &'static str {
+    match n {
+        0 => "immediate",
+        1 => "switch",
+        2 => "marker",
+        3 => "switch_then_marker",
+        4 => "torque",
+        5 => "torque_then_marker",
+        _ => "?",
+    }
+}
+
+/// Home Direction by CIP number.
+pub fn direction_name(n: u8) -> &'static str {
+    match n {
+        0 => "unidirectional_forward",
+        1 => "bidirectional_forward",
+        2 => "unidirectional_reverse",
+        3 => "bidirectional_reverse",
+        _ => "?",
+    }
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+fn r6(x: Option<f64>) -> Option<f64> {
+    x.map(|v| motion_report::round(v, 6))
+}
+
+impl AxisStatusEntry {
+    pub fn has(&self, bit: u16) -> bool {
+        self.bits & bit != 0
+    }
+
+    /// What went wrong, in words, if anything (`names`: every axis's name,
+    /// to name the axis that aborted this one's sequence).
+    pub fn error_text(&self, names: &[String]) -> Option<String> {
+        if self.extra & SX_TIMED_OUT != 0 {
+            return Some("not homed: the home request's --timeout ran out; stopped".into());
+        }
+        if self.aborted_by != NO_AXIS {
+            let who = names
+                .get(self.aborted_by as usize)
+                .map_or("another axis", String::as_str);
+            return Some(if self.has(ST_ER) {
+                format!("home sequence aborted because axis {who} failed: stopped")
+            } else {
+                format!("not homed: the home sequence was aborted because axis {who} failed")
+            });
+        }
+        if self.has(ST_ER) {
+            return Some(motion_report::codes::explain(self.err, self.exerr).to_string());
+        }
+        if self.extra & SX_LOST_HOMED != 0 && !self.has(ST_HOMED) {
+            let why = if self.extra & SX_LOST_FEEDBACK != 0 {
+                "feedback lost"
+            } else if self.extra & SX_LOST_RECONNECT != 0 {
+                "its I/O process reconnected"
+            } else {
+                "HomedStatus cleared"
+            };
+            return Some(format!(
+                "homed, then lost: {why} at t = {:.3} s after homing ended",
+                self.lost_after_s
+            ));
+        }
+        None
+    }
+
+    /// A row of `home --json`.
+    pub fn to_result(&self, names: &[String], ios: &[String]) -> AxisResult {
+        let done = !self.has(ST_IP) && (self.has(ST_DN) || self.has(ST_ER));
+        AxisResult {
+            name: get_str(&self.name),
+            mode: mode_name(self.home_mode).into(),
+            sequence: sequence_name(self.home_sequence).into(),
+            direction: direction_name(self.home_direction).into(),
+            io: ios.get(self.io as usize).cloned().unwrap_or_default(),
+            pc: self.has(ST_PC),
+            er: self.has(ST_ER),
+            err: self.err,
+            exerr: self.exerr,
+            homed: self.has(ST_HOMED),
+            event_raw: r6(self
+                .has(ST_EVENT)
+                .then_some(self.event_raw)
+                .and_then(finite)),
+            final_position: r6(self
+                .has(ST_FEEDBACK)
+                .then_some(self.position)
+                .and_then(finite)),
+            final_raw: r6(self.has(ST_FEEDBACK).then_some(self.raw).and_then(finite)),
+            duration_s: done.then(|| motion_report::round(self.elapsed_s, 3)),
+            error: self.error_text(names),
+            warnings: Vec::new(),
+        }
+    }
+}
+
+impl StatusFrame {
+    pub fn axis_names(&self) -> Vec<String> {
+        self.axes().iter().map(|a| get_str(&a.name)).collect()
+    }
+
+    pub fn io_names(&self) -> Vec<String> {
+        self.ios().iter().map(|i| get_str(&i.name)).collect()
+    }
+
+    /// `status --json`.
+    pub fn to_report(&self) -> StatusReport {
+        let names = self.axis_names();
+        let ios = self.io_names();
+        StatusReport {
+            cycle: self.cycle,
+            cycle_us: self.cycle_us,
+            uptime_ms: self.uptime_ns / 1_000_000,
+            axes: self
+                .axes()
+                .iter()
+                .map(|a| {
+                    let fb = a.has(ST_FEEDBACK);
+                    let val = |x: f64| r6(fb.then_some(x).and_then(finite));
+                    AxisStatus {
+                        name: get_str(&a.name),
+                        io: ios.get(a.io as usize).cloned().unwrap_or_default(),
+                        phase: get_str(&a.phase),
+                        homing: a.has(ST_HOMING),
+                        homed: a.has(ST_HOMED),
+                        en: a.has(ST_EN),
+                        dn: a.has(ST_DN),
+                        er: a.has(ST_ER),
+                        ip: a.has(ST_IP),
+                        pc: a.has(ST_PC),
+                        err: a.err,
+                        exerr: a.exerr,
+                        position: val(a.position),
+                        raw: val(a.raw),
+                        velocity: val(a.velocity),
+                        torque: val(a.torque),
+                        switch: a.has(ST_SWITCH),
+                        marker: a.has(ST_MARKER),
+                        event_raw: r6(a.has(ST_EVENT).then_some(a.event_raw).and_then(finite)),
+                        elapsed_s: motion_report::round(a.elapsed_s, 3),
+                        timeout_s: a.timeout_s,
+                        search_travel: motion_report::round(a.search_travel, 6),
+                        search_limit: (a.search_limit > 0.0).then_some(a.search_limit),
+                        enabled: a.has(ST_ENABLED),
+                        fault: a.has(ST_FAULT),
+                        drive_error_code: a.drive_error_code,
+                        error: a.error_text(&names),
+                    }
+                })
+                .collect(),
+            io: self
+                .ios()
+                .iter()
+                .map(|i| IoStatus {
+                    name: get_str(&i.name),
+                    attached: i.attached != 0,
+                    frames_received: i.frames_received,
+                    frames_missing: i.frames_missing,
+                    frames_refused: i.frames_refused,
+                    attachments: i.attachments,
+                    gaps: GapCounts {
+                        one: i.gaps[0],
+                        two_to_three: i.gaps[1],
+                        four_to_ten: i.gaps[2],
+                        over_ten: i.gaps[3],
+                        longest_cycles: i.longest_gap_cycles,
+                    },
+                    gap_cycles: i.gap_cycles,
+                })
+                .collect(),
+        }
+    }
+}

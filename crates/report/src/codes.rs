@@ -1,0 +1,22 @@
+//! ERR / EXERR in plain words (the table is `motion_homing::codes`).
+
+use motion_homing::codes::*;
+
+/// One line per ERR/EXERR.
+pub fn explain(err: u16, exerr: u16) -> &'static str {
+    match (err, exerr) {
+        (0, _) => "no error",
+        (ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST) => "homing terminated by a stop or disable",
+        (ERR_SERVO_MESSAGE, EX_AXIS_SHUTDOWN) => "axis in shutdown",
+        (ERR_SERVO_MESSAGE, EX_DRIVE_FAULT) => "drive fault during homing",
+        (ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST) => "feedback lost (I/O process silent or gone)",
+        (ERR_SERVO_MESSAGE, EX_FEEDBACK_INVALID) => "invalid feedback (non-finite or absurd)",
+        (ERR_SERVO_MESSAGE, EX_ENABLE_TIMEOUT) => "drive did not enable in time",
+        (ERR_SERVO_MESSAGE, EX_OVERTRAVEL) => "hardware overtravel during homing",
+        (ERR_ILLEGAL_HOMING_CONFIG, _) => "illegal homing configuration",
+        (ERR_INTERRUPTED, _) => "homing interrupted externally",
+        (ERR_TIMEOUT, _) => "home timeout exceeded",
+        (ERR_SEARCH_LIMIT, _) => "search travelled beyond the search limit",
+        _ => "error",
+    }
+}

@@ -1,0 +1,48 @@
+//! What the tools print, as typed `serde` structs: one definition shared by
+//! the writer (`motion-supervisor`, `motionctl`) and every reader (the bench,
+//! the tests, scripts). A field renamed here is renamed everywhere at once;
+//! nothing is read back with `.unwrap_or(0)`.
+//!
+//! * [`latency`] — percentiles of the three latencies (`home`/`run`/`stats`).
+//! * [`home`] — `home --json`: one row per axis (interface.md).
+//! * [`status`] — `status --json`: the live state of every axis and I/O process.
+//! * [`io`] — per I/O process: attached, frames, gaps by length.
+//! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`.
+//! * [`codes`] — ERR/EXERR in plain words.
+//! * [`table`] — the fixed-width text tables of the same reports.
+
+pub mod codes;
+pub mod errors;
+pub mod home;
+pub mod io;
+pub mod latency;
+pub mod status;
+pub mod table;
+
+pub use errors::{ErrorEntry, ErrorReport};
+pub use home::{
+    Allocations, AxisResult, CheckReport, CpuUse, CtlHomeReport, HomeReport, RtInfo, RunReport,
+    StatsReport,
+};
+pub use io::{GapCounts, IoReport};
+pub use latency::{Latency, Percentiles};
+pub use status::{AxisStatus, IoStatus, StatusReport};
+
+/// Rounds to `digits` decimals for printing (JSON keeps what a reader can use,
+/// not float noise).
+pub fn round(x: f64, digits: i32) -> f64 {
+    let k = 10f64.powi(digits);
+    (x * k).round() / k
+}
+
+/// Prints `v` as one line of JSON on stdout.
+pub fn print_json<T: serde::Serialize>(v: &T) {
+    match serde_json::to_string(v) {
+        Ok(s) => println!("{s}"),
+        // Our report types always serialize; say so rather than print nothing.
+        Err(e) => println!(
+            "{{\"errors\":[{{\"axis\":null,\"key\":null,\"err\":null,\"exerr\":null,\"message\":\"report could not be serialized: {}\"}}]}}",
+            e.to_string().replace('"', "'")
+        ),
+    }
+}

@@ -1,0 +1,71 @@
+//! `status --json`: the live state of every axis and I/O process, as the
+//! status service publishes it.
+
+use crate::GapCounts;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AxisStatus {
+    pub name: String,
+    pub io: String,
+    /// Homing phase by name (`idle`, `seek`, `return`, `move_home`, ...).
+    pub phase: String,
+    /// Axis HomingStatus / HomedStatus.
+    pub homing: bool,
+    pub homed: bool,
+    /// The Home instruction's bits.
+    pub en: bool,
+    pub dn: bool,
+    pub er: bool,
+    pub ip: bool,
+    pub pc: bool,
+    pub err: u16,
+    pub exerr: u16,
+    /// Axis position (under the current reference) and raw position, units.
+    pub position: Option<f64>,
+    pub raw: Option<f64>,
+    pub velocity: Option<f64>,
+    /// % rated.
+    pub torque: Option<f64>,
+    /// Home switch actuated (logical, whatever the wiring).
+    pub switch: bool,
+    /// An index pulse passed in the last cycle / the marker latch holds a position.
+    pub marker: bool,
+    pub event_raw: Option<f64>,
+    /// Homing time so far (or of the last homing) and its timeout (0 = none), s.
+    pub elapsed_s: f64,
+    pub timeout_s: f64,
+    /// Distance travelled in the current search leg and the limit, units.
+    pub search_travel: f64,
+    pub search_limit: Option<f64>,
+    pub enabled: bool,
+    pub fault: bool,
+    /// The drive's error code (CiA 402 0x603F) while it reports a fault.
+    pub drive_error_code: u16,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct IoStatus {
+    pub name: String,
+    pub attached: bool,
+    pub frames_received: u64,
+    pub frames_missing: u64,
+    pub frames_refused: u64,
+    pub attachments: u64,
+    pub gaps: GapCounts,
+    /// Current gap (cycles without a fresh answer).
+    pub gap_cycles: u64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StatusReport {
+    /// Cycle counter and cycle period of the supervisor.
+    pub cycle: u64,
+    pub cycle_us: u32,
+    /// Milliseconds since the supervisor started.
+    pub uptime_ms: u64,
+    pub axes: Vec<AxisStatus>,
+    pub io: Vec<IoStatus>,
+}

@@ -1,0 +1,296 @@
+//! The cycle's logic through frames and plants, no threads or IPC: what the
+//! real-time thread does, cycle by cycle, with I/O processes simulated in
+//! place (and made to fall silent or restart at will).
+
+use super::*;
+use motion_control::REASON_IO_NOT_ATTACHED;
+use motion_frames::feedback_to_axis;
+use motion_homing::codes::*;
+use motion_plant::Plant;
+
+const MS: u64 = 1_000_000;
+
+/// A Core, plants per axis and one frame pair per I/O process.
+struct Bench {
+    m: MachineConfig,
+    core: Core,
+    plants: Vec<Plant>,
+    cmd: Vec<CommandFrame>,
+    fb: Vec<FeedbackFrame>,
+    seq: Vec<u64>,
+    origin: Vec<u64>,
+    /// I/O processes that answer.
+    alive: Vec<bool>,
+    k: u64,
+    acks: Vec<Ack>,
+}
+
+impl Bench {
+    fn new(toml: &str) -> Self {
+        let m = motion_config::parse(toml).unwrap_or_else(|p| panic!("{p:#?}"));
+        let ios = m.ios.len();
+        Self {
+            core: Core::new(&m),
+            plants: m.axes.iter().map(|a| Plant::new(a.sim)).collect(),
+            cmd: vec![CommandFrame::ZERO; ios],
+            fb: vec![FeedbackFrame::ZERO; ios],
+            seq: vec![0; ios],
+            origin: (1..=ios as u64).collect(),
+            alive: vec![true; ios],
+            k: 0,
+            acks: Vec::new(),
+            m,
+        }
+    }
+
+    fn control(&mut self, c: Control) {
+        if let Some(a) = self.core.control(c, self.k * MS) {
+            self.acks.push(a);
+        }
+    }
+
+    /// One cycle: the core steps on last cycle's answers, publishes, and
+    /// every live I/O process answers (its plants advance one cycle).
+    fn cycle(&mut self) {
+        let now = self.k * MS;
+        let frames: Vec<Option<&FeedbackFrame>> = (0..self.fb.len())
+            .map(|k| (self.alive[k] && self.seq[k] > 0).then_some(&self.fb[k]))
+            .collect();
+        self.core.step(now, &frames);
+        let dt = self.m.supervisor.cycle_us as f64 * 1e-6;
+        for k in 0..self.cmd.len() {
+            self.core.fill(k, &mut self.cmd[k]);
+            self.seq[k] += 1;
+            self.core.sent(k, self.seq[k], now);
+            if !self.alive[k] {
+                continue;
+            }
+            let axes = self.m.axes_of(k);
+            let f = &mut self.fb[k];
+            f.header.axis_count = axes.len() as u32;
+            f.header.origin = self.origin[k];
+            f.header.timestamp_ns = now + 20_000;
+            f.answers_sequence = self.seq[k];
+            for (j, &i) in axes.iter().enumerate() {
+                let a = &self.m.axes[i];
+                let c =
+                    motion_frames::axis_to_command(&self.cmd[k].axes[j], a.engine.counts_per_unit);
+                let fb = self.plants[i].step(&c, dt);
+                f.axes[j] = feedback_to_axis(&fb, a.engine.counts_per_unit);
+            }
+        }
+        self.k += 1;
+    }
+
+    fn run(&mut self, cycles: u64) {
+        for _ in 0..cycles {
+            self.cycle();
+        }
+    }
+
+    fn snap(&self) -> Snapshot {
+        let mut s = Snapshot::default();
+        self.core.snapshot(self.k * MS, &mut s);
+        s
+    }
+
+    fn home(&mut self, mask: u64, parallel: bool) -> Ack {
+        self.control(Control::Home {
+            id: 7,
+            mask,
+            parallel,
+            timeout_ns: 0,
+        });
+        self.acks.pop().unwrap()
+    }
+}
+
+/// The demo machine homes through frames, one axis after the other.
+#[test]
+fn demo_homes_through_frames_in_config_order() {
+    let mut b = Bench::new(motion_config::DEMO_TOML);
+    b.run(10);
+    let all = b.core.all_mask();
+    assert_eq!(all, 0b1111);
+    let ack = b.home(all, false);
+    assert!(ack.axes[..4].iter().all(|a| a.accepted), "{ack:?}");
+    let mut first_start = [None; 4];
+    for _ in 0..20_000 {
+        b.cycle();
+        let s = b.snap();
+        for (i, f) in first_start.iter_mut().enumerate() {
+            if f.is_none() && s.axes[i].status.ip {
+                *f = Some(b.k);
+            }
+        }
+        if (0..4).all(|i| s.axes[i].settled()) && !s.axes[3].in_sequence {
+            break;
+        }
+    }
+    let s = b.snap();
+    for (i, a) in b.m.axes.iter().enumerate() {
+        assert!(s.axes[i].status.pc, "{}: {:?}", a.name, s.axes[i].status);
+        assert_eq!(s.axes[i].homes_started, 1);
+    }
+    // One at a time: each starts after the one before has finished.
+    let starts: Vec<u64> = first_start.iter().map(|x| x.unwrap()).collect();
+    assert!(starts.windows(2).all(|w| w[0] < w[1]), "{starts:?}");
+    for (i, start) in starts.iter().enumerate().skip(1) {
+        let prev_done = s.axes[i - 1].status.finished_ns.unwrap() / MS;
+        assert!(
+            *start > prev_done,
+            "axis {i} started before the one before ended"
+        );
+    }
+    // Exit: stop, then disable every drive.
+    b.control(Control::Exit);
+    b.run(10);
+    assert!(b.core.exit_done());
+}
+
+const TWO_IO: &str = r#"
+[supervisor]
+cycle_us = 1000
+cpu = 0
+
+[[io]]
+name = "bus0"
+[[io]]
+name = "bus1"
+
+[[axis]]
+name = "A"
+io = "bus0"
+home_sequence = "switch"
+home_speed = 20.0
+home_return_speed = 2.0
+home_acceleration = 500.0
+home_deceleration = 500.0
+[axis.sim]
+start = -10.0
+switch = [0.0, 5.0]
+
+[[axis]]
+name = "B"
+io = "bus1"
+home_sequence = "switch"
+home_speed = 20.0
+home_return_speed = 2.0
+home_acceleration = 500.0
+home_deceleration = 500.0
+[axis.sim]
+start = -10.0
+switch = [0.0, 5.0]
+"#;
+
+/// Issue 7: losing one I/O process aborts homing only on its axes (12/40);
+/// the other axes carry on. Its return clears HomedStatus and is counted.
+#[test]
+fn losing_one_io_process_aborts_only_its_axes() {
+    let mut b = Bench::new(TWO_IO);
+    b.run(5);
+    assert!(b.core.all_attached());
+    let ack = b.home(0b11, true);
+    assert!(ack.axes[0].accepted && ack.axes[1].accepted);
+    b.run(300); // both seeking
+    b.alive[1] = false;
+    b.run(3000);
+    let s = b.snap();
+    assert!(
+        s.axes[0].status.pc && s.axes[0].status.homed,
+        "{:?}",
+        s.axes[0].status
+    );
+    let sb = s.axes[1].status;
+    assert!(sb.er && !sb.homed, "{sb:?}");
+    assert_eq!((sb.err, sb.exerr), (ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST));
+    assert!(!s.ios[1].attached && s.ios[0].attached);
+    // A home request on B is refused while bus1 is gone.
+    let ack = b.home(0b10, false);
+    assert_eq!(ack.axes[1].reason, REASON_IO_NOT_ATTACHED);
+    // bus1 comes back as a new process: attached again, counted.
+    b.origin[1] = 99;
+    b.alive[1] = true;
+    b.run(5);
+    let s = b.snap();
+    assert!(s.ios[1].attached);
+    assert_eq!(s.ios[1].attachments, 2);
+    assert!(s.axes[0].status.homed, "bus0's axis keeps its reference");
+    assert!(s.ios[1].gaps.over_ten == 1);
+}
+
+/// A restarted I/O process (new origin, no gap long enough to detach)
+/// clears HomedStatus of its axes.
+#[test]
+fn a_restarted_io_process_unhomes_its_axes() {
+    let mut b = Bench::new(TWO_IO);
+    b.run(5);
+    b.home(0b11, true);
+    b.run(4000);
+    let s = b.snap();
+    assert!(s.axes[0].status.homed && s.axes[1].status.homed);
+    b.origin[0] = 1234;
+    b.run(2);
+    let s = b.snap();
+    assert!(!s.axes[0].status.homed, "reconnection clears HomedStatus");
+    assert!(s.axes[1].status.homed);
+    assert_eq!(s.ios[0].restarts, 1);
+    assert!(s.axes[0].lost_homed_ns.is_some());
+}
+
+#[test]
+fn stop_and_unhome() {
+    let mut b = Bench::new(TWO_IO);
+    b.run(5);
+    b.home(0b01, false);
+    b.run(100);
+    b.control(Control::Stop { id: 1, mask: 0b01 });
+    b.run(200);
+    let s = b.snap().axes[0].status;
+    assert!(s.er && (s.err, s.exerr) == (ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST));
+    b.home(0b10, false);
+    b.run(4000);
+    assert!(b.snap().axes[1].status.homed);
+    b.control(Control::Unhome { id: 2, mask: 0b10 });
+    assert!(b.acks.pop().unwrap().axes[1].accepted);
+    b.run(1);
+    assert!(!b.snap().axes[1].status.homed);
+}
+
+#[test]
+fn a_second_home_request_on_a_homing_axis_is_refused() {
+    let mut b = Bench::new(TWO_IO);
+    b.run(5);
+    b.home(0b01, false);
+    b.run(3);
+    let ack = b.home(0b11, false);
+    assert_eq!(ack.axes[0].reason, REASON_ALREADY_HOMING);
+    assert!(
+        !ack.axes[1].accepted,
+        "nothing starts when one named axis is refused"
+    );
+}
+
+#[test]
+fn trace_records_one_homing() {
+    let mut b = Bench::new(TWO_IO);
+    b.run(5);
+    b.control(Control::Trace { id: 3, axis: 1 });
+    b.home(0b10, false);
+    let mut recs = Vec::new();
+    for _ in 0..5000 {
+        b.cycle();
+        if let Some(r) = b.core.trace_record() {
+            recs.push(r);
+            if r.end {
+                break;
+            }
+        }
+    }
+    assert!(recs.len() > 100);
+    assert_eq!(recs[0].t_ns, 0);
+    assert_eq!(recs.iter().filter(|r| r.event).count(), 1);
+    assert!(recs.last().unwrap().end);
+    b.run(10);
+    assert!(b.core.trace_record().is_none(), "disarmed after one homing");
+}

@@ -1,0 +1,103 @@
+//! A snapshot of the cycle as a status frame (what the status service
+//! publishes, and what `status --json` reports).
+
+use crate::shared::Snapshot;
+use motion_config::MachineConfig;
+use motion_control::*;
+use motion_homing::{effective_search_limit, HomeMode};
+
+/// Fills `f` (zeroed) from `snap`; `uptime_ns` since the supervisor started.
+pub fn fill(m: &MachineConfig, snap: &Snapshot, uptime_ns: u64, f: &mut StatusFrame) {
+    f.cycle = snap.cycle;
+    f.uptime_ns = uptime_ns;
+    f.cycle_us = m.supervisor.cycle_us;
+    let n = snap.axis_count.min(m.axes.len()).min(MAX_AXES);
+    f.axis_count = n as u32;
+    for (i, (a, e)) in snap.axes[..n].iter().zip(f.axes.iter_mut()).enumerate() {
+        let cfg = &m.axes[i];
+        let s = &a.status;
+        put_str(&mut e.name, &cfg.name);
+        put_str(&mut e.phase, s.phase.name());
+        e.io = cfg.io as u8;
+        let mut bits = 0u16;
+        for (on, bit) in [
+            (s.en, ST_EN),
+            (s.dn, ST_DN),
+            (s.er, ST_ER),
+            (s.ip, ST_IP),
+            (s.pc, ST_PC),
+            (s.homing, ST_HOMING),
+            (s.homed, ST_HOMED),
+            (a.enabled, ST_ENABLED),
+            (a.fault, ST_FAULT),
+            (a.switch, ST_SWITCH),
+            (a.marker, ST_MARKER),
+            (a.raw.is_some(), ST_FEEDBACK),
+            (s.event_raw.is_some(), ST_EVENT),
+            (s.stopping, ST_STOPPING),
+            (a.traced, ST_TRACE),
+        ] {
+            if on {
+                bits |= bit;
+            }
+        }
+        e.bits = bits;
+        e.err = s.err;
+        e.exerr = s.exerr;
+        e.drive_error_code = a.drive_error_code;
+        e.home_mode = match cfg.engine.home_mode {
+            HomeMode::Passive => 0,
+            HomeMode::Active => 1,
+        };
+        e.home_sequence = cfg.engine.home_sequence as u8;
+        e.home_direction = cfg.engine.home_direction as u8;
+        e.aborted_by = a.aborted_by.unwrap_or(NO_AXIS);
+        e.extra = (if a.timed_out { SX_TIMED_OUT } else { 0 })
+            | (if a.lost_homed_ns.is_some() {
+                SX_LOST_HOMED
+            } else {
+                0
+            })
+            | (if a.in_sequence { SX_IN_SEQUENCE } else { 0 })
+            | a.lost_cause;
+        e.position = a.axis.unwrap_or(0.0);
+        e.raw = a.raw.unwrap_or(0.0);
+        e.velocity = a.velocity;
+        e.torque = a.torque;
+        e.event_raw = s.event_raw.unwrap_or(0.0);
+        e.elapsed_s = if a.homes_started > 0 {
+            s.finished_ns
+                .unwrap_or(snap.now_ns)
+                .saturating_sub(s.started_ns) as f64
+                * 1e-9
+        } else {
+            0.0
+        };
+        e.timeout_s = cfg.engine.home_timeout;
+        e.search_travel = 0.0;
+        e.lost_after_s = match (a.lost_homed_ns, s.finished_ns) {
+            (Some(l), Some(f)) => l.saturating_sub(f) as f64 * 1e-9,
+            _ => 0.0,
+        };
+        let limit = effective_search_limit(&cfg.engine);
+        e.search_limit = if limit.is_finite() { limit } else { 0.0 };
+    }
+    let k = snap.io_count.min(m.ios.len()).min(MAX_IOS);
+    f.io_count = k as u32;
+    for (j, (io, e)) in snap.ios[..k].iter().zip(f.ios.iter_mut()).enumerate() {
+        put_str(&mut e.name, &m.ios[j].name);
+        e.attached = u8::from(io.attached);
+        e.frames_received = io.frames_received;
+        e.frames_missing = io.frames_missing;
+        e.frames_refused = io.frames_refused;
+        e.attachments = io.attachments;
+        e.gaps = [
+            io.gaps.one,
+            io.gaps.two_to_three,
+            io.gaps.four_to_ten,
+            io.gaps.over_ten,
+        ];
+        e.longest_gap_cycles = io.gaps.longest_cycles;
+        e.gap_cycles = io.gap_cycles;
+    }
+}
