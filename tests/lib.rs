@@ -151,7 +151,7 @@ pub fn spawn_supervisor(args: &[&str]) -> Child {
 /// so a test can wait for a message and still get everything at the end.
 pub struct Watched {
     pub child: Child,
-    lines: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+    pub lines: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
     reader: Option<std::thread::JoinHandle<()>>,
 }
 
@@ -285,4 +285,104 @@ pub fn close(v: &serde_json::Value, key: &str, want: f64, tol: f64) {
         "{} {key} = {got}, want {want} ± {tol}\n{v}",
         v["name"]
     );
+}
+
+/// Runs `motionctl <args>` to completion.
+pub fn motionctl(args: &[&str]) -> Run {
+    Command::new(bin("motionctl"))
+        .args(args)
+        .output()
+        .expect("run motionctl")
+        .into()
+}
+
+/// `motionctl --service-prefix P <args>`.
+pub fn ctl(prefix: &str, args: &[&str]) -> Run {
+    let mut all = vec!["--service-prefix", prefix];
+    all.extend_from_slice(args);
+    motionctl(&all)
+}
+
+/// A running `motion-supervisor run` (the daemon), stopped with SIGTERM on
+/// drop (and checked to leave nothing behind).
+pub struct Daemon {
+    pub watched: Option<Watched>,
+    pub prefix: String,
+}
+
+impl Daemon {
+    /// Starts `run --config cfg` and waits until `motionctl status` answers
+    /// and every I/O process in `attached` shows attached.
+    pub fn start(cfg: &TempConfig, attached: &[&str]) -> Self {
+        let w = Watched::new(spawn_supervisor(&[
+            "run",
+            "--config",
+            cfg.path.to_str().unwrap(),
+        ]));
+        let d = Daemon {
+            watched: Some(w),
+            prefix: cfg.prefix.clone(),
+        };
+        let ok = wait_for(Duration::from_secs(20), || {
+            let r = ctl(&d.prefix, &["status", "--json"]);
+            r.code == Some(0)
+                && attached.iter().all(|io| {
+                    let v = r.json();
+                    v["io"].as_array().is_some_and(|a| {
+                        a.iter().any(|x| x["name"] == *io && x["attached"] == true)
+                    })
+                })
+        });
+        assert!(ok, "daemon not ready: {}", d.stderr());
+        d
+    }
+
+    pub fn stderr(&self) -> String {
+        self.watched
+            .as_ref()
+            .map(|w| w.lines.lock().unwrap().join("\n"))
+            .unwrap_or_default()
+    }
+
+    pub fn wait_line(&self, needle: &str, timeout: Duration) -> bool {
+        self.watched
+            .as_ref()
+            .is_some_and(|w| w.wait_line(needle, timeout))
+    }
+
+    /// SIGTERM and the daemon's exit (external I/O processes may still hold
+    /// the domain: check it with `assert_clean` once they are gone too).
+    pub fn stop(mut self) -> Run {
+        let w = self.watched.take().expect("running");
+        signal(w.child.id() as i32, nix::sys::signal::Signal::SIGTERM);
+        w.finish()
+    }
+
+    /// The status JSON.
+    pub fn status(&self) -> serde_json::Value {
+        let r = ctl(&self.prefix, &["status", "--json"]);
+        assert_eq!(r.code, Some(0), "{}", r.stderr);
+        r.json()
+    }
+}
+
+impl Drop for Daemon {
+    fn drop(&mut self) {
+        if let Some(w) = self.watched.take() {
+            signal(w.child.id() as i32, nix::sys::signal::Signal::SIGTERM);
+            let _ = w.finish();
+        }
+    }
+}
+
+/// `motion-io <args>` as a child of the test, stderr collected.
+pub fn spawn_io(args: &[&str]) -> Watched {
+    Watched::new(
+        Command::new(bin("motion-io"))
+            .args(args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn motion-io"),
+    )
 }

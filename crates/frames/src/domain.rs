@@ -319,6 +319,15 @@ impl Domain {
         }
     }
 
+    /// Peer side, when the supervisor is gone: removes its session file if
+    /// it still names this session and its process has ended (a supervisor
+    /// killed with SIGKILL could not remove it itself).
+    pub fn withdraw_if_dead(&self) {
+        if !process_alive(self.pid) {
+            self.withdraw();
+        }
+    }
+
     /// Peer side: the domain of the supervisor running under `prefix`, read
     /// from its session file. A missing file or a supervisor that is gone is
     /// [`IpcError::NoSupervisor`]; a file that is not safe to trust (another

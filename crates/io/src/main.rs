@@ -123,8 +123,10 @@ fn real_main() -> i32 {
             Err(code) => return code,
         };
         let outcome = serve(&domain, &io_name, backend.as_mut(), &settings, &label);
-        // node and ports are gone: tidy the domain (dead peers)
+        // node and ports are gone: tidy the domain (dead peers), and the
+        // session file of a supervisor that was killed
         let report = cleanup_domain(&domain);
+        domain.withdraw_if_dead();
         if let Some(e) = &report.error {
             say.always(format_args!("cleanup: {e}"));
         }

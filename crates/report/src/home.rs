@@ -152,3 +152,23 @@ pub struct CheckReport {
     /// Empty when the config is valid.
     pub errors: Vec<ErrorEntry>,
 }
+
+/// `motionctl stop|unhome --json`, `motionctl home --no-wait --json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AcceptedReport {
+    pub accepted: Vec<String>,
+}
+
+/// `motionctl trace --json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TraceReport {
+    pub axis: String,
+    /// Cycles recorded.
+    pub cycles: usize,
+    /// Seconds the homing took.
+    pub duration_s: f64,
+    /// Raw position of the home event, if one was found.
+    pub event_raw: Option<f64>,
+    pub csv: String,
+    pub plot: Option<String>,
+}

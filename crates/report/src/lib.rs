@@ -21,8 +21,8 @@ pub mod table;
 
 pub use errors::{ErrorEntry, ErrorReport};
 pub use home::{
-    Allocations, AxisResult, CheckReport, CpuUse, CtlHomeReport, HomeReport, RtInfo, RunReport,
-    StatsReport,
+    AcceptedReport, Allocations, AxisResult, CheckReport, CpuUse, CtlHomeReport, HomeReport,
+    RtInfo, RunReport, StatsReport, TraceReport,
 };
 pub use io::{GapCounts, IoReport};
 pub use latency::{Latency, Percentiles};

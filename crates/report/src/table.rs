@@ -59,3 +59,95 @@ pub fn axis_results(rows: &[AxisResult]) -> String {
     }
     s
 }
+
+/// `status` as text: one line per axis, one per I/O process.
+pub fn status(r: &crate::StatusReport) -> String {
+    let w = r
+        .axes
+        .iter()
+        .map(|a| a.name.chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4)
+        + 2;
+    let b = |x: bool, c: &'static str| if x { c } else { "." };
+    let mut s = format!(
+        "{:<w$}{:<8}{:<13}{:<12}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17}{:>20}\n",
+        "axis",
+        "io",
+        "phase",
+        "EN DN ER IP PC",
+        "homed",
+        "ERR/EXERR",
+        "position",
+        "raw",
+        "velocity",
+        "torque",
+        "in",
+        "elapsed/timeout s",
+        "travel/limit"
+    );
+    for a in &r.axes {
+        let f = |x: Option<f64>, p: usize, width: usize| {
+            x.map_or(format!("{:>width$}", "-"), |v| format!("{v:>width$.p$}"))
+        };
+        s += &format!(
+            "{:<w$}{:<8}{:<13}{} {} {} {} {} {:>7}{:>10}{}{}{}{} {}{}{:>17}{:>20}\n",
+            a.name,
+            a.io,
+            a.phase,
+            b(a.en, "EN"),
+            b(a.dn, "DN"),
+            b(a.er, "ER"),
+            b(a.ip, "IP"),
+            b(a.pc, "PC"),
+            if a.homed { "yes" } else { "no" },
+            format!("{}/{}", a.err, a.exerr),
+            f(a.position, 4, 12),
+            f(a.raw, 4, 12),
+            f(a.velocity, 3, 10),
+            f(a.torque, 1, 8),
+            if a.switch { "S" } else { "." },
+            if a.marker { "M " } else { ". " },
+            format!(
+                "{:.2}/{}",
+                a.elapsed_s,
+                if a.timeout_s > 0.0 {
+                    format!("{}", a.timeout_s)
+                } else {
+                    "-".into()
+                }
+            ),
+            format!(
+                "{:.3}/{}",
+                a.search_travel,
+                a.search_limit.map_or("-".to_string(), |l| format!("{l}"))
+            ),
+        );
+        if let Some(e) = &a.error {
+            s += &format!("  └ {e}\n");
+        }
+    }
+    for io in &r.io {
+        s += &format!(
+            "I/O {}: {}; frames {} received, {} missing, {} refused; attached {} time(s); gaps 1: {}, 2-3: {}, 4-10: {}, >10: {}, longest {} cycles{}\n",
+            io.name,
+            if io.attached { "attached" } else { "NOT attached" },
+            io.frames_received,
+            io.frames_missing,
+            io.frames_refused,
+            io.attachments,
+            io.gaps.one,
+            io.gaps.two_to_three,
+            io.gaps.four_to_ten,
+            io.gaps.over_ten,
+            io.gaps.longest_cycles,
+            if io.gap_cycles > 0 {
+                format!(", now {} cycles without an answer", io.gap_cycles)
+            } else {
+                String::new()
+            }
+        );
+    }
+    s
+}

@@ -1,0 +1,128 @@
+//! The subcommands; each returns the exit code (see `motionctl --help`).
+
+mod home;
+mod simple;
+mod stats;
+mod status;
+mod trace;
+
+use crate::cli::{Cli, Command, Target};
+use motion_control::{Client, ClientError};
+use motion_report::{print_json, ErrorEntry, ErrorReport};
+use std::path::PathBuf;
+
+pub const EXIT_OK: i32 = 0;
+pub const EXIT_FAILED: i32 = 1;
+pub const EXIT_USAGE: i32 = 2;
+pub const EXIT_NO_SUPERVISOR: i32 = 3;
+
+pub fn run(cli: Cli) -> i32 {
+    let json = cli.command.json();
+    let (prefix, runtime_dir) = match target(&cli.target) {
+        Ok(t) => t,
+        Err(errors) => return fail(json, errors, EXIT_USAGE),
+    };
+    if let Err(e) = motion_rt::termination::install() {
+        return fail(json, vec![ErrorEntry::message(e)], EXIT_FAILED);
+    }
+    let mut client = match Client::connect(&prefix, runtime_dir.as_deref()) {
+        Ok(c) => c,
+        Err(e) => return client_error(json, &e),
+    };
+    match cli.command {
+        Command::Status(a) => status::status(&mut client, &a),
+        Command::Home(a) => home::home(&mut client, &a),
+        Command::Stop(a) => simple::axes(&mut client, motion_control::REQ_STOP, &a),
+        Command::Unhome(a) => simple::axes(&mut client, motion_control::REQ_UNHOME, &a),
+        Command::Stats(a) => stats::stats(&mut client, &a),
+        Command::Trace(a) => trace::trace(&mut client, &a),
+    }
+}
+
+/// The service prefix and runtime directory of the supervisor to talk to.
+fn target(t: &Target) -> Result<(String, Option<PathBuf>), Vec<ErrorEntry>> {
+    let mut prefix = "motion".to_string();
+    let mut runtime_dir = None;
+    if let Some(path) = &t.config {
+        let (m, _) = motion_config::load(Some(path)).map_err(|problems| {
+            problems
+                .iter()
+                .map(|p| ErrorEntry {
+                    axis: p.axis.clone(),
+                    key: Some(p.key.clone()),
+                    err: p.code.map(|c| c.0),
+                    exerr: p.code.map(|c| c.1),
+                    message: p.message.clone(),
+                })
+                .collect::<Vec<_>>()
+        })?;
+        prefix = m.supervisor.service_prefix.clone();
+        runtime_dir = m.supervisor.runtime_dir.clone();
+    }
+    if let Some(p) = &t.service_prefix {
+        prefix = p.clone();
+    }
+    if let Some(d) = &t.runtime_dir {
+        runtime_dir = Some(d.clone());
+    }
+    Ok((prefix, runtime_dir))
+}
+
+/// Reports `errors` (one JSON object with `json`, else on stderr), returns `code`.
+pub fn fail(json: bool, errors: Vec<ErrorEntry>, code: i32) -> i32 {
+    if json {
+        print_json(&ErrorReport { errors });
+    } else {
+        for e in &errors {
+            let code = match (e.err, e.exerr) {
+                (Some(a), Some(b)) => format!(" (ERR {a} EXERR {b})"),
+                _ => String::new(),
+            };
+            match (&e.axis, &e.key) {
+                (Some(a), Some(k)) => log::error!("axis {a}: {k}: {}{code}", e.message),
+                (Some(a), None) => log::error!("axis {a}: {}{code}", e.message),
+                (None, Some(k)) => log::error!("{k}: {}{code}", e.message),
+                _ => log::error!("{}{code}", e.message),
+            }
+        }
+    }
+    code
+}
+
+/// A client error, with the exit code it means.
+pub fn client_error(json: bool, e: &ClientError) -> i32 {
+    let code = match e {
+        ClientError::NoSupervisor(_) | ClientError::Timeout { .. } | ClientError::WrongSession => {
+            EXIT_NO_SUPERVISOR
+        }
+        _ => EXIT_FAILED,
+    };
+    fail(json, vec![ErrorEntry::message(e.to_string())], code)
+}
+
+/// A command line clap refused (exit 2; with `--json`, a JSON error object).
+pub fn argument_error(e: clap::Error) -> i32 {
+    use clap::error::ErrorKind;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        let _ = e.print();
+        return EXIT_OK;
+    }
+    if std::env::args().any(|a| a == "--json") {
+        let text = e.render().to_string();
+        let first = text
+            .lines()
+            .next()
+            .unwrap_or("bad argument")
+            .trim_start_matches("error: ")
+            .to_string();
+        print_json(&ErrorReport::message(first));
+    } else {
+        let _ = e.print();
+    }
+    EXIT_USAGE
+}
+
+/// The signal that interrupted us, as an exit code.
+pub fn signal_code() -> Option<i32> {
+    motion_rt::termination::received().map(|s| 128 + s)
+}

@@ -1,0 +1,37 @@
+use super::{client_error, fail, EXIT_FAILED, EXIT_OK};
+use crate::cli::AxesArgs;
+use motion_control::*;
+use motion_report::{print_json, ErrorEntry};
+use std::time::Duration;
+
+/// `stop` / `unhome`: one request, every axis's answer.
+pub fn axes(client: &mut Client, kind: u32, a: &AxesArgs) -> i32 {
+    let resp = match client.simple(kind, 0, &a.axes, Duration::from_secs(3)) {
+        Ok(r) => r,
+        Err(e) => return client_error(a.json, &e),
+    };
+    let what = if kind == REQ_STOP { "stop" } else { "unhome" };
+    if resp.result != RESULT_ACCEPTED {
+        let mut errors = vec![ErrorEntry::message(format!(
+            "{what} refused: {}",
+            resp.message_text()
+        ))];
+        for x in resp.answers().iter().filter(|x| x.accepted == 0) {
+            errors.push(ErrorEntry {
+                axis: Some(get_str(&x.name)),
+                key: None,
+                err: (x.err != 0).then_some(x.err),
+                exerr: (x.err != 0).then_some(x.exerr),
+                message: reason_text(x.reason).into(),
+            });
+        }
+        return fail(a.json, errors, EXIT_FAILED);
+    }
+    let names: Vec<String> = resp.answers().iter().map(|x| get_str(&x.name)).collect();
+    if a.json {
+        print_json(&motion_report::AcceptedReport { accepted: names });
+    } else {
+        println!("{what}: {}", names.join(" "));
+    }
+    EXIT_OK
+}

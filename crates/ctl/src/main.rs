@@ -1,0 +1,18 @@
+//! `motionctl`: the operator's tool for a running `motion-supervisor` (see
+//! `motionctl --help`). It joins the supervisor through its session file
+//! and talks to it over the control and status services.
+
+mod cli;
+mod commands;
+mod plot;
+
+use clap::Parser;
+
+fn main() {
+    motion_rt::logging::init("motionctl");
+    let code = match cli::Cli::try_parse() {
+        Ok(c) => commands::run(c),
+        Err(e) => commands::argument_error(e),
+    };
+    std::process::exit(code);
+}
