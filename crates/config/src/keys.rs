@@ -183,7 +183,14 @@ impl<'a> Reader<'a> {
                 None => {
                     let names: Vec<String> =
                         options.iter().map(|(n, _)| format!("\"{n}\"")).collect();
-                    self.problem(key, format!("\"{s}\" is not one of {}", names.join(", ")));
+                    self.problem(
+                        key,
+                        format!(
+                            "{} is not one of {}",
+                            crate::names::shown(s),
+                            names.join(", ")
+                        ),
+                    );
                     default
                 }
             },

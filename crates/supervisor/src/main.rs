@@ -8,6 +8,9 @@ static ALLOCATOR: motion_rt::RtAllocator = motion_rt::RtAllocator;
 
 fn main() {
     motion_rt::logging::init("motion-supervisor");
+    // A panic is logged; unwinding then drops the session, which stops every
+    // axis, ends the I/O processes and cleans shared memory (Session::drop).
+    std::panic::set_hook(Box::new(|info| log::error!("internal error: {info}")));
     let code = match cli::Cli::try_parse() {
         Ok(c) => commands::run(c),
         Err(e) => commands::argument_error(e),

@@ -263,13 +263,17 @@ impl Session {
         }
     }
 
-    /// `Some(reason)` if the real-time thread died.
+    /// `Some(reason)` if the real-time thread or the control thread died.
     pub fn check_alive(&mut self) -> Option<String> {
         match self.shared.phase() {
-            Phase::Failed => Some(self.rt_error()),
-            Phase::Exited => Some("the real-time thread ended".into()),
-            _ => None,
+            Phase::Failed => return Some(self.rt_error()),
+            Phase::Exited => return Some("the real-time thread ended".into()),
+            _ => {}
         }
+        if self.control.as_ref().is_some_and(|h| h.is_finished()) {
+            return Some("the control thread ended unexpectedly".into());
+        }
+        None
     }
 
     /// Spawned I/O processes that ended since the last call, in words; with
