@@ -175,6 +175,9 @@ pub enum Target {
     /// Quick stop: the drive decelerates on its quick-stop ramp (0x6085);
     /// from states without a running power stage this is "disable voltage".
     QuickStop,
+    /// "Disable voltage" from every state: power stage off at once, no ramp
+    /// (the emergency stop).
+    Off,
 }
 
 /// Fault-reset handshake progress.
@@ -275,6 +278,8 @@ impl Cia402 {
 
             (Target::QuickStop, _) => cw::CMD_QUICK_STOP,
 
+            (Target::Off, _) => cw::CMD_DISABLE_VOLTAGE,
+
             (_, State::Fault | State::FaultReactionActive) => cw::CMD_DISABLE_VOLTAGE,
         }
     }
@@ -349,7 +354,15 @@ mod tests {
     fn every_transition_command() {
         use State::*;
         use Target::*;
-        let table: [(State, Target, u16); 24] = [
+        let table: [(State, Target, u16); 32] = [
+            (NotReadyToSwitchOn, Off, 0x0000),
+            (SwitchOnDisabled, Off, 0x0000),
+            (ReadyToSwitchOn, Off, 0x0000),  // 7
+            (SwitchedOn, Off, 0x0000),       // 10
+            (OperationEnabled, Off, 0x0000), // 9
+            (QuickStopActive, Off, 0x0000),  // 12
+            (FaultReactionActive, Off, 0x0000),
+            (Fault, Off, 0x0000),
             (NotReadyToSwitchOn, Enabled, 0x0000),
             (NotReadyToSwitchOn, Disabled, 0x0000),
             (NotReadyToSwitchOn, QuickStop, 0x0000),
