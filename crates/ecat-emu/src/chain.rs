@@ -456,7 +456,11 @@ fn serve(fd: OwnedFd, chain: &Mutex<Chain>, stop: &AtomicBool) {
         };
         // SAFETY: one valid pollfd.
         let r = unsafe { libc::poll(&mut pfd, 1, 1) };
-        if r > 0 {
+        let broken = libc::POLLERR | libc::POLLHUP | libc::POLLNVAL;
+        if r > 0 && pfd.revents & libc::POLLIN == 0 && pfd.revents & broken != 0 {
+            // interface gone: do not spin
+            std::thread::sleep(Duration::from_millis(1));
+        } else if r > 0 {
             loop {
                 // SAFETY: zeroed sockaddr_ll is valid; lengths match.
                 let mut sa: libc::sockaddr_ll = unsafe { std::mem::zeroed() };

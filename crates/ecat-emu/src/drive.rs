@@ -735,6 +735,10 @@ impl Drive {
                         State::Fault
                     }
                 };
+                // at rest: this last step holds, then the power stage goes off
+                self.plant.step(&cmd, dt);
+                self.power_off(matches!(r.after, After::Fault(_)));
+                return;
             } else {
                 self.ramp = Some(r);
             }
@@ -770,6 +774,24 @@ impl Drive {
             self.state = State::Fault;
             self.od.put(0x603F, 0, u64::from(ERR_FOLLOWING));
         }
+    }
+
+    /// Power stage off now (a zero-length step without enable); `fault`:
+    /// the plant reports a fault too (cleared by the next enable edge).
+    fn power_off(&mut self, fault: bool) {
+        if fault {
+            self.plant.inject_fault();
+        }
+        let fb = self.plant.feedback();
+        let (marker_arm, switch_arm) = self.probe_arms();
+        let off = Command {
+            enable: false,
+            position: fb.position,
+            marker_arm,
+            switch_arm,
+            ..Command::default()
+        };
+        self.plant.step(&off, 0.0);
     }
 
     fn update_inputs(&mut self) {

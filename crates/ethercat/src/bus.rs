@@ -203,11 +203,15 @@ struct Engine {
     window_pending: Vec<bool>,
     /// Per SubDevice: not in OP since (ns), last recovery attempt (ns).
     not_op_since: Vec<Option<u64>>,
+    /// Per SubDevice: answered its AL status read last cycle.
+    answering: Vec<bool>,
     last_recovery: Vec<u64>,
     given_up: Vec<bool>,
     period_ns: u64,
     reply_ns: u64,
     cycle: u64,
+    /// Counting no-data causes (not while waiting for OP at start-up).
+    counting: bool,
 }
 
 impl Engine {
@@ -257,11 +261,13 @@ impl Engine {
             window_written,
             window_pending: vec![false; n],
             not_op_since: vec![None; count],
+            answering: vec![true; count],
             last_recovery: vec![0; count],
             given_up: vec![false; count],
             period_ns: cfg.cycle.as_nanos() as u64,
             reply_ns: cfg.reply_timeout().as_nanos() as u64,
             cycle: 0,
+            counting: false,
             shared,
         }
     }
@@ -330,10 +336,11 @@ impl Engine {
                     .sum();
                 let all_ok = ex.wkc == self.expected_wkc;
                 let explained = !all_ok && self.expected_wkc.checked_sub(ex.wkc) == Some(silent);
-                if !all_ok {
+                if !all_ok && self.counting {
                     sh.wkc_errors.fetch_add(1, Ordering::Relaxed);
                 }
                 for i in 0..count {
+                    self.answering[i] = state(i) != SubDeviceState::None;
                     let op = state(i) == SubDeviceState::Op;
                     cause_not_op[i] = !op;
                     valid[i] = op && (all_ok || explained);
@@ -349,7 +356,9 @@ impl Engine {
                 true
             }
             _ => {
-                sh.lost_frames.fetch_add(1, Ordering::Relaxed);
+                if self.counting {
+                    sh.lost_frames.fetch_add(1, Ordering::Relaxed);
+                }
                 false
             }
         };
@@ -364,6 +373,8 @@ impl Engine {
                     .subdevice(md, sdi)
                     .ok()
                     .map(|sd| self.plans[k].layout.unpack_inputs(&sd.inputs_raw()))
+            } else if !self.counting {
+                None
             } else {
                 let a = &sh.axis[k];
                 if !frame_ok {
@@ -400,6 +411,7 @@ impl Engine {
         for i in 0..self.contrib.len() {
             if let Some(since) = self.not_op_since[i] {
                 if !self.given_up[i]
+                    && self.answering[i]
                     && now.saturating_sub(since) >= RECOVERY_INTERVAL_NS / 4
                     && now.saturating_sub(self.last_recovery[i]) >= RECOVERY_INTERVAL_NS
                 {
@@ -559,6 +571,7 @@ pub(crate) fn thread_main(
     }
 
     shared.running.store(true, Ordering::Release);
+    engine.counting = true;
     let report = StartupReport {
         axes: engine.sd_of_axis.iter().copied().zip(syncs).collect(),
         subdevices: reports,

@@ -31,6 +31,25 @@ pub struct IoCounters {
     pub send_errors: u64,
     /// Received frames ethercrab had no waiting frame for (late answers).
     pub unmatched: u64,
+    /// Waits that found the socket in error (interface down or gone).
+    pub socket_errors: u64,
+}
+
+/// Sleeps to an absolute CLOCK_MONOTONIC time.
+fn sleep_until(ns: u64) {
+    let ts = libc::timespec {
+        tv_sec: (ns / 1_000_000_000) as libc::time_t,
+        tv_nsec: (ns % 1_000_000_000) as libc::c_long,
+    };
+    // SAFETY: valid timespec; EINTR just ends the sleep early.
+    unsafe {
+        libc::clock_nanosleep(
+            libc::CLOCK_MONOTONIC,
+            libc::TIMER_ABSTIME,
+            &ts,
+            std::ptr::null_mut(),
+        );
+    }
 }
 
 /// Socket plus ethercrab's frame queues.
@@ -142,8 +161,13 @@ impl<'sto> BusIo<'sto> {
                 revents: 0,
             };
             // SAFETY: one valid pollfd, valid timespec, no signal mask.
-            unsafe {
-                libc::ppoll(&mut pfd, 1, &ts, std::ptr::null());
+            let r = unsafe { libc::ppoll(&mut pfd, 1, &ts, std::ptr::null()) };
+            let broken = libc::POLLERR | libc::POLLHUP | libc::POLLNVAL;
+            if r > 0 && pfd.revents & libc::POLLIN == 0 && pfd.revents & broken != 0 {
+                // the interface is gone or down: never spin on it
+                self.counters.socket_errors += 1;
+                sleep_until(until_ns);
+                return 0;
             }
         }
         let mut n = 0;
