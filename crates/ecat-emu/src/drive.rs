@@ -64,6 +64,8 @@ pub struct DriveConfig {
     /// 0x60FD bit that shows "an index pulse passed last cycle"
     /// (manufacturer-specific range 16..=31); `None`: not reported.
     pub index_pulse_bit: Option<u8>,
+    /// 0x100A; a long one needs a segmented upload.
+    pub software_version: String,
 }
 
 impl DriveConfig {
@@ -87,6 +89,7 @@ impl DriveConfig {
             quick_stop_deceleration: 1000.0,
             cycle_ns: 1_000_000,
             index_pulse_bit: Some(16),
+            software_version: "ecat-emu".to_string(),
         }
     }
 }
@@ -194,7 +197,11 @@ impl Drive {
         od.var(0x1001, "error register", 8, Ro, No, 0);
         od.string(0x1008, "manufacturer device name", &cfg.name);
         od.string(0x1009, "manufacturer hardware version", "1.0");
-        od.string(0x100A, "manufacturer software version", "ecat-emu");
+        od.string(
+            0x100A,
+            "manufacturer software version",
+            &cfg.software_version,
+        );
         od.record(
             0x1018,
             "identity",

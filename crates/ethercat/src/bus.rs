@@ -59,6 +59,8 @@ const OP_TIMEOUT_NS: u64 = 10_000_000_000;
 const RECOVERY_INTERVAL_NS: u64 = 20_000_000;
 const JOB_TIMEOUT_NS: u64 = 500_000_000;
 const EXIT_TIMEOUT_NS: u64 = 3_000_000_000;
+/// Cycles after which the bus thread's allocations are counted.
+pub const WARM_UP_CYCLES: u64 = 200;
 
 const _: () = {
     assert!(size_of::<AxisCommand>() == AXIS_WORDS * 8);
@@ -226,7 +228,8 @@ impl Engine {
         let cycle_s = cfg.cycle.as_secs_f64();
         let axes = plans
             .iter()
-            .map(|p| AxisLogic::new(p.layout, cycle_s, Some(16)))
+            .zip(&cfg.axes)
+            .map(|(p, a)| AxisLogic::new(p.layout, cycle_s, a.index_pulse_bit))
             .collect();
         let count = group.len();
         let mut contrib = vec![0u16; count];
@@ -618,7 +621,18 @@ fn run_cycles(engine: &mut Engine, io: &mut BusIo<'_>, group: &OpGroup, md: &Mai
     let mut slot_started = 0u64;
     let period = engine.period_ns;
     let mut deadline = now_ns() + period;
+    let mut cycles = 0u64;
+    let mut alloc_base = 0u64;
     while !shared.stop.load(Ordering::Relaxed) {
+        cycles += 1;
+        let allocs = motion_rt::counting::system_calls_on_this_thread();
+        if cycles == WARM_UP_CYCLES {
+            alloc_base = allocs;
+        } else if cycles > WARM_UP_CYCLES {
+            shared
+                .bus_allocations
+                .store(allocs.wrapping_sub(alloc_base), Ordering::Relaxed);
+        }
         // wait, with the background job progressing
         loop {
             if let Some(f) = slot.as_mut().as_pin_mut() {

@@ -34,6 +34,22 @@ pub struct AxisMapping {
     /// the backend passes them through unchanged; this value is only used
     /// for messages in position units.
     pub counts_per_unit: f64,
+    /// Manufacturer-specific bit of 0x60FD (16..=31) that reports "an
+    /// index pulse passed during the last cycle", for axes configured with
+    /// `marker_latch = false`; `None` (default): not reported.
+    pub index_pulse_bit: Option<u8>,
+}
+
+impl AxisMapping {
+    /// An axis on `subdevice` without an index-pulse input.
+    pub fn new(name: &str, subdevice: SubDeviceSelector, counts_per_unit: f64) -> AxisMapping {
+        AxisMapping {
+            name: name.to_string(),
+            subdevice,
+            counts_per_unit,
+            index_pulse_bit: None,
+        }
+    }
 }
 
 /// Distributed clocks.
@@ -149,6 +165,12 @@ impl EthercatConfig {
             }
             if !(a.counts_per_unit.is_finite() && a.counts_per_unit > 0.0) {
                 p.push(format!("axis {}: counts_per_unit must be > 0", a.name));
+            }
+            if a.index_pulse_bit.is_some_and(|b| !(16..=31).contains(&b)) {
+                p.push(format!(
+                    "axis {}: index_pulse_bit must be a manufacturer-specific bit 16..=31",
+                    a.name
+                ));
             }
         }
         let wd_units = self.sm_watchdog.as_micros() / 100;

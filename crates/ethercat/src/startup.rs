@@ -585,6 +585,7 @@ mod tests {
                     name: format!("A{i}"),
                     subdevice: s.clone(),
                     counts_per_unit: 1.0,
+                    index_pulse_bit: None,
                 })
                 .collect(),
         )

@@ -51,6 +51,10 @@ pub(crate) struct Shared {
     pub frames_received: AtomicU64,
     pub window_write_failures: AtomicU64,
     pub needs_restart: AtomicU64,
+    /// System-allocator calls of the bus thread in the cycle loop after
+    /// warm-up (only counted when motion_rt::RtAllocator is the global
+    /// allocator).
+    pub bus_allocations: AtomicU64,
     hist: Vec<AtomicU64>,
     hist_over: AtomicU64,
     rt_min: AtomicU64,
@@ -87,6 +91,7 @@ impl Shared {
             frames_received: AtomicU64::new(0),
             window_write_failures: AtomicU64::new(0),
             needs_restart: AtomicU64::new(0),
+            bus_allocations: AtomicU64::new(0),
             hist: (0..HIST_US).map(|_| AtomicU64::new(0)).collect(),
             hist_over: AtomicU64::new(0),
             rt_min: AtomicU64::new(u64::MAX),
@@ -142,6 +147,7 @@ impl Shared {
             recoveries: l(&self.recoveries),
             recovery_failures: l(&self.recovery_failures),
             needs_restart: l(&self.needs_restart),
+            bus_thread_allocations: l(&self.bus_allocations),
             command_read_failures: l(&self.command_read_failures),
             feedback_read_failures: self.feedback.read_failures(),
             frames_sent: l(&self.frames_sent),
@@ -222,6 +228,10 @@ pub struct BusStatus {
     /// SubDevices found in INIT / PRE-OP (lost their configuration, e.g.
     /// power-cycled): only a restart of the backend brings them back.
     pub needs_restart: u64,
+    /// System-allocator calls the bus thread made while cycling, after
+    /// [`crate::bus::WARM_UP_CYCLES`] (counted only in a binary whose global
+    /// allocator is `motion_rt::RtAllocator`; 0 otherwise).
+    pub bus_thread_allocations: u64,
     pub command_read_failures: u64,
     pub feedback_read_failures: u64,
     pub frames_sent: u64,
