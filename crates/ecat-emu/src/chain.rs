@@ -397,6 +397,14 @@ impl Emulator {
         self.chain().set_silent(silent);
     }
 
+    /// SubDevice `position` refuses process data (working counter short)
+    /// while staying in its AL state.
+    pub fn refuse_process_data(&self, position: usize, refuse: bool) {
+        if let Some(e) = self.chain().escs.get_mut(position) {
+            e.pd_refused = refuse;
+        }
+    }
+
     /// The drive at `position` faults with `code` (0x603F) at its next cycle.
     pub fn inject_fault(&self, position: usize, code: u16) {
         if let Some(e) = self.chain().escs.get_mut(position) {
@@ -498,5 +506,206 @@ fn serve(fd: OwnedFd, chain: &Mutex<Chain>, stop: &AtomicBool) {
         }
         let now = Instant::now();
         chain.lock().unwrap_or_else(|e| e.into_inner()).poll(now);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An Ethernet frame with the given datagrams (cmd, adp, ado, data).
+    fn frame(dgrams: &[(u8, u16, u16, Vec<u8>)]) -> Vec<u8> {
+        let mut pdus = Vec::new();
+        for (k, (cmd, adp, ado, data)) in dgrams.iter().enumerate() {
+            pdus.push(*cmd);
+            pdus.push(k as u8);
+            pdus.extend_from_slice(&adp.to_le_bytes());
+            pdus.extend_from_slice(&ado.to_le_bytes());
+            let more = if k + 1 < dgrams.len() { 0x8000 } else { 0 };
+            pdus.extend_from_slice(&(data.len() as u16 | more).to_le_bytes());
+            pdus.extend_from_slice(&[0, 0]);
+            pdus.extend_from_slice(data);
+            pdus.extend_from_slice(&[0, 0]);
+        }
+        let mut f = vec![0xFF; 6];
+        f.extend_from_slice(&[0x10; 6]);
+        f.extend_from_slice(&ETHERTYPE.to_be_bytes());
+        f.extend_from_slice(&(pdus.len() as u16 | 0x1000).to_le_bytes());
+        f.extend_from_slice(&pdus);
+        f
+    }
+
+    /// (data, wkc) of datagram `k` of a processed frame.
+    fn result(f: &[u8], k: usize) -> (Vec<u8>, u16) {
+        let mut o = 16;
+        for i in 0.. {
+            let len = usize::from(u16::from_le_bytes([f[o + 6], f[o + 7]]) & 0x7FF);
+            if i == k {
+                let d = f[o + 10..o + 10 + len].to_vec();
+                let w = u16::from_le_bytes([f[o + 10 + len], f[o + 11 + len]]);
+                return (d, w);
+            }
+            o += 12 + len;
+        }
+        unreachable!()
+    }
+
+    fn chain(n: usize) -> Chain {
+        Chain::new((0..n).map(|i| DriveConfig::new(&format!("D{i}"))).collect())
+    }
+
+    fn run(c: &mut Chain, dgrams: &[(u8, u16, u16, Vec<u8>)]) -> Option<Vec<u8>> {
+        let mut f = frame(dgrams);
+        c.process(&mut f, Instant::now()).then_some(f)
+    }
+
+    #[test]
+    fn broadcast_counts_and_reply_source_address() {
+        let mut c = chain(3);
+        let f = run(&mut c, &[(7, 0, 0x0000, vec![0])]).unwrap();
+        assert_eq!(result(&f, 0), (vec![0x11], 3));
+        assert_eq!(&f[6..12], &[0x12, 0x10, 0x10, 0x10, 0x10, 0x10]);
+        // unplugged behind the first: only it answers; silent: no reply
+        c.set_plugged(1, false);
+        assert_eq!(result(&run(&mut c, &[(7, 0, 0, vec![0])]).unwrap(), 0).1, 1);
+        c.set_plugged(1, true);
+        c.set_silent(true);
+        assert!(run(&mut c, &[(7, 0, 0, vec![0])]).is_none());
+    }
+
+    #[test]
+    fn auto_increment_then_configured_addressing() {
+        let mut c = chain(3);
+        // APWR to position 1 (ADP = -1), then FPRD of its AL status
+        let f = run(
+            &mut c,
+            &[
+                (
+                    2,
+                    0u16.wrapping_sub(1),
+                    0x0010,
+                    0x1001u16.to_le_bytes().to_vec(),
+                ),
+                (4, 0x1001, 0x0130, vec![0, 0]),
+                (4, 0x2222, 0x0130, vec![0, 0]),
+            ],
+        )
+        .unwrap();
+        assert_eq!(result(&f, 0).1, 1);
+        assert_eq!(c.escs[1].station_address(), 0x1001);
+        assert_eq!(c.escs[0].station_address(), 0);
+        // the FPRD ran in the same frame, after the APWR passed SubDevice 1
+        assert_eq!(result(&f, 1), (vec![0x01, 0x00], 1));
+        assert_eq!(result(&f, 2).1, 0, "nobody at 0x2222");
+    }
+
+    #[test]
+    fn al_state_rules_and_codes() {
+        let mut c = chain(1);
+        run(&mut c, &[(2, 0, 0x0010, 0x1000u16.to_le_bytes().to_vec())]);
+        // INIT → SAFE-OP is not a transition
+        run(
+            &mut c,
+            &[(5, 0x1000, 0x0120, 0x0004u16.to_le_bytes().to_vec())],
+        );
+        assert_eq!((c.escs[0].al_status(), c.escs[0].al_code()), (0x11, 0x0011));
+        // not acknowledged: a new request is ignored
+        run(
+            &mut c,
+            &[(5, 0x1000, 0x0120, 0x0002u16.to_le_bytes().to_vec())],
+        );
+        assert_eq!(c.escs[0].al_status(), 0x11);
+        // acknowledged; PRE-OP without mailbox sync managers is refused
+        run(
+            &mut c,
+            &[(5, 0x1000, 0x0120, 0x0012u16.to_le_bytes().to_vec())],
+        );
+        assert_eq!((c.escs[0].al_status(), c.escs[0].al_code()), (0x11, 0x0016));
+        // configure SM0/SM1 as the EEPROM says, then PRE-OP works
+        let sm = |start: u16, control: u8| {
+            let mut v = start.to_le_bytes().to_vec();
+            v.extend_from_slice(&128u16.to_le_bytes());
+            v.extend_from_slice(&[control, 0, 1, 0]);
+            v
+        };
+        run(
+            &mut c,
+            &[
+                (5, 0x1000, 0x0800, sm(0x1000, 0x26)),
+                (5, 0x1000, 0x0808, sm(0x1080, 0x22)),
+                (5, 0x1000, 0x0120, 0x0012u16.to_le_bytes().to_vec()),
+            ],
+        );
+        assert_eq!((c.escs[0].al_status(), c.escs[0].al_code()), (0x02, 0));
+        // the read mailbox is empty: reading it is refused (wkc 0); a
+        // mailbox write is accepted once, then refused while full
+        let f = run(&mut c, &[(4, 0x1000, 0x1080, vec![0; 128])]).unwrap();
+        assert_eq!(result(&f, 0).1, 0);
+        // a CoE upload of 0x1000 device type
+        let mut req = vec![
+            0x0A, 0, 0, 0, 0, 0x13, 0x00, 0x20, 0x40, 0x00, 0x10, 0, 0, 0, 0, 0,
+        ];
+        req.resize(128, 0);
+        let f = run(&mut c, &[(5, 0x1000, 0x1000, req.clone())]).unwrap();
+        assert_eq!(result(&f, 0).1, 1);
+        let f = run(&mut c, &[(4, 0x1000, 0x080D, vec![0])]).unwrap();
+        assert_eq!(result(&f, 0).0, [0x08], "response waiting");
+        let f = run(&mut c, &[(4, 0x1000, 0x1080, vec![0; 128])]).unwrap();
+        let (resp, wkc) = result(&f, 0);
+        assert_eq!(wkc, 1);
+        assert_eq!(&resp[8..16], &[0x43, 0x00, 0x10, 0, 0x92, 0x01, 0x02, 0x00]);
+        let f = run(&mut c, &[(4, 0x1000, 0x080D, vec![0])]).unwrap();
+        assert_eq!(result(&f, 0).0, [0x00], "read: empty again");
+    }
+
+    #[test]
+    fn sii_reads_the_generated_image() {
+        let mut c = chain(1);
+        run(&mut c, &[(2, 0, 0x0010, 0x1000u16.to_le_bytes().to_vec())]);
+        // read word 0x0008 (vendor id): control + address in one write
+        let req = vec![0x00, 0x01, 0x08, 0x00, 0x00, 0x00];
+        run(&mut c, &[(5, 0x1000, 0x0502, req)]);
+        let f = run(
+            &mut c,
+            &[
+                (4, 0x1000, 0x0502, vec![0; 2]),
+                (4, 0x1000, 0x0508, vec![0; 8]),
+            ],
+        )
+        .unwrap();
+        let (ctl, _) = result(&f, 0);
+        assert_eq!(ctl[1] & 0x80, 0, "not busy");
+        assert_eq!(ctl[0] & 0x40, 0x40, "8-byte reads");
+        let (data, _) = result(&f, 1);
+        assert_eq!(u32::from_le_bytes(data[0..4].try_into().unwrap()), 0x0EC7);
+    }
+
+    #[test]
+    fn dc_registers_only_where_supported() {
+        let mut cfg = DriveConfig::new("NODC");
+        cfg.dc = false;
+        let mut c = Chain::new(vec![DriveConfig::new("DC"), cfg]);
+        // latch receive times: counted by the DC SubDevice only
+        let f = run(&mut c, &[(8, 0, 0x0900, vec![0; 4])]).unwrap();
+        assert_eq!(result(&f, 0).1, 1);
+        run(&mut c, &[(2, 0, 0x0010, 0x1000u16.to_le_bytes().to_vec())]);
+        let f = run(
+            &mut c,
+            &[
+                (4, 0x1000, 0x0900, vec![0; 16]),
+                (4, 0x1000, 0x0008, vec![0; 2]),
+            ],
+        )
+        .unwrap();
+        let (times, w) = result(&f, 0);
+        assert_eq!(w, 1);
+        let p0 = u32::from_le_bytes(times[0..4].try_into().unwrap());
+        let p1 = u32::from_le_bytes(times[4..8].try_into().unwrap());
+        assert!(p1 > p0, "the frame comes back later through port 1");
+        assert_eq!(
+            result(&f, 1).0,
+            0x010Cu16.to_le_bytes(),
+            "DC, 64 bit, SYNC0"
+        );
     }
 }

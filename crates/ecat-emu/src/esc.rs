@@ -111,6 +111,9 @@ pub struct Esc {
     downstream: usize,
     frame_local: u64,
     next_tick: Option<Instant>,
+    /// Test fault: logical (FMMU) accesses are refused — the working
+    /// counter comes back short while the AL state stays as it is.
+    pub pd_refused: bool,
     pub stats: EscStats,
 }
 
@@ -165,6 +168,7 @@ impl Esc {
             downstream: 0,
             frame_local: 0,
             next_tick: None,
+            pd_refused: false,
             stats: EscStats::default(),
         };
         e.reset_registers();
@@ -456,6 +460,9 @@ impl Esc {
     /// Logical (FMMU) access of `cmd` 10 LRD / 11 LWR / 12 LRW at logical
     /// address `la`; returns the working-counter increment.
     pub fn logical(&mut self, cmd: u8, la: u32, data: &mut [u8]) -> u16 {
+        if self.pd_refused {
+            return 0;
+        }
         let orig = data.to_vec();
         let (mut read, mut wrote) = (false, false);
         for f in 0..8 {

@@ -12,13 +12,14 @@ use std::process::{Command, Stdio};
 use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use ecat_emu::{DriveConfig, Emulator, EmulatorConfig, State, VethPair};
+use ecat_emu::{DriveConfig, Emulator, EmulatorConfig, State, TorqueObjects, VethPair};
 use motion_ethercat::{
     AxisMapping, DcMode, EthercatBackend, EthercatConfig, SubDeviceSelector, SyncMode,
 };
 use motion_frames::{
     AxisCommand, CommandFrame, FeedbackFrame, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE,
-    EDGE_FALLING, EDGE_RISING, SW_ENABLED, SW_FAULT, SW_NO_DATA,
+    DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED,
+    SW_FAULT, SW_NO_DATA,
 };
 
 const CPU: f64 = 1000.0;
@@ -38,6 +39,7 @@ fn drive(name: &str) -> DriveConfig {
     d.plant.marker_at = 2.5;
     d.plant.switch = Some((5.0, 8.0));
     d.plant.hard_stop = Some((-50.0, 50.0));
+    d.plant.overtravel = Some((-45.0, 45.0));
     d
 }
 
@@ -388,6 +390,11 @@ fn torque_limits_applied_and_restored() {
     r.enable(0);
     r.move_to(0, 49_000, 50);
     r.settle(0);
+    assert_eq!(
+        r.fb.axes[0].digital_inputs & (DI_OVERTRAVEL_POSITIVE | DI_OVERTRAVEL_NEGATIVE),
+        DI_OVERTRAVEL_POSITIVE,
+        "0x60FD bit 1: positive limit switch"
+    );
     // torque homing: limits down, push 2 units into the stop at 50
     r.axis(0).torque_limit_positive = 30.0;
     r.axis(0).torque_limit_negative = 20.0;
@@ -410,6 +417,53 @@ fn torque_limits_applied_and_restored() {
     });
     r.settle(0);
     assert!(r.fb.axes[0].torque.abs() < 5.0);
+}
+
+#[test]
+fn max_torque_only_drive_gets_the_larger_limit_through_0x6072() {
+    let _t = turn();
+    let mut d = drive("EMU-6072");
+    d.torque_objects = TorqueObjects::MaxTorqueOnly;
+    let Some(mut r) = rig_with(vec![d], |_| {}) else {
+        return;
+    };
+    let w = &r.backend.report().warnings;
+    assert!(w.iter().any(|w| w.contains("0x6072")), "{w:?}");
+    r.enable(0);
+    r.axis(0).torque_limit_positive = 30.0;
+    r.axis(0).torque_limit_negative = 20.0;
+    r.until("0x6072 = 300", Duration::from_secs(2), |r| {
+        let d = r.emu().view(0).unwrap().drive;
+        d.torque_limit_positive == 30.0 && d.torque_limit_negative == 30.0
+    });
+}
+
+#[test]
+fn working_counter_mismatch_is_no_data_on_every_axis() {
+    let _t = turn();
+    let Some(mut r) = rig(2) else { return };
+    r.enable(0);
+    r.ticks(20);
+    // SubDevice 1 refuses its process data for ~15 ms (shorter than its
+    // SM watchdog): the working counter is short and nobody is known to be
+    // gone, so no axis' data can be trusted
+    r.emu().refuse_process_data(1, true);
+    r.until("no data", Duration::from_secs(1), |r| {
+        r.fb.axes[0].status_word & SW_NO_DATA != 0 && r.fb.axes[1].status_word & SW_NO_DATA != 0
+    });
+    std::thread::sleep(Duration::from_millis(10));
+    r.emu().refuse_process_data(1, false);
+    r.until("data again", Duration::from_secs(2), |r| {
+        r.fb.axes[0].status_word & SW_NO_DATA == 0 && r.fb.axes[1].status_word & SW_NO_DATA == 0
+    });
+    let st = r.backend.bus_status();
+    assert!(st.wkc_errors > 0);
+    assert!(
+        st.axes[0].no_data_wkc > 0 && st.axes[1].no_data_wkc > 0,
+        "{:?}",
+        st.axes
+    );
+    assert_eq!(st.axes[0].no_data_lost_frame, 0);
 }
 
 #[test]
