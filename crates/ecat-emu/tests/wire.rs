@@ -749,3 +749,45 @@ fn child_master() {
         }
     }
 }
+
+/// Figures for the report (run on purpose, ideally `--release`):
+/// `cargo test --release -p ecat-emu --test wire -- --ignored measure --nocapture`.
+#[test]
+#[ignore = "measurement, ~10 s"]
+fn measure_round_trip_and_exchange_time() {
+    let _t = turn();
+    let Some(mut r) = rig(2) else { return };
+    r.enable(0);
+    r.enable(1);
+    let mut took = Vec::with_capacity(10_000);
+    for k in 0..10_000i64 {
+        let t = k % 4000;
+        let p = if t < 2000 { t * 10 } else { (4000 - t) * 10 };
+        r.axis(0).target_position = p;
+        r.axis(1).target_position = -p;
+        let now = Instant::now();
+        if r.next > now {
+            std::thread::sleep(r.next - now);
+        }
+        r.next += CYCLE;
+        let t0 = Instant::now();
+        r.backend.exchange(&r.cmd, &mut r.fb).unwrap();
+        took.push(t0.elapsed().as_nanos() as u64);
+    }
+    took.sort_unstable();
+    let q = |f: f64| took[((took.len() - 1) as f64 * f) as usize] as f64 / 1000.0;
+    let st = r.backend.bus_status();
+    eprintln!("bus round trip (frame out → data back): {}", st.roundtrip);
+    eprintln!(
+        "exchange() call: min {:.2} / p50 {:.2} / p99 {:.2} / p99.9 {:.2} / max {:.2} us",
+        q(0.0),
+        q(0.5),
+        q(0.99),
+        q(0.999),
+        q(1.0)
+    );
+    eprintln!(
+        "cycles {}, lost frames {}, late {}, wkc errors {}, overruns {}, no data {:?}",
+        st.cycles, st.lost_frames, st.late_frames, st.wkc_errors, st.overruns, st.axes
+    );
+}

@@ -16,9 +16,9 @@
 //!   every cycle's difference (so it never wraps), targets are sent modulo
 //!   2³² and must lie within ±2³⁰ counts of the actual position. A target
 //!   outside that, the invalid-position sentinel or a NaN torque limit is
-//!   refused: the last good target stays, the axis is disabled and reports a
-//!   fault until the enable handshake (a real drive faults on a bad
-//!   set-point).
+//!   refused: the last good target stays, the axis quick-stops on the
+//!   drive's ramp, is disabled and reports a fault until the enable handshake
+//!   (a real drive faults on a bad set-point).
 //! * **Torque limits** (% rated, f32) → per mille (u16), clamped to
 //!   0..=65535.
 //! * **Position error tolerance** (counts, 0 = off) → the following error
@@ -211,14 +211,18 @@ impl AxisLogic {
         };
 
         // CiA 402
+        let moving_in_qs = self.state == State::QuickStopActive
+            && f64::from(inp.velocity).abs() >= self.rest_velocity;
         let target = match mode {
             Mode::Normal if enable && !self.fault_latch => Target::Enabled,
+            // a refused set-point while enabled: stop on the drive's ramp
+            // first, then disable
+            Mode::Normal if self.fault_latch && (self.state.is_enabled() || moving_in_qs) => {
+                Target::QuickStop
+            }
             Mode::Normal => Target::Disabled,
             Mode::WatchdogStop => {
-                if self.state.is_enabled()
-                    || (self.state == State::QuickStopActive
-                        && f64::from(inp.velocity).abs() >= self.rest_velocity)
-                {
+                if self.state.is_enabled() || moving_in_qs {
                     Target::QuickStop
                 } else {
                     if self.last_enable {
@@ -448,7 +452,7 @@ mod tests {
             Some(&inputs(State::OperationEnabled, 10)),
         );
         assert_eq!(o.target_position, 10, "last good target held");
-        assert_eq!(o.controlword, 0x0006, "disabled");
+        assert_eq!(o.controlword, 0x0002, "quick stop on the drive's ramp");
         assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
         assert_eq!(a.counters.rejected_setpoints, 1);
         // too far away
