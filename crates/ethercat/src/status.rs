@@ -1,0 +1,242 @@
+//! What the bus thread and `motion-io`'s thread share: the two process-image
+//! buffers ([`SeqBuffer`]) and counters (relaxed atomics, written by one
+//! thread, read by anyone), plus their public snapshots.
+
+use std::fmt;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+use crate::shared::SeqBuffer;
+
+/// Header words of both buffers.
+pub(crate) const HEADER_WORDS: usize = 4;
+/// Words per axis (an `AxisCommand` / `AxisFeedback`, 48 bytes).
+pub(crate) const AXIS_WORDS: usize = 6;
+
+/// Commands header: `[generation, mode, 0, 0]`.
+pub(crate) const MODE_NORMAL: u64 = 0;
+pub(crate) const MODE_WATCHDOG_STOP: u64 = 1;
+pub(crate) const MODE_EMERGENCY: u64 = 2;
+
+/// Feedback header: `[bus cycle, CLOCK_MONOTONIC ns of the exchange,
+/// flags, at-rest mask]`.
+pub(crate) const FLAG_RUNNING: u64 = 1;
+
+/// Round-trip histogram: 1 µs buckets up to this.
+const HIST_US: usize = 10_000;
+
+pub(crate) struct AxisAtomics {
+    pub lost: AtomicU64,
+    pub wkc: AtomicU64,
+    pub not_op: AtomicU64,
+    pub stale: AtomicU64,
+    pub rejected: AtomicU64,
+    pub window_writes: AtomicU64,
+}
+
+pub(crate) struct Shared {
+    pub commands: SeqBuffer,
+    pub feedback: SeqBuffer,
+    pub stop: AtomicBool,
+    pub running: AtomicBool,
+    pub axis: Vec<AxisAtomics>,
+    pub cycles: AtomicU64,
+    pub lost_frames: AtomicU64,
+    pub wkc_errors: AtomicU64,
+    pub overruns: AtomicU64,
+    pub late_frames: AtomicU64,
+    pub recoveries: AtomicU64,
+    pub recovery_failures: AtomicU64,
+    pub command_read_failures: AtomicU64,
+    pub frames_sent: AtomicU64,
+    pub frames_received: AtomicU64,
+    pub window_write_failures: AtomicU64,
+    pub needs_restart: AtomicU64,
+    /// System-allocator calls of the bus thread in the cycle loop after
+    /// warm-up (only counted when motion_rt::RtAllocator is the global
+    /// allocator).
+    pub bus_allocations: AtomicU64,
+    hist: Vec<AtomicU64>,
+    hist_over: AtomicU64,
+    rt_min: AtomicU64,
+    rt_max: AtomicU64,
+}
+
+impl Shared {
+    pub fn new(axes: usize) -> Shared {
+        let words = HEADER_WORDS + axes * AXIS_WORDS;
+        Shared {
+            commands: SeqBuffer::new(words),
+            feedback: SeqBuffer::new(words),
+            stop: AtomicBool::new(false),
+            running: AtomicBool::new(false),
+            axis: (0..axes)
+                .map(|_| AxisAtomics {
+                    lost: AtomicU64::new(0),
+                    wkc: AtomicU64::new(0),
+                    not_op: AtomicU64::new(0),
+                    stale: AtomicU64::new(0),
+                    rejected: AtomicU64::new(0),
+                    window_writes: AtomicU64::new(0),
+                })
+                .collect(),
+            cycles: AtomicU64::new(0),
+            lost_frames: AtomicU64::new(0),
+            wkc_errors: AtomicU64::new(0),
+            overruns: AtomicU64::new(0),
+            late_frames: AtomicU64::new(0),
+            recoveries: AtomicU64::new(0),
+            recovery_failures: AtomicU64::new(0),
+            command_read_failures: AtomicU64::new(0),
+            frames_sent: AtomicU64::new(0),
+            frames_received: AtomicU64::new(0),
+            window_write_failures: AtomicU64::new(0),
+            needs_restart: AtomicU64::new(0),
+            bus_allocations: AtomicU64::new(0),
+            hist: (0..HIST_US).map(|_| AtomicU64::new(0)).collect(),
+            hist_over: AtomicU64::new(0),
+            rt_min: AtomicU64::new(u64::MAX),
+            rt_max: AtomicU64::new(0),
+        }
+    }
+
+    /// Records one cycle's round trip (exchange start → data back).
+    pub fn record_roundtrip(&self, ns: u64) {
+        let us = (ns / 1000) as usize;
+        match self.hist.get(us) {
+            Some(b) => b.fetch_add(1, Ordering::Relaxed),
+            None => self.hist_over.fetch_add(1, Ordering::Relaxed),
+        };
+        self.rt_min.fetch_min(ns, Ordering::Relaxed);
+        self.rt_max.fetch_max(ns, Ordering::Relaxed);
+    }
+
+    fn percentile(&self, total: u64, q: f64) -> f64 {
+        let want = ((total as f64) * q).ceil().max(1.0) as u64;
+        let mut acc = 0;
+        for (us, b) in self.hist.iter().enumerate() {
+            acc += b.load(Ordering::Relaxed);
+            if acc >= want {
+                return us as f64 + 0.5;
+            }
+        }
+        HIST_US as f64
+    }
+
+    pub fn snapshot(&self) -> BusStatus {
+        let l = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        let total: u64 = self.hist.iter().map(l).sum::<u64>() + l(&self.hist_over);
+        let roundtrip = if total == 0 {
+            RoundTrip::default()
+        } else {
+            RoundTrip {
+                samples: total,
+                min_us: l(&self.rt_min) as f64 / 1000.0,
+                p50_us: self.percentile(total, 0.5),
+                p99_us: self.percentile(total, 0.99),
+                p999_us: self.percentile(total, 0.999),
+                max_us: l(&self.rt_max) as f64 / 1000.0,
+            }
+        };
+        BusStatus {
+            running: self.running.load(Ordering::Acquire),
+            cycles: l(&self.cycles),
+            lost_frames: l(&self.lost_frames),
+            wkc_errors: l(&self.wkc_errors),
+            overruns: l(&self.overruns),
+            late_frames: l(&self.late_frames),
+            recoveries: l(&self.recoveries),
+            recovery_failures: l(&self.recovery_failures),
+            needs_restart: l(&self.needs_restart),
+            bus_thread_allocations: l(&self.bus_allocations),
+            command_read_failures: l(&self.command_read_failures),
+            feedback_read_failures: self.feedback.read_failures(),
+            frames_sent: l(&self.frames_sent),
+            frames_received: l(&self.frames_received),
+            window_write_failures: l(&self.window_write_failures),
+            roundtrip,
+            axes: self
+                .axis
+                .iter()
+                .map(|a| AxisStatus {
+                    no_data_lost_frame: l(&a.lost),
+                    no_data_wkc: l(&a.wkc),
+                    no_data_not_op: l(&a.not_op),
+                    no_data_stale: l(&a.stale),
+                    rejected_setpoints: l(&a.rejected),
+                    following_window_writes: l(&a.window_writes),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Per-axis counters: cycles reported with `SW_NO_DATA`, by cause (one
+/// cause per cycle, in this priority: lost frame, SubDevice not in OP,
+/// working counter), and refused set-points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AxisStatus {
+    /// The cycle's frame did not come back in time.
+    pub no_data_lost_frame: u64,
+    /// The working counter did not match (not attributable to a SubDevice
+    /// that is known to be gone).
+    pub no_data_wkc: u64,
+    /// The SubDevice was not in OP (unplugged, SM watchdog, AL error).
+    pub no_data_not_op: u64,
+    /// `exchange` found no bus cycle newer than 3 cycles (bus thread late).
+    pub no_data_stale: u64,
+    pub rejected_setpoints: u64,
+    /// SDO writes of 0x6065 (following error window) done.
+    pub following_window_writes: u64,
+}
+
+/// Round-trip statistics of the cyclic exchange (frame out → data back), µs.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RoundTrip {
+    pub samples: u64,
+    pub min_us: f64,
+    pub p50_us: f64,
+    pub p99_us: f64,
+    pub p999_us: f64,
+    pub max_us: f64,
+}
+
+impl fmt::Display for RoundTrip {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} cycles: min {:.1} / p50 {:.1} / p99 {:.1} / p99.9 {:.1} / max {:.1} us",
+            self.samples, self.min_us, self.p50_us, self.p99_us, self.p999_us, self.max_us
+        )
+    }
+}
+
+/// A snapshot of the bus.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BusStatus {
+    /// The bus thread cycles process data.
+    pub running: bool,
+    pub cycles: u64,
+    pub lost_frames: u64,
+    pub wkc_errors: u64,
+    /// Cycles whose exchange overran the cycle (deadlines skipped).
+    pub overruns: u64,
+    /// Answers that came after their cycle gave up on them.
+    pub late_frames: u64,
+    /// SubDevices brought back to OP.
+    pub recoveries: u64,
+    pub recovery_failures: u64,
+    /// SubDevices found in INIT / PRE-OP (lost their configuration, e.g.
+    /// power-cycled): only a restart of the backend brings them back.
+    pub needs_restart: u64,
+    /// System-allocator calls the bus thread made while cycling, after
+    /// [`crate::bus::WARM_UP_CYCLES`] (counted only in a binary whose global
+    /// allocator is `motion_rt::RtAllocator`; 0 otherwise).
+    pub bus_thread_allocations: u64,
+    pub command_read_failures: u64,
+    pub feedback_read_failures: u64,
+    pub frames_sent: u64,
+    pub frames_received: u64,
+    pub window_write_failures: u64,
+    pub roundtrip: RoundTrip,
+    pub axes: Vec<AxisStatus>,
+}
