@@ -64,17 +64,28 @@ impl Drop for TempConfig {
 pub fn config(tag: &str, supervisor_extra: &str, axes: &str) -> TempConfig {
     let prefix = unique_prefix(tag);
     let path = std::env::temp_dir().join(format!("{prefix}.toml"));
-    let stale = if supervisor_extra.contains("stale_cycles")
-        || supervisor_extra.contains("feedback_timeout_ms")
-    {
-        ""
-    } else {
-        "feedback_timeout_ms = 20\n"
+    // Defaults for the keys the test does not set itself.
+    let given = |k: &str| {
+        supervisor_extra.lines().any(|l| {
+            l.trim_start().starts_with(&format!("{k} "))
+                || l.trim_start().starts_with(&format!("{k}="))
+        })
     };
-    let text = format!(
-        "[supervisor]\ncycle_us = 1000\ncpu = 1\npriority = 80\nio = \"sim\"\n\
-         service_prefix = \"{prefix}\"\n{stale}{supervisor_extra}\n{axes}"
-    );
+    let mut sup = String::new();
+    for (k, v) in [
+        ("cycle_us", "1000"),
+        ("cpu", "1"),
+        ("priority", "80"),
+        ("io", "\"sim\""),
+        ("feedback_timeout_ms", "20"),
+    ] {
+        let implied = k == "feedback_timeout_ms" && given("stale_cycles");
+        if !given(k) && !implied {
+            sup += &format!("{k} = {v}\n");
+        }
+    }
+    let text =
+        format!("[supervisor]\n{sup}service_prefix = \"{prefix}\"\n{supervisor_extra}\n{axes}");
     std::fs::write(&path, text).expect("write config");
     TempConfig { path, prefix }
 }
@@ -199,6 +210,16 @@ impl Watched {
             code: status.code(),
             stdout,
             stderr,
+        }
+    }
+}
+
+impl Drop for Watched {
+    /// A test that failed half-way must not leave its processes running.
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
         }
     }
 }

@@ -92,15 +92,14 @@ pub fn spawn(settings: RtSettings, shared: Arc<Shared>) -> std::io::Result<JoinH
             // A panic must not leave the phase at Running: the main thread
             // would wait for a cycle that no longer runs. (The drives are
             // then stopped by motion-io's watchdog: commands stop.)
-            let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                body(settings, &shared)
-            }))
-            .unwrap_or_else(|_| RtOutcome {
-                report: None,
-                error: Some("the real-time thread panicked".into()),
-                cycles: 0,
-                pool: None,
-            });
+            let out =
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(settings, &shared)))
+                    .unwrap_or_else(|_| RtOutcome {
+                        report: None,
+                        error: Some("the real-time thread panicked".into()),
+                        cycles: 0,
+                        pool: None,
+                    });
             shared.set_phase(if out.error.is_some() {
                 Phase::Failed
             } else {
