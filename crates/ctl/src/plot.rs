@@ -68,6 +68,19 @@ pub fn draw(rows: &[Row], axis: &str, path: &Path) -> Result<(), String> {
         y0 = y0.min(y);
         y1 = y1.max(y);
     }
+    // The velocity axis spans what the sequence commanded (with a margin):
+    // a cycle in which the I/O process skipped commands shows as a spike of
+    // the actual velocity, drawn clipped at the edge rather than squashing
+    // the legs the plot is about.
+    let (c0, c1) = rows
+        .iter()
+        .filter_map(|r| r.cmd_velocity)
+        .fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+    if c1 > c0 {
+        let m = 0.3 * (c1 - c0);
+        y0 = y0.max(c0 - m);
+        y1 = y1.min(c1 + m);
+    }
     let padx = ((x1 - x0) * 0.05).max(1e-3);
     let pady = ((y1 - y0) * 0.1).max(1e-3);
     let e = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
@@ -116,7 +129,7 @@ pub fn draw(rows: &[Row], axis: &str, path: &Path) -> Result<(), String> {
         let leg: Vec<(f64, f64)> = rows[start..end.min(rows.len())]
             .iter()
             .chain(rows.get(end))
-            .filter_map(|r| Some((r.position?, r.velocity?)))
+            .filter_map(|r| Some((r.position?, r.velocity?.clamp(y0 - pady, y1 + pady))))
             .collect();
         let k = match seen.iter().position(|p| *p == phase) {
             Some(k) => k,
