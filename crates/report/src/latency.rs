@@ -45,8 +45,21 @@ impl Percentiles {
     }
 }
 
-/// The `latency` object of `home --json`, `run --json` and `stats --json`.
+/// One of the worst wake-ups and what the cycle before it did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LateWakeup {
+    pub latency_us: f64,
+    /// The previous cycle's compute time, and how long before this
+    /// deadline it went back to sleep (negative: it overran).
+    pub prev_compute_us: f64,
+    pub prev_slack_us: f64,
+    /// The previous cycle handed over a status snapshot / a histogram set.
+    pub prev_snapshot: bool,
+    pub prev_stats: bool,
+}
+
+/// The `latency` object of `home --json`, `run --json` and `stats --json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Latency {
     pub cycles: u64,
     /// Cycles that woke a whole period late or published after the next deadline.
@@ -59,6 +72,9 @@ pub struct Latency {
     pub compute_us: Percentiles,
     /// I/O round trip: command published → the answer to it published.
     pub io_roundtrip_us: Percentiles,
+    /// The worst wake-ups, worst first, with what the cycle before did.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub worst: Vec<LateWakeup>,
 }
 
 impl Latency {
@@ -82,6 +98,25 @@ impl Latency {
             "cycles {}, deadline misses {}, late I/O replies {}\n",
             self.cycles, self.deadline_misses, self.late_replies
         );
+        for w in self.worst.iter().take(3) {
+            s += &format!(
+                "late wake-up {:.1} µs: the cycle before computed {:.1} µs and slept {:.1} µs \
+                 before this deadline{}{}\n",
+                w.latency_us,
+                w.prev_compute_us,
+                w.prev_slack_us,
+                if w.prev_snapshot {
+                    ", handed a snapshot over"
+                } else {
+                    ""
+                },
+                if w.prev_stats {
+                    ", handed statistics over"
+                } else {
+                    ""
+                },
+            );
+        }
         s
     }
 }

@@ -25,7 +25,7 @@ pub use home::{
     RtInfo, RunReport, StatsReport, TraceReport,
 };
 pub use io::{GapCounts, IoReport};
-pub use latency::{Latency, Percentiles};
+pub use latency::{LateWakeup, Latency, Percentiles};
 pub use status::{AxisStatus, IoStatus, StatusReport};
 
 /// Rounds to `digits` decimals for printing (JSON keeps what a reader can use,

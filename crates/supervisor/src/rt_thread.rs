@@ -163,6 +163,9 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
     let period = s.machine.supervisor.cycle_ns();
     let mut timer = PeriodicTimer::new(period);
     let mut attached_cycles: u64 = 0;
+    // What the previous cycle did, for the worst wake-ups.
+    let mut prev = crate::stats::LateCycle::default();
+    let mut prev_end_ns: u64 = 0;
     let mut baseline: Option<(u64, u64)> = None;
     let mut cycle: u64 = 0;
 
@@ -216,6 +219,15 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
             attached_cycles += 1;
         }
         if baseline.is_some() {
+            hist.note_late(crate::stats::LateCycle {
+                latency_ns: wake.latency_ns,
+                deadline_ns: wake.deadline_ns,
+                prev_slack_ns: wake.deadline_ns as i64 - prev_end_ns as i64,
+                ..prev
+            });
+            prev.prev_compute_ns = t_published.saturating_sub(wake.woke_ns);
+            prev.prev_snapshot = false;
+            prev.prev_stats = false;
             hist.wakeup.saturating_record(wake.latency_ns.max(1));
             hist.compute
                 .saturating_record(t_published.saturating_sub(wake.woke_ns).max(1));
@@ -240,6 +252,7 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
         }
 
         if cycle % s.snapshot_every == 0 || core.exiting() {
+            prev.prev_snapshot = true;
             if let Some(mut snap) = shared.snap_free.pop() {
                 core.snapshot(wake.deadline_ns, &mut snap);
                 if let Err(snap) = shared.snap_full.push(snap) {
@@ -249,6 +262,7 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
         }
         let done = core.exit_done();
         if cycle % s.stats_every == 0 || done {
+            prev.prev_stats = true;
             if let Some(fresh) = shared.stats_free.pop() {
                 let full = std::mem::replace(&mut hist, fresh);
                 if let Err(full) = shared.stats_full.push(full) {
@@ -265,6 +279,7 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
         if done {
             break;
         }
+        prev_end_ns = now_ns();
     }
     out.cycles = cycle;
     out.pool = rt_pool::thread_stats();

@@ -12,6 +12,26 @@ pub use motion_report::{Latency, Percentiles};
 /// Highest value a histogram holds, ns (larger values saturate).
 pub const HIGHEST_NS: u64 = 10_000_000_000;
 
+/// Worst wake-ups kept per interval (and in the totals).
+pub const WORST: usize = 8;
+
+/// A late wake-up and what the cycle before it did: where a late cycle's
+/// time went (its own timer, or something of ours just before).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LateCycle {
+    /// Wake-up latency, ns.
+    pub latency_ns: u64,
+    /// Monotonic deadline of the late cycle.
+    pub deadline_ns: u64,
+    /// The previous cycle: its compute time, and how long before this
+    /// deadline it went to sleep (negative slack = it overran).
+    pub prev_compute_ns: u64,
+    pub prev_slack_ns: i64,
+    /// The previous cycle handed over a snapshot / a histogram set.
+    pub prev_snapshot: bool,
+    pub prev_stats: bool,
+}
+
 /// One interval's worth of measurements.
 #[derive(Clone, Debug)]
 pub struct HistSet {
@@ -26,6 +46,8 @@ pub struct HistSet {
     pub deadline_misses: u64,
     /// Cycles whose answer did not arrive within the wait budget.
     pub late_replies: u64,
+    /// The worst wake-ups, worst first (zeroed entries unused).
+    pub worst: [LateCycle; WORST],
     /// Monotonic time span covered, ns (0 = empty).
     pub start_ns: u64,
     pub end_ns: u64,
@@ -51,6 +73,7 @@ impl HistSet {
             cycles: 0,
             deadline_misses: 0,
             late_replies: 0,
+            worst: [LateCycle::default(); WORST],
             start_ns: 0,
             end_ns: 0,
         }
@@ -63,6 +86,7 @@ impl HistSet {
         self.cycles = 0;
         self.deadline_misses = 0;
         self.late_replies = 0;
+        self.worst = [LateCycle::default(); WORST];
         self.start_ns = 0;
         self.end_ns = 0;
     }
@@ -76,10 +100,28 @@ impl HistSet {
         self.cycles += other.cycles;
         self.deadline_misses += other.deadline_misses;
         self.late_replies += other.late_replies;
+        for w in other.worst.iter().filter(|w| w.latency_ns > 0) {
+            self.note_late(*w);
+        }
         if other.start_ns != 0 && (self.start_ns == 0 || other.start_ns < self.start_ns) {
             self.start_ns = other.start_ns;
         }
         self.end_ns = self.end_ns.max(other.end_ns);
+    }
+
+    /// Keeps `c` if it is among the worst wake-ups (no allocation: a fixed
+    /// array, insertion in place).
+    pub fn note_late(&mut self, c: LateCycle) {
+        let last = &self.worst[WORST - 1];
+        if c.latency_ns <= last.latency_ns {
+            return;
+        }
+        let mut i = WORST - 1;
+        self.worst[i] = c;
+        while i > 0 && self.worst[i - 1].latency_ns < self.worst[i].latency_ns {
+            self.worst.swap(i - 1, i);
+            i -= 1;
+        }
     }
 
     /// Percentiles in µs (the `latency` object of the reports).
@@ -91,6 +133,18 @@ impl HistSet {
             wakeup_us: percentiles(&self.wakeup).rounded(),
             compute_us: percentiles(&self.compute).rounded(),
             io_roundtrip_us: percentiles(&self.roundtrip).rounded(),
+            worst: self
+                .worst
+                .iter()
+                .filter(|w| w.latency_ns > 0)
+                .map(|w| motion_report::LateWakeup {
+                    latency_us: motion_report::round(w.latency_ns as f64 / 1000.0, 1),
+                    prev_compute_us: motion_report::round(w.prev_compute_ns as f64 / 1000.0, 1),
+                    prev_slack_us: motion_report::round(w.prev_slack_ns as f64 / 1000.0, 1),
+                    prev_snapshot: w.prev_snapshot,
+                    prev_stats: w.prev_stats,
+                })
+                .collect(),
         }
     }
 }
@@ -115,6 +169,31 @@ pub fn percentiles(h: &Histogram<u64>) -> Percentiles {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_worst_wake_ups_are_kept_in_order() {
+        let mut a = HistSet::new();
+        for (k, l) in [5u64, 90, 1, 40, 300, 7, 8, 9, 10, 11, 200]
+            .iter()
+            .enumerate()
+        {
+            a.note_late(LateCycle {
+                latency_ns: *l,
+                deadline_ns: k as u64,
+                ..LateCycle::default()
+            });
+        }
+        let kept: Vec<u64> = a.worst.iter().map(|w| w.latency_ns).collect();
+        assert_eq!(kept, [300, 200, 90, 40, 11, 10, 9, 8]);
+        let mut b = HistSet::new();
+        b.note_late(LateCycle {
+            latency_ns: 250,
+            ..LateCycle::default()
+        });
+        a.merge(&b);
+        assert_eq!(a.worst[1].latency_ns, 250);
+        assert_eq!(a.summary().worst.len(), WORST);
+    }
 
     #[test]
     fn merge_and_percentiles() {

@@ -112,7 +112,7 @@ pub fn home(a: &HomeArgs) -> i32 {
     let f = session.finish();
     let report = HomeReport {
         axes: rows,
-        latency: f.latency,
+        latency: f.latency.clone(),
         io: f.io.clone(),
         rt: rt_info(&f),
         warnings: f.warnings.clone(),

@@ -67,7 +67,7 @@ pub fn run(a: &RunArgs) -> i32 {
     }
     let f = session.finish();
     let report = RunReport {
-        latency: f.latency,
+        latency: f.latency.clone(),
         io: f.io.clone(),
         rt: rt_info(&f),
         warnings: f.warnings.clone(),
