@@ -413,6 +413,32 @@ mod tests {
     }
 
     #[test]
+    fn virtual_axes_echo_their_command_between_the_bus_axes() {
+        let mut bus = FeedbackFrame::ZERO;
+        bus.axes[0].position = 111;
+        bus.axes[1].position = 222;
+        let mut last = vec![AxisCommand::ZERO; 3];
+        last[1].target_position = 5_000;
+        last[1].target_velocity = 20.0;
+        last[1].control_word = CW_ENABLE;
+        let mut fb = FeedbackFrame::ZERO;
+        unpack(&[Some(0), None, Some(1)], &last, &bus, &mut fb);
+        assert_eq!(fb.header.axis_count, 3);
+        assert_eq!(
+            (
+                fb.axes[0].position,
+                fb.axes[1].position,
+                fb.axes[2].position
+            ),
+            (111, 5_000, 222)
+        );
+        assert_eq!(
+            (fb.axes[1].velocity, fb.axes[1].status_word),
+            (20.0, SW_ENABLED)
+        );
+    }
+
+    #[test]
     fn mistakes_are_named() {
         // --backend ethercat on an I/O process configured for the sim
         let (m, io) = machine("[[axis]]\nname = \"X\"\n");
