@@ -1,6 +1,8 @@
 //! Shared pieces of the benchmarks (see `bench/README.md`):
 //!
-//! * `jitter` — the supervisor's real cycle side by side with cyclictest;
+//! * `jitter` — the supervisor's real cycle side by side with cyclictest
+//!   (and, with `--ethercat`, with the EtherCAT backend over a veth pair to
+//!   emulated drives, [`ecat`]);
 //! * `ipc` — the command/feedback round trip through iceoryx2, next to a bare
 //!   iceoryx2 ping-pong;
 //! * `benches/engine.rs` — criterion benches of one engine step and one
@@ -12,6 +14,7 @@
 
 pub mod args;
 pub mod cyclictest;
+pub mod ecat;
 pub mod hist;
 pub mod machine;
 pub mod proc;

@@ -1,10 +1,13 @@
 //! Jitter bench: the supervisor's real cycle (`motion-supervisor run`) side
 //! by side with cyclictest, same period, priority and CPU, in alternating
-//! slices so that both see the same host noise. See `bench/README.md`.
+//! slices so that both see the same host noise; with `--ethercat` also the
+//! supervisor with the EtherCAT backend (over a veth pair to emulated
+//! drives) in the same slices. See `bench/README.md`.
 
 use hdrhistogram::Histogram;
 use motion_bench::args::Args;
 use motion_bench::cyclictest::{self, CtHistogram};
+use motion_bench::ecat::{self, BusRun, EcatRig};
 use motion_bench::hist::{self, new_hist, thousands, us, Pct, COLUMNS};
 use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc::{self, Running};
@@ -20,7 +23,7 @@ use std::time::{Duration, Instant, SystemTime};
 const USAGE: &str = "\
 usage: jitter [--duration S] [--period-us N] [--slice S] [--priority P] [--cpu N]
               [--stress] [--out DIR] [--supervisor PATH] [--cyclictest PATH]
-              [--no-cyclictest] [--hist-max-us N]
+              [--no-cyclictest] [--hist-max-us N] [--ethercat]
 
 Runs `motion-supervisor run` and `cyclictest` in alternating slices until each
 has run --duration seconds, at the same period, SCHED_FIFO priority and CPU,
@@ -40,6 +43,10 @@ DIR/jitter-<period>us.{hlog,svg,json}.
   --no-cyclictest    run the supervisor half only
   --hist-max-us N    cyclictest's histogram range, µs (default 20000; more
                      goes to its overflow count)
+  --ethercat         also run the supervisor with motion-io --backend ethercat
+                     in every slice: the demo machine's axes over a veth pair
+                     to ecat-emu's emulated drives (root: ip netns, raw
+                     sockets); reported next to the sim backend
 
 Exit status: 0, or 1 if a tool failed to run or crashed, or the supervisor
 missed more than 1 % of its deadlines; 2 on a command-line mistake; 130 if
@@ -63,6 +70,7 @@ struct Opts {
     cyclictest: Option<PathBuf>,
     no_cyclictest: bool,
     hist_max_us: u64,
+    ethercat: bool,
 }
 
 fn parse_opts() -> Result<Option<Opts>, String> {
@@ -84,6 +92,7 @@ fn parse_opts() -> Result<Option<Opts>, String> {
         cyclictest: a.value("--cyclictest")?.map(PathBuf::from),
         no_cyclictest: a.flag("--no-cyclictest"),
         hist_max_us: a.num("--hist-max-us", 20_000)?,
+        ethercat: a.flag("--ethercat"),
     };
     a.finish()?;
     if !(o.duration > 0.0 && o.duration.is_finite()) {
@@ -303,6 +312,27 @@ fn run(o: &Opts) -> Result<i32, String> {
     };
     note_other_rt("before the bench");
 
+    // --ethercat: the veth pair and the emulated drives, for the whole bench
+    let rig = if o.ethercat {
+        let demo = motion_config::parse(motion_config::DEMO_TOML)
+            .map_err(|p| format!("deploy/demo.toml: {p:?}"))?;
+        // below motion-io (priority − 10), whose answer to the supervisor
+        // is what the cycle measures; the emulator plays hardware that
+        // would take no CPU at all
+        let emu_priority = (o.priority - 15).clamp(1, 99);
+        let rig = EcatRig::start(&demo, other_cpu, emu_priority)
+            .map_err(|e| format!("--ethercat: {e}"))?;
+        eprintln!(
+            "jitter: EtherCAT: motion-io --backend ethercat on {} ↔ veth ↔ ecat-emu ({} drives, \
+             SCHED_FIFO {emu_priority} on CPU {other_cpu})",
+            rig.interface(),
+            rig.drives
+        );
+        Some(rig)
+    } else {
+        None
+    };
+
     let t0 = Instant::now();
     let t0_wall = SystemTime::now();
     let mut failures: Vec<String> = Vec::new();
@@ -334,6 +364,8 @@ fn run(o: &Opts) -> Result<i32, String> {
     };
 
     let mut ours: Vec<OurSlice> = Vec::new();
+    let mut ours_ecat: Vec<OurSlice> = Vec::new();
+    let mut bus_runs: Vec<BusRun> = Vec::new();
     let mut ct: Vec<CtSlice> = Vec::new();
     let mut interrupted = false;
     let mut ct_command = String::new();
@@ -352,23 +384,17 @@ fn run(o: &Opts) -> Result<i32, String> {
             priority: o.priority,
             service_prefix: prefix.clone(),
         })?;
-        let cfg_path = tmp.join(format!("slice{i}.toml"));
-        std::fs::write(&cfg_path, toml).map_err(|e| format!("{}: {e}", cfg_path.display()))?;
         let hlog_path = tmp.join(format!("ours{i}.hlog"));
         let start = t0.elapsed();
-        let mut cmd = Command::new(&supervisor);
-        cmd.arg("run")
-            .arg("--config")
-            .arg(&cfg_path)
-            .arg("--duration")
-            .arg(format!("{len}"))
-            .arg("--json")
-            .arg("--hlog")
-            .arg(&hlog_path)
-            .arg("--service-prefix")
-            .arg(&prefix);
-        let ended = Running::spawn(&mut cmd, "motion-supervisor", true, false)?
-            .wait(Duration::from_secs_f64(len + 60.0), Duration::from_secs(10));
+        let ended = supervisor_run(
+            &supervisor,
+            &tmp,
+            &format!("slice{i}"),
+            &toml,
+            &prefix,
+            len,
+            &hlog_path,
+        )?;
         if ended.interrupted {
             interrupted = true;
             break;
@@ -394,6 +420,76 @@ fn run(o: &Opts) -> Result<i32, String> {
             }
         }
         leftover_shm(&prefix, &mut warnings);
+
+        // --- the supervisor with the EtherCAT backend
+        if let Some(rig) = &rig {
+            if proc::stop_requested() {
+                interrupted = true;
+                break;
+            }
+            let prefix = format!("mbj{pid}e{i}");
+            let (toml, _) = machine::demo_with(&Supervisor {
+                cycle_us: o.period_us,
+                cpu: o.cpu,
+                priority: o.priority,
+                service_prefix: prefix.clone(),
+            })?;
+            let (toml, _) = ecat::on_ethercat(&toml, rig.interface())?;
+            let hlog_path = tmp.join(format!("ecat{i}.hlog"));
+            let start = t0.elapsed();
+            let ended = supervisor_run(
+                &supervisor,
+                &tmp,
+                &format!("ecat{i}"),
+                &toml,
+                &prefix,
+                len,
+                &hlog_path,
+            )?;
+            if ended.interrupted {
+                interrupted = true;
+                break;
+            }
+            let bus = ecat::bus_run(&ended.stderr);
+            match our_slice(&ended, &hlog_path, start, len) {
+                Ok((s, w)) => {
+                    eprintln!(
+                        "jitter: slice {}/{} EtherCAT:   {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies); bus round trip {}",
+                        i + 1,
+                        slices,
+                        s.cycles,
+                        us(s.json_wakeup.p99),
+                        us(s.json_wakeup.max),
+                        s.misses,
+                        s.late,
+                        bus.map_or("not reported".to_string(), |b| format!(
+                            "p50 {} / p99 {} / max {} µs, {} lost frame(s)",
+                            us(b.p50),
+                            us(b.p99),
+                            us(b.max),
+                            b.lost
+                        ))
+                    );
+                    warnings.extend(w.into_iter().map(|w| format!("EtherCAT: {w}")));
+                    ours_ecat.push(s);
+                    if let Some(b) = bus {
+                        bus_runs.push(b);
+                    } else {
+                        warnings.insert(
+                            "EtherCAT: motion-io reported no bus summary in a slice".into(),
+                        );
+                    }
+                }
+                Err(e) => {
+                    failures.push(format!(
+                        "slice {}: motion-supervisor (EtherCAT): {e}",
+                        i + 1
+                    ));
+                    break 'slices;
+                }
+            }
+            leftover_shm(&prefix, &mut warnings);
+        }
 
         // --- cyclictest
         if let Some(ct_bin) = &cyclictest {
@@ -487,23 +583,34 @@ fn run(o: &Opts) -> Result<i32, String> {
         hist::merge(&mut ours_compute, &s.compute);
         hist::merge(&mut ours_rt, &s.roundtrip);
     }
-    let exact = |p: Pct, f: &dyn Fn(&OurSlice) -> Pct| {
-        let v: Vec<Pct> = ours.iter().map(f).filter(|p| p.count > 0).collect();
-        let mut p = p;
-        if !v.is_empty() {
-            p.min = v.iter().map(|p| p.min).fold(f64::INFINITY, f64::min);
-            p.max = v.iter().map(|p| p.max).fold(0.0, f64::max);
-        }
-        p
-    };
-    let w_ours = exact(pct_of(&ours_wake), &|s| s.json_wakeup);
-    let c_ours = exact(pct_of(&ours_compute), &|s| s.json_compute);
-    let r_ours = exact(pct_of(&ours_rt), &|s| s.json_roundtrip);
+    let w_ours = exact(&ours, pct_of(&ours_wake), |s| s.json_wakeup);
+    let c_ours = exact(&ours, pct_of(&ours_compute), |s| s.json_compute);
+    let r_ours = exact(&ours, pct_of(&ours_rt), |s| s.json_roundtrip);
     let cycles: u64 = ours.iter().map(|s| s.cycles).sum();
     let misses: u64 = ours.iter().map(|s| s.misses).sum();
     let late: u64 = ours.iter().map(|s| s.late).sum();
     let miss_ratio = misses as f64 / cycles.max(1) as f64;
     let ours_secs: f64 = ours.iter().map(|s| s.len.as_secs_f64()).sum();
+
+    // the same for the EtherCAT backend's slices
+    let mut e_wake = new_hist();
+    let mut e_compute = new_hist();
+    let mut e_rt = new_hist();
+    for s in &ours_ecat {
+        hist::merge(&mut e_wake, &s.wakeup);
+        hist::merge(&mut e_compute, &s.compute);
+        hist::merge(&mut e_rt, &s.roundtrip);
+    }
+    let have_ecat = !ours_ecat.is_empty();
+    let w_ecat = exact(&ours_ecat, pct_of(&e_wake), |s| s.json_wakeup);
+    let c_ecat = exact(&ours_ecat, pct_of(&e_compute), |s| s.json_compute);
+    let r_ecat = exact(&ours_ecat, pct_of(&e_rt), |s| s.json_roundtrip);
+    let e_cycles: u64 = ours_ecat.iter().map(|s| s.cycles).sum();
+    let e_misses: u64 = ours_ecat.iter().map(|s| s.misses).sum();
+    let e_late: u64 = ours_ecat.iter().map(|s| s.late).sum();
+    let e_miss_ratio = e_misses as f64 / e_cycles.max(1) as f64;
+    let e_secs: f64 = ours_ecat.iter().map(|s| s.len.as_secs_f64()).sum();
+    let bus = bus_summary(&bus_runs);
 
     let mut ct_hdr = new_hist();
     let mut ct_total = CtHistogram::default();
@@ -528,6 +635,18 @@ fn run(o: &Opts) -> Result<i32, String> {
             miss_ratio * 100.0,
             MAX_MISS_RATIO * 100.0
         ));
+    }
+    if have_ecat && e_miss_ratio > MAX_MISS_RATIO {
+        failures.push(format!(
+            "the supervisor (EtherCAT backend) missed {} of {} deadlines ({:.2} % > {:.0} %)",
+            e_misses,
+            e_cycles,
+            e_miss_ratio * 100.0,
+            MAX_MISS_RATIO * 100.0
+        ));
+    }
+    if o.ethercat && !have_ecat && failures.is_empty() && !interrupted {
+        failures.push("the EtherCAT backend produced no slice".into());
     }
     if cyclictest.is_some() && !have_ct && failures.is_empty() && !interrupted {
         failures.push("cyclictest produced no samples".into());
@@ -596,6 +715,12 @@ fn run(o: &Opts) -> Result<i32, String> {
         &mut t,
         row("ours (supervisor)", &w_ours, Some(w_ours.count)),
     );
+    if have_ecat {
+        line(
+            &mut t,
+            row("ours, EtherCAT backend", &w_ecat, Some(w_ecat.count)),
+        );
+    }
     if have_ct {
         line(&mut t, row("cyclictest", &w_ct, Some(w_ct.count)));
         let mut s = format!("{:<22}", "ratio ours/cyclictest");
@@ -603,6 +728,13 @@ fn run(o: &Opts) -> Result<i32, String> {
             s += &format!("{:>9}", hist::ratio(r));
         }
         line(&mut t, s);
+        if have_ecat {
+            let mut s = format!("{:<22}", "ratio EtherCAT/cyclic.");
+            for r in w_ecat.ratio(&w_ct) {
+                s += &format!("{:>9}", hist::ratio(r));
+            }
+            line(&mut t, s);
+        }
     } else {
         line(&mut t, format!("{:<22}(not run)", "cyclictest"));
     }
@@ -618,6 +750,17 @@ fn run(o: &Opts) -> Result<i32, String> {
             MAX_MISS_RATIO * 100.0
         ),
     );
+    if have_ecat {
+        line(
+            &mut t,
+            format!(
+                "                  EtherCAT backend: {} of {} cycles ({:.3} %)",
+                e_misses,
+                thousands(e_cycles),
+                e_miss_ratio * 100.0
+            ),
+        );
+    }
     if have_ct {
         line(
             &mut t,
@@ -631,11 +774,44 @@ fn run(o: &Opts) -> Result<i32, String> {
     line(&mut t, header("ours, other (µs)"));
     line(&mut t, row("compute", &c_ours, None));
     line(&mut t, row("I/O round trip", &r_ours, None));
+    if have_ecat {
+        line(&mut t, row("compute, EtherCAT", &c_ecat, None));
+        line(&mut t, row("round trip, EtherCAT", &r_ecat, None));
+        match &bus {
+            Some(b) => {
+                let mut s = format!("{:<22}", "EtherCAT bus round trip");
+                for v in [b.min, b.p50, b.p99, b.p999] {
+                    s += &format!("{:>9}", us(v));
+                }
+                s += &format!("{:>9}{:>9}", "-", us(b.max));
+                line(&mut t, s);
+                line(
+                    &mut t,
+                    format!(
+                        "  (motion-io's bus thread: frame out → inputs back over veth, {} bus cycles, {} lost frame(s); \
+                         p50/p99/p99.9 = the highest of the {} slices)",
+                        thousands(b.cycles),
+                        b.lost,
+                        bus_runs.len()
+                    ),
+                );
+            }
+            None => line(
+                &mut t,
+                "EtherCAT bus round trip: not reported by motion-io".into(),
+            ),
+        }
+    }
     line(
         &mut t,
         format!(
-            "late I/O replies (no answer within half a period): {late} of {}",
-            thousands(cycles)
+            "late I/O replies (no answer within half a period): {late} of {}{}",
+            thousands(cycles),
+            if have_ecat {
+                format!("; EtherCAT backend: {e_late} of {}", thousands(e_cycles))
+            } else {
+                String::new()
+            }
         ),
     );
     line(
@@ -675,6 +851,9 @@ fn run(o: &Opts) -> Result<i32, String> {
     let svg_path = base.with_extension("svg");
     let json_path = base.with_extension("json");
     let mut intervals: Vec<(&str, Duration, Duration, &Histogram<u64>)> = Vec::new();
+    for s in &ours_ecat {
+        intervals.push(("ours_ethercat", s.start, s.len, &s.wakeup));
+    }
     for (i, s) in ours.iter().enumerate() {
         intervals.push(("ours", s.start, s.len, &s.wakeup));
         if let Some(c) = ct.get(i) {
@@ -687,7 +866,7 @@ fn run(o: &Opts) -> Result<i32, String> {
             "motion-bench jitter: wake-up latency, ns; period {} us, SCHED_FIFO {} on CPU {}",
             o.period_us, o.priority, o.cpu
         ),
-        "tags: ours = motion-supervisor run (wake-up), cyclictest = cyclictest (1 us bins, recorded at the bin's lower edge)".into(),
+        "tags: ours = motion-supervisor run (wake-up), ours_ethercat = the same with motion-io --backend ethercat (--ethercat), cyclictest = cyclictest (1 us bins, recorded at the bin's lower edge)".into(),
         format!("kernel {} ({})", env.kernel, env.preemption),
     ];
     if let Err(e) = hist::write_interval_log(&hlog_path, &comments, t0_wall, &intervals) {
@@ -721,6 +900,13 @@ fn run(o: &Opts) -> Result<i32, String> {
         colour: "#1f6fd1",
         hist: &ours_wake,
     }];
+    if have_ecat {
+        series.push(Series {
+            name: "ours, EtherCAT backend",
+            colour: "#2ca02c",
+            hist: &e_wake,
+        });
+    }
     if have_ct {
         series.push(Series {
             name: "cyclictest",
@@ -779,6 +965,21 @@ fn run(o: &Opts) -> Result<i32, String> {
             "io_roundtrip_us": serde_json::to_value(r_ours).unwrap_or_default(),
             "warnings": warnings.iter().cloned().collect::<Vec<_>>(),
         },
+        "ours_ethercat": if have_ecat { json!({
+            "seconds": e_secs,
+            "slices": ours_ecat.len(),
+            "cycles": e_cycles,
+            "deadline_misses": e_misses,
+            "deadline_miss_ratio": e_miss_ratio,
+            "late_replies": e_late,
+            "wakeup_us": serde_json::to_value(w_ecat).unwrap_or_default(),
+            "compute_us": serde_json::to_value(c_ecat).unwrap_or_default(),
+            "io_roundtrip_us": serde_json::to_value(r_ecat).unwrap_or_default(),
+            "bus_roundtrip_us_per_slice": bus_runs.iter().map(|b| json!({
+                "cycles": b.cycles, "min": b.min, "p50": b.p50, "p99": b.p99,
+                "p999": b.p999, "max": b.max, "lost_frames": b.lost,
+            })).collect::<Vec<_>>(),
+        }) } else { json!({"skipped": true}) },
         "cyclictest": if have_ct { json!({
             "command": ct_command,
             "seconds": ct_secs,
@@ -942,4 +1143,67 @@ impl Drop for RemoveDir {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
     }
+}
+
+/// Runs `motion-supervisor run` on `toml` for `len` s with an interval log
+/// at `hlog`, output captured.
+fn supervisor_run(
+    supervisor: &Path,
+    tmp: &Path,
+    tag: &str,
+    toml: &str,
+    prefix: &str,
+    len: f64,
+    hlog: &Path,
+) -> Result<proc::Ended, String> {
+    let cfg_path = tmp.join(format!("{tag}.toml"));
+    std::fs::write(&cfg_path, toml).map_err(|e| format!("{}: {e}", cfg_path.display()))?;
+    let mut cmd = Command::new(supervisor);
+    cmd.arg("run")
+        .arg("--config")
+        .arg(&cfg_path)
+        .arg("--duration")
+        .arg(format!("{len}"))
+        .arg("--json")
+        .arg("--hlog")
+        .arg(hlog)
+        .arg("--service-prefix")
+        .arg(prefix);
+    Ok(Running::spawn(&mut cmd, "motion-supervisor", true, false)?
+        .wait(Duration::from_secs_f64(len + 60.0), Duration::from_secs(10)))
+}
+
+/// Percentiles of `p` (merged interval logs) with min and max taken exactly
+/// from the slices' JSON.
+fn exact(slices: &[OurSlice], p: Pct, f: fn(&OurSlice) -> Pct) -> Pct {
+    let v: Vec<Pct> = slices.iter().map(f).filter(|p| p.count > 0).collect();
+    let mut p = p;
+    if !v.is_empty() {
+        p.min = v.iter().map(|p| p.min).fold(f64::INFINITY, f64::min);
+        p.max = v.iter().map(|p| p.max).fold(0.0, f64::max);
+    }
+    p
+}
+
+/// The bus round trips of all slices in one row: min and max over all,
+/// p50 / p99 / p99.9 the highest of the slices (motion-io reports
+/// percentiles per run, not its histogram).
+fn bus_summary(runs: &[BusRun]) -> Option<BusRun> {
+    let first = runs.first()?;
+    Some(runs.iter().fold(
+        BusRun {
+            cycles: 0,
+            lost: 0,
+            ..*first
+        },
+        |a, b| BusRun {
+            cycles: a.cycles + b.cycles,
+            min: a.min.min(b.min),
+            p50: a.p50.max(b.p50),
+            p99: a.p99.max(b.p99),
+            p999: a.p999.max(b.p999),
+            max: a.max.max(b.max),
+            lost: a.lost + b.lost,
+        },
+    ))
 }

@@ -19,6 +19,11 @@ pub fn io(s: &str) -> Result<String, String> {
     names::check_io_name(s).map(|()| s.to_string())
 }
 
+/// `--interface IF`: a network interface name.
+pub fn interface(s: &str) -> Result<String, String> {
+    names::check_interface_name(s).map(|()| s.to_string())
+}
+
 /// Seconds: a finite positive number of at most a day.
 pub fn seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {

@@ -34,6 +34,23 @@ pub const FEEDBACK_TIMEOUT_MS: (f64, f64) = (1.0, 1000.0);
 /// The I/O process's command watchdog, ms of cycles: at most a second.
 pub const WATCHDOG_MS: f64 = 1000.0;
 
+/// EtherCAT: SM watchdog of the drives, ms (and at least 3 cycles).
+pub const SM_WATCHDOG_MS: (u32, u32) = (1, 1000);
+/// EtherCAT: shortest bus cycle the backend runs, µs.
+pub const ETHERCAT_MIN_CYCLE_US: u32 = 100;
+/// EtherCAT: reply deadline of a bus frame, µs (and at most 95 % of the cycle).
+pub const REPLY_TIMEOUT_US: (u32, u32) = (10, 95_000);
+/// EtherCAT: INIT → OP limit, s.
+pub const STARTUP_TIMEOUT_S: (u32, u32) = (1, 300);
+/// EtherCAT: rounds of static drift compensation at start-up.
+pub const DC_STATIC_SYNC_ITERATIONS: (u32, u32) = (0, 100_000);
+/// EtherCAT: bus position of an axis' drive.
+pub const ETHERCAT_POSITION: (u32, u32) = (0, 65_535);
+/// EtherCAT: manufacturer-specific bits of 0x60FD.
+pub const INDEX_PULSE_BIT: (u32, u32) = (16, 31);
+/// EtherCAT: most axes (SubDevices) one EtherCAT I/O process drives.
+pub const ETHERCAT_MAX_AXES: usize = 32;
+
 /// The table as the README prints it.
 pub const TABLE: &[Range] = &[
     ("[supervisor] cycle_us", 50.0, 100_000.0, "µs"),
@@ -79,4 +96,25 @@ pub const TABLE: &[Range] = &[
     ),
     ("home_timeout", 0.0, TIMEOUT_S, "s"),
     ("home_torque_time, enable_timeout", 0.0, SHORT_TIME_S, "s"),
+    (
+        "[[io]] sm_watchdog_ms (EtherCAT; also ≥ 3 × cycle_us)",
+        1.0,
+        1000.0,
+        "ms",
+    ),
+    (
+        "[[io]] reply_timeout_us (EtherCAT; also ≤ 95 % of cycle_us)",
+        10.0,
+        95_000.0,
+        "µs",
+    ),
+    ("[[io]] startup_timeout_s (EtherCAT)", 1.0, 300.0, "s"),
+    (
+        "[[io]] dc_static_sync_iterations (EtherCAT)",
+        0.0,
+        100_000.0,
+        "",
+    ),
+    ("ethercat_position", 0.0, 65_535.0, "bus position"),
+    ("ethercat_index_pulse_bit", 16.0, 31.0, "bit of 0x60FD"),
 ];

@@ -86,6 +86,48 @@ pub fn check_service_prefix(s: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Longest network interface name (the kernel's IFNAMSIZ − 1).
+pub const INTERFACE_MAX: usize = 15;
+/// Longest EtherCAT SubDevice name an axis may name (SII strings are short).
+pub const SUBDEVICE_NAME_MAX: usize = 64;
+
+/// A network interface name (`[[io]] interface`, `motion-io --interface`):
+/// 1..=15 printable ASCII characters, none of `/`, `:` or space (the
+/// kernel's rules), not `.` or `..`.
+pub fn check_interface_name(s: &str) -> Result<(), String> {
+    let ok = !s.is_empty()
+        && s.len() <= INTERFACE_MAX
+        && s != "."
+        && s != ".."
+        && s.chars()
+            .all(|c| c.is_ascii_graphic() && c != '/' && c != ':');
+    if !ok {
+        return Err(format!(
+            "interface name {} must be 1..={INTERFACE_MAX} printable ASCII characters \
+             without '/', ':' or spaces",
+            shown(s)
+        ));
+    }
+    Ok(())
+}
+
+/// An EtherCAT SubDevice name (`ethercat_name`): 1..=64 printable ASCII
+/// characters (spaces allowed inside).
+pub fn check_subdevice_name(s: &str) -> Result<(), String> {
+    let ok = !s.is_empty()
+        && s.len() <= SUBDEVICE_NAME_MAX
+        && s.chars().all(|c| c.is_ascii_graphic() || c == ' ')
+        && s.trim() == s;
+    if !ok {
+        return Err(format!(
+            "SubDevice name {} must be 1..={SUBDEVICE_NAME_MAX} printable ASCII characters \
+             (no leading or trailing space)",
+            shown(s)
+        ));
+    }
+    Ok(())
+}
+
 /// A user-supplied string made safe to print: quoted, control and
 /// non-ASCII characters escaped, cut after 40 characters.
 pub fn shown(s: &str) -> String {
@@ -133,5 +175,24 @@ mod name_tests {
         }
         assert!(check_service_prefix("motion_1-a").is_ok());
         assert!(check_io_name("bus.0").is_err());
+        assert!(check_interface_name("eth1").is_ok());
+        assert!(check_interface_name("enp3s0f1.100").is_ok());
+        for bad in [
+            "",
+            "0123456789abcdef",
+            "a b",
+            "a/b",
+            "eth0:1",
+            ".",
+            "..",
+            "é",
+            "x\u{1b}",
+        ] {
+            assert!(check_interface_name(bad).is_err(), "{bad:?}");
+        }
+        assert!(check_subdevice_name("X5-Servo drive").is_ok());
+        for bad in ["", " x", "x ", "a\tb", &"n".repeat(65)] {
+            assert!(check_subdevice_name(bad).is_err(), "{bad:?}");
+        }
     }
 }

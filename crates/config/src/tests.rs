@@ -286,3 +286,238 @@ fn stale_cycles_is_read_in_milliseconds() {
     assert_eq!(m.supervisor.feedback_timeout_ms, 4.0);
     assert!(m.warnings.iter().any(|w| w.contains("stale_cycles")));
 }
+
+const ECAT_IO: &str = r#"
+[[io]]
+name = "bus0"
+spawn = "supervisor"
+backend = "ethercat"
+interface = "eth1"
+"#;
+
+#[test]
+fn ethercat_io_process_and_its_axes() {
+    let text = format!(
+        r#"{ECAT_IO}dc = "off"
+sm_watchdog_ms = 20
+reply_timeout_us = 500
+startup_timeout_s = 5
+mode_in_pdo = true
+dc_static_sync_iterations = 0
+
+[[io]]
+name = "sim0"
+
+[[axis]]
+name = "X"
+io = "bus0"
+ethercat_position = 0
+
+[[axis]]
+name = "Y"
+io = "bus0"
+ethercat_name = "X5-Servo 2"
+ethercat_index_pulse_bit = 17
+
+[[axis]]
+name = "V"
+io = "bus0"
+configuration = "virtual"
+
+[[axis]]
+name = "S"
+io = "sim0"
+"#
+    );
+    let m = parse(&text).unwrap_or_else(|p| panic!("{p:#?}"));
+    let bus = &m.ios[0];
+    assert_eq!((bus.spawn, bus.backend), (IoMode::Sim, IoBackend::Ethercat));
+    let e = bus.ethercat.as_ref().unwrap();
+    assert_eq!(
+        *e,
+        EthercatIo {
+            interface: "eth1".into(),
+            dc: EthercatDc::Off,
+            sm_watchdog_ms: 20,
+            reply_timeout_us: Some(500),
+            startup_timeout_s: 5,
+            mode_in_pdo: true,
+            dc_static_sync_iterations: 0,
+        }
+    );
+    assert_eq!(
+        (m.ios[1].backend, &m.ios[1].ethercat),
+        (IoBackend::Sim, &None)
+    );
+    assert_eq!(
+        m.axes[0].ethercat,
+        Some(AxisEthercat {
+            drive: EthercatDrive::Position(0),
+            index_pulse_bit: None
+        })
+    );
+    assert_eq!(
+        m.axes[1].ethercat,
+        Some(AxisEthercat {
+            drive: EthercatDrive::Name("X5-Servo 2".into()),
+            index_pulse_bit: Some(17)
+        })
+    );
+    assert_eq!(m.axes[2].ethercat, None, "virtual: no drive");
+    assert_eq!(m.axes[3].ethercat, None);
+
+    // defaults
+    let m = parse(&format!(
+        "{ECAT_IO}[[axis]]\nname = \"X\"\nethercat_position = 3\n"
+    ))
+    .unwrap();
+    assert_eq!(
+        *m.ios[0].ethercat.as_ref().unwrap(),
+        EthercatIo {
+            interface: "eth1".into(),
+            ..EthercatIo::default()
+        }
+    );
+    assert_eq!(m.ios[0].ethercat.as_ref().unwrap().sm_watchdog_ms, 50);
+    // without [[io]] nothing changes
+    let m = parse(ONE_AXIS).unwrap();
+    assert_eq!(
+        (m.ios[0].backend, &m.ios[0].ethercat),
+        (IoBackend::Sim, &None)
+    );
+    assert_eq!(m.axes[0].ethercat, None);
+}
+
+#[test]
+fn ethercat_mistakes_are_reported_by_axis_and_key() {
+    let text = r#"
+[supervisor]
+cycle_us = 2000
+
+[[io]]
+name = "bus0"
+backend = "ethercat"
+interface = "a/very/long/interface"
+dc = "sometimes"
+sm_watchdog_ms = 5
+reply_timeout_us = 1990
+startup_timeout_s = 0
+dc_static_sync_iterations = 1000000
+mode_in_pdo = "yes"
+
+[[io]]
+name = "sim0"
+spawn = "by-hand"
+interface = "eth0"
+dc = "on"
+
+[[io]]
+name = "bus1"
+backend = "profinet"
+
+[[io]]
+name = "bus2"
+backend = "ethercat"
+
+[[axis]]
+name = "A"
+io = "bus0"
+
+[[axis]]
+name = "B"
+io = "bus0"
+ethercat_position = 70000
+ethercat_index_pulse_bit = 3
+
+[[axis]]
+name = "C"
+io = "bus0"
+ethercat_position = 1
+ethercat_name = "drive\u001b[31m"
+
+[[axis]]
+name = "D"
+io = "sim0"
+ethercat_position = 0
+ethercat_index_pulse_bit = 16
+
+[[axis]]
+name = "E"
+io = "bus0"
+configuration = "virtual"
+ethercat_name = "X"
+
+[[axis]]
+name = "F"
+io = "bus0"
+ethercat_position = 1
+
+[[axis]]
+name = "G"
+io = "bus2"
+ethercat_position = 0
+"#;
+    let p = problems_of(text);
+    for want in [
+        "io.interface: I/O process bus0: interface name \"a/very/long/interface\" must be",
+        "io.dc: \"sometimes\" is not one of \"auto\", \"on\", \"off\"",
+        "io.sm_watchdog_ms: I/O process bus0: 5 ms is shorter than 3 cycles of 2000 µs",
+        "io.reply_timeout_us: I/O process bus0: 1990 µs leaves no time in a cycle of 2000 µs",
+        "io.startup_timeout_s: 0 is outside 1..=300",
+        "io.dc_static_sync_iterations: 1000000 is outside 0..=100000",
+        "io.mode_in_pdo: expected true or false, found string",
+        "io.spawn: io #2: \"by-hand\" is not one of \"sim\", \"supervisor\", \"external\"",
+        "io.interface: I/O process sim0: only for backend = \"ethercat\" (this I/O process has backend = \"sim\")",
+        "io.dc: I/O process sim0: only for backend = \"ethercat\"",
+        "io.backend: \"profinet\" is not one of \"sim\", \"ethercat\"",
+        "io.interface: I/O process bus2: missing: backend = \"ethercat\" needs the network interface",
+        "axis A: ethercat_position: missing: an axis of EtherCAT I/O process bus0 names its drive",
+        "axis B: ethercat_position: 70000 is outside 0..=65535",
+        "axis B: ethercat_index_pulse_bit: 3 is outside 16..=31",
+        "axis C: ethercat_name: give ethercat_position or ethercat_name, not both",
+        "axis C: ethercat_name: SubDevice name \"drive\\u{1b}[31m\" must be",
+        "axis D: ethercat_position: only for an axis of an EtherCAT I/O process (its I/O process sim0 has backend = \"sim\")",
+        "axis D: ethercat_index_pulse_bit: only for an axis of an EtherCAT I/O process",
+        "axis E: ethercat_name: a virtual axis has no drive",
+    ] {
+        has(&p, want);
+    }
+    assert!(p.iter().all(|l| !l.contains('\u{1b}')), "{p:?}");
+
+    // one drive per axis; "unknown key" never doubles a reported one
+    let p = problems_of(&format!(
+        "{ECAT_IO}[[axis]]\nname = \"X\"\nethercat_position = 1\n\
+         [[axis]]\nname = \"Y\"\nethercat_position = 1\n\
+         [[axis]]\nname = \"Z\"\nethercat_name = \"N\"\n\
+         [[axis]]\nname = \"W\"\nethercat_name = \"N\"\n"
+    ));
+    has(
+        &p,
+        "axis Y: ethercat_position: the SubDevice at position 1 already drives axis X",
+    );
+    has(
+        &p,
+        "axis W: ethercat_name: the SubDevice at name \"N\" already drives axis Z",
+    );
+    assert_eq!(p.len(), 2, "{p:#?}");
+    let p = problems_of(&format!(
+        "[[io]]\nname = \"s\"\ninterface = \"eth0\"\n{ONE_AXIS}ethercat_position = 0\n"
+    ));
+    assert_eq!(p.len(), 2, "{p:#?}");
+    assert!(p.iter().all(|l| !l.contains("unknown key")), "{p:#?}");
+
+    // the bus cycle has a floor
+    let p = problems_of(&format!(
+        "[supervisor]\ncycle_us = 50\n{ECAT_IO}sm_watchdog_ms = 1\n[[axis]]\nname = \"X\"\nethercat_position = 0\n"
+    ));
+    has(&p, "io.backend: I/O process bus0: the EtherCAT bus cycles at [supervisor] cycle_us = 50 µs; it needs at least 100 µs");
+    // at most 32 drives on one EtherCAT I/O process
+    let mut t = ECAT_IO.to_string();
+    for i in 0..33 {
+        t += &format!("[[axis]]\nname = \"A{i}\"\nethercat_position = {i}\n");
+    }
+    has(
+        &problems_of(&t),
+        "io: EtherCAT I/O process bus0 drives 33 axes, at most 32",
+    );
+}

@@ -6,123 +6,49 @@
 use motion_homing::{Axis, DriveState, Feedback, Request};
 use proptest::prelude::*;
 
+#[rustfmt::skip]
 const SUPERVISOR_KEYS: &[&str] = &[
-    "cycle_us",
-    "cpu",
-    "priority",
-    "io",
-    "service_prefix",
-    "feedback_timeout_ms",
-    "feedback_loss_drain",
-    "stale_cycles",
-    "io_watchdog_cycles",
-    "lock_memory",
-    "io_priority",
-    "io_cpu",
-    "cpu_dma_latency_us",
-    "runtime_dir",
-    "bogus",
+    "cycle_us", "cpu", "priority", "io", "service_prefix", "feedback_timeout_ms",
+    "feedback_loss_drain", "stale_cycles", "io_watchdog_cycles", "lock_memory", "io_priority",
+    "io_cpu", "cpu_dma_latency_us", "runtime_dir", "bogus",
 ];
+#[rustfmt::skip]
 const AXIS_KEYS: &[&str] = &[
-    "name",
-    "io",
-    "configuration",
-    "control_mode",
-    "travel",
-    "unwind",
-    "counts_per_unit",
-    "marker",
-    "registration",
-    "home_mode",
-    "home_direction",
-    "home_sequence",
-    "home_switch_normally_closed",
-    "home_position",
-    "home_offset",
-    "home_speed",
-    "home_return_speed",
-    "home_acceleration",
-    "home_deceleration",
-    "home_torque_level",
-    "home_torque_threshold",
-    "home_torque_time",
-    "home_timeout",
-    "home_creep_speed",
-    "search_limit",
-    "torque_limit",
-    "max_position",
-    "travel_limits",
-    "home_order",
-    "enable_timeout",
-    "marker_latch",
+    "name", "io", "configuration", "control_mode", "travel", "unwind", "counts_per_unit",
+    "marker", "registration", "home_mode", "home_direction", "home_sequence",
+    "home_switch_normally_closed", "home_position", "home_offset", "home_speed",
+    "home_return_speed", "home_acceleration", "home_deceleration", "home_torque_level",
+    "home_torque_threshold", "home_torque_time", "home_timeout", "home_creep_speed",
+    "search_limit", "torque_limit", "max_position", "travel_limits", "home_order",
+    "enable_timeout", "marker_latch", "ethercat_position", "ethercat_name",
+    "ethercat_index_pulse_bit",
 ];
+#[rustfmt::skip]
+const IO_KEYS: &[&str] = &[
+    "spawn", "cpu", "priority", "backend", "interface", "dc", "sm_watchdog_ms",
+    "reply_timeout_us", "startup_timeout_s", "mode_in_pdo", "dc_static_sync_iterations",
+];
+#[rustfmt::skip]
 const SIM_KEYS: &[&str] = &[
-    "start",
-    "switch",
-    "marker_every",
-    "marker_at",
-    "hard_stop",
-    "overtravel",
-    "external_speed",
-    "push_gain",
-    "inertia_gain",
-    "friction",
-    "enable_delay_cycles",
+    "start", "switch", "marker_every", "marker_at", "hard_stop", "overtravel",
+    "external_speed", "push_gain", "inertia_gain", "friction", "enable_delay_cycles",
 ];
+#[rustfmt::skip]
 const WORDS: &[&str] = &[
-    "sim",
-    "external",
-    "servo",
-    "feedback_only",
-    "virtual",
-    "position",
-    "velocity",
-    "torque",
-    "linear",
-    "cyclic",
-    "active",
-    "passive",
-    "absolute",
-    "bidirectional_forward",
-    "unidirectional_reverse",
-    "switch",
-    "marker",
-    "switch_then_marker",
-    "torque_then_marker",
-    "immediate",
-    "X",
-    "io",
-    "bus0",
-    "a/b",
-    "\u{1b}[31m",
-    "",
-    "../x",
+    "sim", "external", "servo", "feedback_only", "virtual", "position", "velocity", "torque",
+    "linear", "cyclic", "active", "passive", "absolute", "bidirectional_forward",
+    "unidirectional_reverse", "switch", "marker", "switch_then_marker", "torque_then_marker",
+    "immediate", "X", "io", "bus0", "a/b", "\u{1b}[31m", "", "../x", "ethercat", "supervisor",
+    "eth0", "auto", "on", "off",
 ];
 
+#[rustfmt::skip]
 fn value() -> impl Strategy<Value = String> {
     prop_oneof![
         prop::sample::select(vec![
-            "nan",
-            "inf",
-            "-inf",
-            "1e308",
-            "-1e308",
-            "1e-300",
-            "0",
-            "-0.0",
-            "4294967295",
-            "9223372036854775807",
-            "-1",
-            "true",
-            "false",
-            "[]",
-            "[1]",
-            "[1, 2]",
-            "[inf, -inf]",
-            "[nan, 0]",
-            "{}",
-            "[[1]]",
-            "\"\"",
+            "nan", "inf", "-inf", "1e308", "-1e308", "1e-300", "0", "-0.0", "4294967295",
+            "9223372036854775807", "-1", "true", "false", "[]", "[1]", "[1, 2]", "[inf, -inf]",
+            "[nan, 0]", "{}", "[[1]]", "\"\"",
         ])
         .prop_map(str::to_string),
         any::<f64>().prop_map(|x| format!("{x:?}")),
@@ -151,12 +77,12 @@ fn machine() -> impl Strategy<Value = String> {
     (
         table(SUPERVISOR_KEYS),
         prop::collection::vec((table(AXIS_KEYS), table(SIM_KEYS)), 0..4),
-        0usize..3,
+        prop::collection::vec(table(IO_KEYS), 0..3),
     )
         .prop_map(|(sup, axes, ios)| {
             let mut t = format!("[supervisor]\n{sup}\n");
-            for k in 0..ios {
-                t += &format!("[[io]]\nname = \"bus{k}\"\n");
+            for (k, io) in ios.iter().enumerate() {
+                t += &format!("[[io]]\nname = \"bus{k}\"\n{io}\n");
             }
             for (i, (a, s)) in axes.iter().enumerate() {
                 t += &format!("[[axis]]\nname = \"A{i}\"\n{a}\n[axis.sim]\n{s}\n");

@@ -1,6 +1,7 @@
-//! The drive backend: what sits behind the frames. `sim` ([`crate::sim`]) is
-//! the only one today; a fieldbus master (EtherCAT, CANopen, ...) implements
-//! the same trait.
+//! The drive backend: what sits behind the frames. `sim` ([`crate::sim`])
+//! simulates the axes; `ethercat` ([`crate::ethercat`]) drives CiA 402
+//! drives on an EtherCAT bus; another fieldbus master (CANopen, ...) would
+//! implement the same trait.
 
 use std::fmt;
 
@@ -100,6 +101,12 @@ pub trait Backend {
     /// Immediate stop: disable every axis now (power stage off, a fault
     /// reported), without a deceleration ramp. Last resort.
     fn emergency_stop(&mut self, fb: &mut FeedbackFrame);
+
+    /// A summary for the log when the process ends (bus counters and the
+    /// like); `None`: nothing to say.
+    fn summary(&self) -> Option<String> {
+        None
+    }
 
     /// The process is shutting down: a controlled stop of every axis now,
     /// bounded in time. The default runs [`watchdog_stop`](Self::watchdog_stop)

@@ -2,7 +2,7 @@
 //! the config file; a mistake is answered with the usage and exit code 2.
 
 use clap::{Parser, ValueEnum};
-use motion_config::args::{cpu, io, runtime_dir, service_prefix};
+use motion_config::args::{cpu, interface, io, runtime_dir, service_prefix};
 use std::path::PathBuf;
 
 /// Drive backends `--backend` accepts.
@@ -11,6 +11,20 @@ pub enum BackendKind {
     /// One simulated plant per axis of the config (switch, markers, hard
     /// stops, torque).
     Sim,
+    /// CiA 402 drives on an EtherCAT bus (ethercrab on a real-time bus
+    /// thread, bus cycle = the supervisor's cycle): `--interface` or the
+    /// [[io]] section's `interface`.
+    Ethercat,
+}
+
+impl BackendKind {
+    /// The backend an I/O process of the config asks for.
+    pub fn of(b: motion_config::IoBackend) -> BackendKind {
+        match b {
+            motion_config::IoBackend::Sim => BackendKind::Sim,
+            motion_config::IoBackend::Ethercat => BackendKind::Ethercat,
+        }
+    }
 }
 
 /// The drive-I/O process of motion-supervisor: takes one command frame per
@@ -30,9 +44,14 @@ pub struct Options {
     /// demo machine (deploy/demo.toml).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Drive backend.
-    #[arg(long, value_enum, default_value = "sim")]
-    pub backend: BackendKind,
+    /// Drive backend; default: the I/O process's `backend` in the config
+    /// (`sim` without [[io]] sections).
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendKind>,
+    /// EtherCAT: the network interface of the bus; overrides the [[io]]
+    /// section's `interface`.
+    #[arg(long, value_name = "IF", value_parser = interface)]
+    pub interface: Option<String>,
     /// Attach as this I/O process ([[io]] name) and serve only its axes;
     /// default: the config's only I/O process.
     #[arg(long = "io", value_name = "NAME", value_parser = io)]
@@ -53,10 +72,11 @@ pub struct Options {
     /// (lowest latency; burns one CPU, use with --cpu).
     #[arg(long)]
     pub spin: bool,
-    /// Pin this process to CPU N.
+    /// Pin this process to CPU N (EtherCAT: also its bus thread).
     #[arg(long, value_name = "N", value_parser = cpu)]
     pub cpu: Option<usize>,
-    /// Run SCHED_FIFO at priority P; default SCHED_OTHER.
+    /// Run SCHED_FIFO at priority P; default SCHED_OTHER (EtherCAT: the bus
+    /// thread runs at P, default 70).
     #[arg(long, value_name = "P", value_parser = clap::value_parser!(i32).range(1..=99))]
     pub priority: Option<i32>,
     /// Print only errors and watchdog messages.
@@ -78,6 +98,12 @@ mod tests {
         assert_eq!(o.io.as_deref(), Some("bus0"));
         assert!(o.spin && o.priority == Some(70));
         assert!(p("--backend ethercab").is_err());
+        let o = p("--backend ethercat --interface veth0").unwrap();
+        assert_eq!(o.backend, Some(BackendKind::Ethercat));
+        assert_eq!(o.interface.as_deref(), Some("veth0"));
+        assert_eq!(p("").unwrap().backend, None, "the config decides");
+        assert!(p("--interface a/b").is_err());
+        assert!(p("--interface 0123456789abcdef").is_err());
         assert!(p("--priority 0").is_err());
         assert!(p("--cpu 99").is_err());
         assert!(p("--service-prefix a/b").is_err());

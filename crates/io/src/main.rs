@@ -9,12 +9,14 @@
 //! for the loop, the watchdog and the signal handling.
 //!
 //! Exit codes: 0 after SIGINT/SIGTERM or when the supervisor is gone
-//! (`--exit-with-supervisor`); 1 on an IPC start-up failure or no supervisor
-//! within 10 s (`--exit-with-supervisor`); 2 on a command-line or config
-//! mistake.
+//! (`--exit-with-supervisor`); 1 on an IPC start-up failure, an EtherCAT
+//! start-up failure (the message names the SubDevice and the object or
+//! state) or no supervisor within 10 s (`--exit-with-supervisor`); 2 on a
+//! command-line or config mistake.
 
 mod backend;
 mod cli;
+mod ethercat;
 mod run;
 mod say;
 mod sim;
@@ -105,8 +107,19 @@ fn real_main() -> i32 {
     apply_rt(&opts, say);
 
     let mine = cfg.only_io(io);
-    let mut backend: Box<dyn Backend> = match opts.backend {
+    let kind = opts
+        .backend
+        .unwrap_or_else(|| BackendKind::of(cfg.ios[io].backend));
+    if kind != BackendKind::Ethercat && opts.interface.is_some() {
+        log::error!("--interface is for --backend ethercat");
+        return 2;
+    }
+    let mut backend: Box<dyn Backend> = match kind {
         BackendKind::Sim => Box::new(SimBackend::new(&mine)),
+        BackendKind::Ethercat => match start_ethercat(&mine, &cfg.ios[io], &opts, say) {
+            Ok(b) => Box::new(b),
+            Err(code) => return code,
+        },
     };
     let settings = run::Settings {
         cycle_ns: cfg.supervisor.cycle_ns(),
@@ -130,10 +143,53 @@ fn real_main() -> i32 {
         if let Some(e) = &report.error {
             say.always(format_args!("cleanup: {e}"));
         }
-        match outcome {
+        let code = match outcome {
             Ok(run::Outcome::Rejoin) => continue,
-            Ok(o) => return o.exit_code(),
-            Err(code) => return code,
+            Ok(o) => o.exit_code(),
+            Err(code) => code,
+        };
+        if let Some(s) = backend.summary() {
+            say.notice(format_args!("{s}"));
+        }
+        return code;
+    }
+}
+
+/// Starts the EtherCAT bus for the axes of `mine` (blocking until every
+/// SubDevice is in OP) and logs the start-up report; on failure logs why
+/// and returns the exit code.
+fn start_ethercat(
+    mine: &motion_config::MachineConfig,
+    io: &motion_config::IoConfig,
+    opts: &Options,
+    say: Say,
+) -> Result<ethercat::EthercatIo, i32> {
+    let at = ethercat::Placement {
+        cpu: opts.cpu,
+        priority: opts.priority,
+    };
+    let names = mine.axes.iter().map(|a| a.name.clone()).collect();
+    let started =
+        ethercat::bus_config(mine, io, opts.interface.as_deref(), at).and_then(|(cfg, map)| {
+            say.info(format_args!(
+                "EtherCAT: starting the bus on {} (cycle {} us, dc {:?}, SM watchdog {} ms)",
+                cfg.interface,
+                cfg.cycle.as_micros(),
+                cfg.dc,
+                cfg.sm_watchdog.as_millis()
+            ));
+            ethercat::EthercatIo::start(cfg, map, names)
+        });
+    match started {
+        Ok(b) => {
+            for line in b.report_lines() {
+                say.notice(format_args!("{line}"));
+            }
+            Ok(b)
+        }
+        Err(e) => {
+            say.always(format_args!("error: {}", e.message));
+            Err(e.code)
         }
     }
 }

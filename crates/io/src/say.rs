@@ -18,6 +18,19 @@ impl Say {
         }
     }
 
+    /// A one-time report of the hardware in use (the EtherCAT start-up
+    /// report, the bus summary at exit): at info level, shown also with
+    /// `--quiet`.
+    pub fn notice(&self, args: fmt::Arguments<'_>) {
+        if self.quiet {
+            log::set_max_level(log::LevelFilter::Info);
+            log::info!("{args}");
+            log::set_max_level(log::LevelFilter::Warn);
+        } else {
+            log::info!("{args}");
+        }
+    }
+
     /// Errors, warnings and watchdog messages: always shown (a message that
     /// starts with `error: ` at error level, the rest as warnings).
     pub fn always(&self, args: fmt::Arguments<'_>) {

@@ -14,6 +14,10 @@ pub fn init(program: &'static str) {
     let journal = std::env::var_os("JOURNAL_STREAM").is_some();
     let mut b = env_logger::Builder::new();
     b.filter_level(log::LevelFilter::Info);
+    // ethercrab (motion-io's EtherCAT backend) logs every late bus frame at
+    // error level from the real-time bus thread; the backend counts them
+    // instead (bus summary). `RUST_LOG=ethercrab=debug` shows them again.
+    b.filter_module("ethercrab", log::LevelFilter::Off);
     if let Ok(spec) = std::env::var("RUST_LOG") {
         b.parse_filters(&spec);
     }

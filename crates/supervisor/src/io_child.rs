@@ -28,12 +28,13 @@ pub fn io_binary() -> PathBuf {
 }
 
 impl IoChild {
-    /// Starts `motion-io --backend sim --io NAME` on the same config, service
+    /// Starts `motion-io --backend BACKEND --io NAME` on the same config, service
     /// prefix and runtime directory; it joins the supervisor's domain through
     /// the session file. Its stdout is discarded (ours may carry JSON); its
     /// stderr is shared.
     pub fn spawn(
         name: &str,
+        backend: &str,
         config: Option<&Path>,
         service_prefix: &str,
         runtime_dir: &Path,
@@ -42,7 +43,7 @@ impl IoChild {
         let bin = io_binary();
         let mut cmd = Command::new(&bin);
         cmd.arg("--backend")
-            .arg("sim")
+            .arg(backend)
             .arg("--io")
             .arg(name)
             .arg("--service-prefix")

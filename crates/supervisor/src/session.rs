@@ -205,6 +205,7 @@ impl Session {
         args.extend(self.io_args.iter().cloned());
         let child = IoChild::spawn(
             &self.machine.ios[k].name,
+            self.machine.ios[k].backend.name(),
             self.opts_config.as_deref(),
             &self.domain.prefix,
             &self.domain.runtime_dir,
