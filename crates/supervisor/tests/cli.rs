@@ -14,10 +14,17 @@ fn sup(args: &[&str]) -> std::process::Output {
 fn help_and_usage_errors() {
     let o = sup(&["--help"]);
     assert!(o.status.success());
-    assert!(String::from_utf8_lossy(&o.stdout).contains("motion-supervisor home"));
+    let help = String::from_utf8_lossy(&o.stdout);
+    for cmd in ["run", "home", "check", "Exit codes"] {
+        assert!(help.contains(cmd), "{help}");
+    }
     let o = sup(&["fly"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown command 'fly'"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unrecognized subcommand 'fly'"));
+    let o = sup(&["fly", "--json"]);
+    assert_eq!(o.status.code(), Some(2));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    assert!(v["errors"][0]["message"].as_str().unwrap().contains("fly"));
     let o = sup(&[]);
     assert_eq!(o.status.code(), Some(2));
 }
