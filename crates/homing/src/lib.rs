@@ -7,7 +7,8 @@
 //!
 //! * [`config`]: the homing attributes (spec §2) and axis facts.
 //! * [`validate`]: every configuration problem at once, with CIP codes.
-//! * [`axis`]: the state machine for every active and passive sequence.
+//! * [`plan`]: every sequence as one ordered list of legs.
+//! * [`axis`]: the state machine that runs a plan, for every active and passive sequence.
 //! * [`profile`]: jog / stop / trapezoid profiles that never exceed their limits.
 //! * [`codes`]: the ERR / EXERR table.
 //! * [`io`]: the per-cycle feedback, command and request types.
@@ -16,6 +17,7 @@ pub mod axis;
 pub mod codes;
 pub mod config;
 pub mod io;
+pub mod plan;
 pub mod position;
 pub mod profile;
 pub mod status;
