@@ -1,8 +1,10 @@
 //! The Motion Axis Home instruction's status (EN, DN, ER, IP, PC, ERR, EXERR)
 //! and the axis status bits homing drives (HomingStatus, HomedStatus).
 
-/// Where the engine is in a sequence. The number is reported as EXERR of a
-/// search-limit failure (1016), so it is part of the interface.
+/// Where the engine is in a sequence, derived from the state machine's state
+/// (the leg of the plan it runs). Names ([`Phase::name`]) are shown to
+/// operators and the numbers are kept stable; the EXERR of a search-limit
+/// failure has its own explicit mapping in [`codes`](crate::codes).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[repr(u16)]
 pub enum Phase {
