@@ -43,7 +43,8 @@ pub struct SupervisorConfig {
     pub priority: i32,
     pub io: IoMode,
     pub service_prefix: String,
-    /// Missing-feedback cycles tolerated during homing (engine `stale_limit`).
+    /// Missing-feedback cycles tolerated during homing (engine
+    /// `feedback_timeout_ns` = this × the cycle).
     pub stale_cycles: u32,
     /// Missing-command cycles after which `motion-io` stops every axis.
     pub io_watchdog_cycles: u32,
@@ -291,7 +292,9 @@ fn parse_axis(
         position_error_tolerance: r.f64("position_error_tolerance", 0.0),
         velocity_error_tolerance: r.f64("velocity_error_tolerance", 0.0),
         enable_timeout: r.f64("enable_timeout", d.enable_timeout),
-        stale_limit: sup.stale_cycles,
+        // `stale_cycles` keeps its meaning: that many cycles of missing feedback.
+        feedback_timeout_ns: u64::from(sup.stale_cycles) * sup.cycle_ns(),
+        feedback_loss_drain: d.feedback_loss_drain,
         max_position: r.f64("max_position", d.max_position),
     };
     let sim_table = r.table("sim");

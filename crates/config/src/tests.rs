@@ -8,7 +8,7 @@ fn demo_parses() {
     let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["U", "X", "C", "Z"]);
     assert_eq!(m.axes[1].sim.switch, Some((0.0, 5.0)));
-    assert_eq!(m.axes[0].engine.stale_limit, 10);
+    assert_eq!(m.axes[0].engine.feedback_timeout_ns, 10_000_000);
 }
 
 #[test]

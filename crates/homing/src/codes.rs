@@ -10,7 +10,7 @@
 //! | 12   | 1     | process terminated on request: a stop during homing |
 //! | 12   | 12    | axis in shutdown (at start or during homing) |
 //! | 12   | 16    | device in wrong state: drive fault during homing |
-//! | 12   | 40    | *ours* feedback lost: no fresh feedback for `stale_limit` cycles (stale frames, I/O process gone) |
+//! | 12   | 40    | *ours* feedback lost: the leaky bucket of missing-feedback time went above `feedback_timeout_ns` (I/O process gone, or frames lost too often); `Status::lost_after_ns` holds the gap |
 //! | 12   | 41    | *ours* feedback invalid: non-finite or absurd value (the status names the attribute) |
 //! | 12   | 42    | *ours* drive did not report enabled within `enable_timeout` |
 //! | 12   | 43    | *ours* hardware overtravel input tripped during homing |

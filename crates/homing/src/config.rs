@@ -153,8 +153,17 @@ pub struct AxisConfig {
     pub velocity_error_tolerance: f64,
     /// Time the drive gets to report "enabled" after an active start (s).
     pub enable_timeout: f64,
-    /// Consecutive cycles without fresh feedback tolerated during homing.
-    pub stale_limit: u32,
+    /// Feedback-loss rule, stated in time so it means the same at any cycle
+    /// rate: a leaky bucket of missing-feedback time. Every step without a
+    /// fresh valid sample adds the time since the previous step; every step
+    /// with one drains `feedback_loss_drain` x that time. The rule trips when
+    /// the bucket holds more than this (ns): a dead peer trips within this
+    /// plus one cycle, an isolated gap shorter than this never trips.
+    pub feedback_timeout_ns: u64,
+    /// Drain rate of the feedback-loss bucket per unit of time with fresh
+    /// feedback. With `d`, sustained loss of more than `d / (1 + d)` of the
+    /// cycles trips eventually (0.25: above 20 %).
+    pub feedback_loss_drain: f64,
     /// Raw positions beyond ±this (units) are treated as absurd feedback.
     pub max_position: f64,
 }
@@ -193,7 +202,8 @@ impl Default for AxisConfig {
             position_error_tolerance: 0.0,
             velocity_error_tolerance: 0.0,
             enable_timeout: 1.0,
-            stale_limit: 3,
+            feedback_timeout_ns: 10_000_000,
+            feedback_loss_drain: 0.25,
             max_position: 1.0e9,
         }
     }

@@ -82,6 +82,19 @@ pub struct Status {
     /// Monotonic time homing started and finished, ns.
     pub started_ns: u64,
     pub finished_ns: Option<u64>,
-    /// Feedback is fresh and valid (not stale beyond `stale_limit`).
+    /// Feedback is usable: the feedback-loss rule has not tripped since the
+    /// last fresh valid sample.
     pub feedback_ok: bool,
+    /// Length of the current feedback gap: time since the last step with a
+    /// fresh valid sample, ns (0 in a step that had one).
+    pub feedback_gap_ns: u64,
+    /// Content of the feedback-loss bucket (missing time not yet drained),
+    /// ns; the rule trips above `feedback_timeout_ns`. Next to
+    /// `feedback_gap_ns` it tells a dead peer (both large) from intermittent
+    /// loss (a short gap on a full bucket).
+    pub feedback_loss_ns: u64,
+    /// When the feedback-loss rule tripped (HomedStatus cleared, ERR 12 /
+    /// EXERR 40 while homing): the gap at that moment, ns. Cleared when
+    /// homing starts.
+    pub lost_after_ns: Option<u64>,
 }

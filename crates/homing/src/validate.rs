@@ -92,6 +92,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
         true,
     );
     p.number("enable_timeout", cfg.enable_timeout, true);
+    p.number("feedback_loss_drain", cfg.feedback_loss_drain, true);
     if p.number("max_position", cfg.max_position, true) && cfg.max_position == 0.0 {
         p.add("max_position", EX_BAD_NUMBER, "must be positive".into());
     }

@@ -2,9 +2,25 @@
 //!
 //! Feedback is validated before anything looks at it (finite, within
 //! `max_position`); corrupt feedback clears HomedStatus and aborts homing
-//! with ERR 12 / EXERR 41, naming the attribute. A cycle without a usable
-//! sample counts towards feedback loss; too many in a row clear HomedStatus
-//! and abort homing with ERR 12 / EXERR 40.
+//! with ERR 12 / EXERR 41, naming the attribute. A step without a usable
+//! sample counts towards feedback loss ([`loss`](super::loss), a leaky
+//! bucket in time); when that rule trips, HomedStatus is cleared and homing
+//! aborts with ERR 12 / EXERR 40 (`Status::lost_after_ns` says how long the
+//! gap was).
+//!
+//! # During a tolerated gap
+//!
+//! The engine takes no decision on old data: nothing is detected until a
+//! fresh sample arrives (no event from a stale sample), and no profile is
+//! changed: the planned profile just runs on, so a leg that ends by time (a
+//! stop ramp) reaches its end, and the next leg starts on the next fresh
+//! sample. When feedback returns, a sampled switch edge found across the gap
+//! is placed at the midpoint of the samples around it, so its precision
+//! degrades from speed × cycle / 2 to **speed × (gap + cycle) / 2**. Drive
+//! latches (markers, registration) are exact whatever the gap. An index
+//! pulse reported without a latch (`marker_latch = false`) falls in the frame
+//! that was lost: a marker search across a gap can miss it, which is why
+//! such drives should home with a latch or slowly.
 
 use super::{Abort, Axis};
 use crate::codes::*;
@@ -22,6 +38,19 @@ pub(super) struct Sample {
 impl Axis {
     /// This cycle's usable sample, if any.
     pub(super) fn intake(&mut self, now: u64, feedback: Option<&Feedback>) -> Option<Sample> {
+        let dt = self.loss.tick(now);
+        let sample = self.sample(now, feedback);
+        match sample {
+            Some(_) => self.loss.fresh(now, dt, self.cfg.feedback_loss_drain),
+            None => self.missing(now, dt),
+        }
+        self.status.feedback_gap_ns = self.loss.gap(now);
+        self.status.feedback_loss_ns = self.loss.bucket();
+        sample
+    }
+
+    /// The usable sample of this step's feedback, if any.
+    fn sample(&mut self, now: u64, feedback: Option<&Feedback>) -> Option<Sample> {
         if self.cfg.configuration == AxisConfiguration::Virtual {
             // No hardware: the command is the position.
             let (p, v) = self.profile.sample(now);
@@ -37,10 +66,7 @@ impl Axis {
             return Some(self.accept(fb));
         }
         match feedback {
-            None => {
-                self.missing(now);
-                None
-            }
+            None => None,
             Some(fb) => match check_feedback(fb, self.cfg.max_position) {
                 Ok(()) => Some(self.accept(*fb)),
                 Err(attribute) => {
@@ -55,7 +81,6 @@ impl Axis {
                             Abort::Controlled,
                         );
                     }
-                    self.missing(now);
                     None
                 }
             },
@@ -67,18 +92,18 @@ impl Axis {
             fb,
             switch_active: fb.home_switch != self.cfg.home_switch_normally_closed,
         };
-        self.stale = 0;
         self.status.feedback_ok = true;
         self.prev = self.last;
         self.last = Some(s);
         s
     }
 
-    fn missing(&mut self, now: u64) {
-        self.stale = self.stale.saturating_add(1);
-        if self.stale > self.cfg.stale_limit {
+    /// A step without a usable sample, `dt` after the previous step.
+    fn missing(&mut self, now: u64, dt: u64) {
+        if self.loss.missing(dt, self.cfg.feedback_timeout_ns) {
             self.status.feedback_ok = false;
             self.status.homed = false;
+            self.status.lost_after_ns = Some(self.loss.gap(now));
             // Edges across a gap of unknown length mean nothing.
             self.prev = None;
             self.last = None;

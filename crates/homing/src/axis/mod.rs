@@ -29,6 +29,7 @@ mod detect;
 mod intake;
 mod latches;
 mod legs;
+mod loss;
 mod state;
 
 use crate::codes::*;
@@ -41,6 +42,7 @@ use crate::status::Status;
 use crate::validate::{effective_search_limit, validate, ConfigError};
 use intake::Sample;
 use latches::Latches;
+use loss::FeedbackLoss;
 use state::{Run, State};
 
 /// How an abort treats the axis.
@@ -73,7 +75,7 @@ pub struct Axis {
     /// Last two valid samples (`last` is the newest).
     prev: Option<Sample>,
     last: Option<Sample>,
-    stale: u32,
+    loss: FeedbackLoss,
     /// axis position = raw + offset (wrapped on a cyclic axis).
     offset: f64,
     last_command: Command,
@@ -106,7 +108,7 @@ impl Axis {
             latches: Latches::default(),
             prev: None,
             last: None,
-            stale: 0,
+            loss: FeedbackLoss::default(),
             offset: 0.0,
             last_command: cmd,
         }
@@ -202,6 +204,8 @@ impl Axis {
             en: true,
             homed: self.status.homed,
             feedback_ok: self.status.feedback_ok,
+            feedback_gap_ns: self.status.feedback_gap_ns,
+            feedback_loss_ns: self.status.feedback_loss_ns,
             started_ns: now,
             ..Status::default()
         };
