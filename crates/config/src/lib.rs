@@ -296,6 +296,7 @@ fn parse_axis(
         feedback_timeout_ns: u64::from(sup.stale_cycles) * sup.cycle_ns(),
         feedback_loss_drain: d.feedback_loss_drain,
         max_position: r.f64("max_position", d.max_position),
+        max_speed: d.max_speed,
     };
     let sim_table = r.table("sim");
     r.finish();

@@ -14,6 +14,7 @@
 //! | 12   | 41    | *ours* feedback invalid: non-finite or absurd value (the status names the attribute) |
 //! | 12   | 42    | *ours* drive did not report enabled within `enable_timeout` |
 //! | 12   | 43    | *ours* hardware overtravel input tripped during homing |
+//! | 12   | 44    | *ours* feedback implausible: position jump larger than `max_speed` allows between two samples (a forged or corrupt frame; never an event) |
 //! | 41   | 4     | home sequence incompatible with home mode / axis (passive torque, virtual axis moving sequence) |
 //! | 41   | 6     | home speed zero |
 //! | 41   | 7     | home return speed zero |
@@ -30,6 +31,7 @@
 //! | 41   | 30    | *ours* conversion constant not positive |
 //! | 41   | 31    | *ours* home position outside the travel limits |
 //! | 41   | 32    | *ours* travel limits empty or reversed |
+//! | 41   | 34    | *ours* a homing speed the sequence commands is above `max_speed` |
 //! | 1014 | 0     | homing interrupted externally: the wrapper's code, kept for tools that map it; this engine reports every interruption it sees more precisely (a stop request or the supervisor shutting down: 12/1, a shutdown: 12/12, lost feedback: 12/40) |
 //! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
 //! | 1016 | leg | *ours* search limit: a search leg travelled farther than `search_limit`; EXERR names the leg: 2 seek, 5 return, 10 creep (an explicit mapping, kept equal to the numbers these legs' phases had when the code was introduced) |
@@ -58,6 +60,7 @@ pub const EX_FEEDBACK_LOST: u16 = 40;
 pub const EX_FEEDBACK_INVALID: u16 = 41;
 pub const EX_ENABLE_TIMEOUT: u16 = 42;
 pub const EX_OVERTRAVEL: u16 = 43;
+pub const EX_FEEDBACK_IMPLAUSIBLE: u16 = 44;
 
 // EXERR under ERR 41.
 pub const EX_SEQUENCE_INCOMPATIBLE: u16 = 4;
@@ -76,3 +79,4 @@ pub const EX_UNWIND: u16 = 29;
 pub const EX_CONVERSION_CONSTANT: u16 = 30;
 pub const EX_HOME_POSITION_LIMITS: u16 = 31;
 pub const EX_TRAVEL_LIMITS: u16 = 32;
+pub const EX_ABOVE_MAX_SPEED: u16 = 34;

@@ -166,6 +166,12 @@ pub struct AxisConfig {
     pub feedback_loss_drain: f64,
     /// Raw positions beyond ±this (units) are treated as absurd feedback.
     pub max_position: f64,
+    /// The fastest the axis can physically move, units/s: feedback that
+    /// implies more is implausible (a forged or corrupt frame), never an
+    /// event. `0.0` = derive 2 × the fastest homing speed the configured
+    /// sequence commands; a sequence that commands none (passive, immediate)
+    /// then gets no plausibility check. See `validate::effective_max_speed`.
+    pub max_speed: f64,
 }
 
 impl Default for AxisConfig {
@@ -205,6 +211,7 @@ impl Default for AxisConfig {
             feedback_timeout_ns: 10_000_000,
             feedback_loss_drain: 0.25,
             max_position: 1.0e9,
+            max_speed: 0.0,
         }
     }
 }

@@ -26,5 +26,7 @@ pub mod validate;
 pub use axis::Axis;
 pub use config::*;
 pub use io::*;
-pub use status::{Phase, Status};
-pub use validate::{advisories, effective_search_limit, validate, ConfigError};
+pub use status::{Implausible, Phase, Status};
+pub use validate::{
+    advisories, effective_max_speed, effective_search_limit, validate, ConfigError,
+};

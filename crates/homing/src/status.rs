@@ -51,6 +51,22 @@ impl Phase {
     }
 }
 
+/// Feedback refused as implausible, by kind, counted over the axis's life.
+/// Each one is a frame that was forged, corrupt, or from a broken encoder;
+/// none ever became an event.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Implausible {
+    /// Samples whose position moved further since the previous plausible
+    /// one than `max_speed` allows (not used; ERR 12 / EXERR 44 while homing).
+    pub jumps: u32,
+    /// Marker latch positions outside the travel since the latch was armed
+    /// (ignored, latch re-armed).
+    pub marker_latches: u32,
+    /// Registration (switch) latch positions outside the travel since arming
+    /// (ignored: the sampled edge is used).
+    pub switch_latches: u32,
+}
+
 /// Instruction and axis status after a cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Status {
@@ -97,4 +113,6 @@ pub struct Status {
     /// EXERR 40 while homing): the gap at that moment, ns. Cleared when
     /// homing starts.
     pub lost_after_ns: Option<u64>,
+    /// Implausible feedback refused so far.
+    pub implausible: Implausible,
 }

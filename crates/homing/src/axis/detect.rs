@@ -9,9 +9,12 @@
 //!   the switch edge (or on the wrong side of it) is rejected and the latch
 //!   re-armed. This needs marker spacing above ~2 cycles of travel, which any
 //!   sane return speed gives.
-//! * Only a fresh, validated sample is ever looked at (see `intake`).
+//! * Only a fresh, validated sample is ever looked at (see `intake`), and a
+//!   latched position off the travel since arming is ignored (see
+//!   `plausible`).
 
 use super::intake::Sample;
+use super::latches::Travel;
 use super::Axis;
 use crate::plan::Goal;
 
@@ -37,7 +40,7 @@ impl Axis {
             goal,
             Goal::Marker | Goal::SwitchClearThenMarker | Goal::SwitchDetectThenMarker
         ) {
-            self.latches.arm_marker();
+            self.arm_marker();
         }
         if matches!(goal, Goal::SwitchDetect | Goal::SwitchDetectThenMarker) {
             self.arm_switch(true);
@@ -105,7 +108,7 @@ impl Axis {
         match search.edge {
             Some(e) if (m - e) * (s.fb.position - e) >= 0.0 => Some(m),
             _ => {
-                self.latches.arm_marker();
+                self.arm_marker();
                 None
             }
         }
@@ -113,7 +116,9 @@ impl Axis {
 
     /// The marker, if one was passed: the latched position, or for a drive
     /// without a latch the midpoint of the samples around the index pulse.
-    fn marker_seen(&self, prev_pos: f64, s: &Sample) -> Option<f64> {
+    /// A latch off the travel since arming is implausible: counted, ignored,
+    /// and the latch re-armed for the next marker.
+    fn marker_seen(&mut self, prev_pos: f64, s: &Sample) -> Option<f64> {
         if !self.cfg.marker_latch {
             return s
                 .fb
@@ -122,27 +127,59 @@ impl Axis {
         }
         let l = s.fb.marker_latch;
         let id = self.latches.marker_id;
-        (id != 0 && l.id == id && l.latched).then_some(l.position)
+        if !(id != 0 && l.id == id && l.latched) {
+            return None;
+        }
+        let travel = self.latches.marker_travel;
+        if !self.latch_plausible(travel, l.position, s) {
+            let n = &mut self.status.implausible.marker_latches;
+            *n = n.saturating_add(1);
+            self.arm_marker();
+            return None;
+        }
+        Some(l.position)
     }
 
     /// Switch edge position: the registration latch where the drive has one,
-    /// else the midpoint of the samples around the edge.
-    fn edge_position(&self, prev_pos: f64, s: &Sample) -> f64 {
+    /// else the midpoint of the samples around the edge. A latch off the
+    /// travel since arming is implausible: counted and ignored (the sampled
+    /// edge is used).
+    fn edge_position(&mut self, prev_pos: f64, s: &Sample) -> f64 {
+        let midpoint = 0.5 * (prev_pos + s.fb.position);
         let l = s.fb.switch_latch;
         let id = self.latches.switch_id;
-        if self.cfg.registration && id != 0 && l.id == id && l.latched {
-            l.position
-        } else {
-            0.5 * (prev_pos + s.fb.position)
+        if !(self.cfg.registration && id != 0 && l.id == id && l.latched) {
+            return midpoint;
         }
+        if !self.latch_plausible(self.latches.switch_travel, l.position, s) {
+            let n = &mut self.status.implausible.switch_latches;
+            *n = n.saturating_add(1);
+            return midpoint;
+        }
+        l.position
+    }
+
+    /// A latched position lies on the travel seen since arming, give or take
+    /// one step of travel at `max_speed` (no check without a `max_speed`).
+    fn latch_plausible(&self, travel: Option<Travel>, at: f64, s: &Sample) -> bool {
+        match (self.plausible.latch_margin(s.dt_ns), travel) {
+            (Some(margin), Some(t)) => t.covers(at, margin),
+            _ => true,
+        }
+    }
+
+    fn arm_marker(&mut self) {
+        let at = self.last.map(|s| s.fb.position);
+        self.latches.arm_marker(at);
     }
 
     /// Arms the registration latch (if the drive has one) for the electrical
     /// edge of the switch being actuated (`true`) or released (`false`).
     pub(super) fn arm_switch(&mut self, actuated: bool) {
         if self.cfg.registration {
+            let at = self.last.map(|s| s.fb.position);
             self.latches
-                .arm_switch(actuated != self.cfg.home_switch_normally_closed);
+                .arm_switch(actuated != self.cfg.home_switch_normally_closed, at);
         }
     }
 }

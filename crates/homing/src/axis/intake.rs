@@ -2,7 +2,9 @@
 //!
 //! Feedback is validated before anything looks at it (finite, within
 //! `max_position`); corrupt feedback clears HomedStatus and aborts homing
-//! with ERR 12 / EXERR 41, naming the attribute. A step without a usable
+//! with ERR 12 / EXERR 41, naming the attribute. A finite position that
+//! jumped further than the axis can move is refused too
+//! ([`plausible`](super::plausible), ERR 12 / EXERR 44). A step without a usable
 //! sample counts towards feedback loss ([`loss`](super::loss), a leaky
 //! bucket in time); when that rule trips, HomedStatus is cleared and homing
 //! aborts with ERR 12 / EXERR 40 (`Status::lost_after_ns` says how long the
@@ -33,6 +35,8 @@ pub(super) struct Sample {
     pub fb: Feedback,
     /// Logical switch state: actuated, whatever the wiring.
     pub switch_active: bool,
+    /// Time since the previous usable sample, ns (0 for the first).
+    pub dt_ns: u64,
 }
 
 impl Axis {
@@ -63,12 +67,27 @@ impl Axis {
                 },
                 ..Feedback::default()
             };
-            return Some(self.accept(fb));
+            return Some(self.accept(now, fb));
         }
         match feedback {
             None => None,
             Some(fb) => match check_feedback(fb, self.cfg.max_position) {
-                Ok(()) => Some(self.accept(*fb)),
+                Ok(()) if !self.plausible.position(fb.position, now) => {
+                    // A forged or corrupt frame: never used, never an event.
+                    let n = &mut self.status.implausible.jumps;
+                    *n = n.saturating_add(1);
+                    self.status.homed = false;
+                    if self.status.ip {
+                        self.fail(
+                            now,
+                            ERR_SERVO_MESSAGE,
+                            EX_FEEDBACK_IMPLAUSIBLE,
+                            Abort::Controlled,
+                        );
+                    }
+                    None
+                }
+                Ok(()) => Some(self.accept(now, *fb)),
                 Err(attribute) => {
                     self.status.bad_attribute = Some(attribute);
                     // Corrupt feedback: the reference can no longer be trusted.
@@ -87,11 +106,14 @@ impl Axis {
         }
     }
 
-    fn accept(&mut self, fb: Feedback) -> Sample {
+    fn accept(&mut self, now: u64, fb: Feedback) -> Sample {
         let s = Sample {
             fb,
             switch_active: fb.home_switch != self.cfg.home_switch_normally_closed,
+            dt_ns: self.last_sample_ns.map_or(0, |t| now.saturating_sub(t)),
         };
+        self.last_sample_ns = Some(now);
+        self.latches.seen_at(fb.position);
         self.status.feedback_ok = true;
         self.prev = self.last;
         self.last = Some(s);

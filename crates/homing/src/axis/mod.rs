@@ -30,6 +30,7 @@ mod intake;
 mod latches;
 mod legs;
 mod loss;
+mod plausible;
 mod state;
 
 use crate::codes::*;
@@ -43,6 +44,7 @@ use crate::validate::{effective_search_limit, validate, ConfigError};
 use intake::Sample;
 use latches::Latches;
 use loss::FeedbackLoss;
+use plausible::Plausibility;
 use state::{Run, State};
 
 /// How an abort treats the axis.
@@ -75,7 +77,10 @@ pub struct Axis {
     /// Last two valid samples (`last` is the newest).
     prev: Option<Sample>,
     last: Option<Sample>,
+    /// Time of the last usable sample, ns.
+    last_sample_ns: Option<u64>,
     loss: FeedbackLoss,
+    plausible: Plausibility,
     /// axis position = raw + offset (wrapped on a cyclic axis).
     offset: f64,
     last_command: Command,
@@ -108,7 +113,9 @@ impl Axis {
             latches: Latches::default(),
             prev: None,
             last: None,
+            last_sample_ns: None,
             loss: FeedbackLoss::default(),
+            plausible: Plausibility::new(&cfg),
             offset: 0.0,
             last_command: cmd,
         }
@@ -206,6 +213,7 @@ impl Axis {
             feedback_ok: self.status.feedback_ok,
             feedback_gap_ns: self.status.feedback_gap_ns,
             feedback_loss_ns: self.status.feedback_loss_ns,
+            implausible: self.status.implausible,
             started_ns: now,
             ..Status::default()
         };
