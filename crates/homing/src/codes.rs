@@ -35,6 +35,7 @@
 //! | 1014 | 0     | homing interrupted externally: the wrapper's code, kept for tools that map it; this engine reports every interruption it sees more precisely (a stop request or the supervisor shutting down: 12/1, a shutdown: 12/12, lost feedback: 12/40) |
 //! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
 //! | 1016 | leg | *ours* search limit: a search leg travelled farther than `search_limit`; EXERR names the leg: 2 seek, 5 return, 10 creep (an explicit mapping, kept equal to the numbers these legs' phases had when the code was introduced) |
+//! | 1017 | 0     | *ours* gantry skew: the sides of a gantry found their events further apart than `max_skew` (reported by the coordinator through `Request::stop_code`) |
 
 /// Servo message failure.
 pub const ERR_SERVO_MESSAGE: u16 = 12;
@@ -46,6 +47,9 @@ pub const ERR_INTERRUPTED: u16 = 1014;
 pub const ERR_TIMEOUT: u16 = 1015;
 /// Search leg went farther than the search limit (ours).
 pub const ERR_SEARCH_LIMIT: u16 = 1016;
+/// Gantry sides' events further apart than `max_skew` (ours; reported by the
+/// machine coordinator as a stop code).
+pub const ERR_GANTRY_SKEW: u16 = 1017;
 
 // EXERR under ERR 1016: which search leg went too far.
 pub const EX_SEARCH_SEEK: u16 = 2;

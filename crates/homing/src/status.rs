@@ -93,6 +93,24 @@ pub struct Status {
     pub phase: Phase,
     /// Raw position of the home event, once found.
     pub event_raw: Option<f64>,
+    /// Command position (raw) in the cycle the event was detected: where the
+    /// axis latched in the common command frame of a coordinated machine.
+    pub event_command: Option<f64>,
+    /// Raw position of the switch edge found by a switch-then-marker
+    /// sequence (the marker beyond it is the event).
+    pub switch_edge_raw: Option<f64>,
+    /// Index of the current leg in the sequence's [plan](crate::plan) (the
+    /// last one reached, once homing has ended).
+    pub leg: u8,
+    /// At rest at a barrier (`Request::hold`), ready to start leg `leg`.
+    pub waiting: bool,
+    /// While waiting before the move to Home Position: the shortest that move
+    /// can take, ns (0 otherwise, and when there is no move to make).
+    pub min_move_ns: u64,
+    /// Distance travelled in the current (or last) search leg, units: the
+    /// command's for a commanded search, checked against the search limit;
+    /// the actual position's for a passive watch.
+    pub search_travel: f64,
     /// The feedback attribute that was invalid (ERR 12 / EXERR 41).
     pub bad_attribute: Option<&'static str>,
     /// Monotonic time homing started and finished, ns.

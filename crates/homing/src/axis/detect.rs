@@ -77,12 +77,15 @@ impl Axis {
                         return Some(at);
                     }
                     search.edge = Some(at);
+                    self.status.switch_edge_raw = Some(at);
                 }
                 self.marker_after_edge(prev_pos, s, search)
             }
             Goal::SwitchDetectThenMarker => {
                 if detected && search.edge.is_none() {
-                    search.edge = Some(self.edge_position(prev_pos, s));
+                    let at = self.edge_position(prev_pos, s);
+                    search.edge = Some(at);
+                    self.status.switch_edge_raw = Some(at);
                 }
                 self.marker_after_edge(prev_pos, s, search)
             }

@@ -31,7 +31,7 @@ impl Axis {
                 if self.cfg.home_direction.is_unidirectional() {
                     // Establish the event where we stand, then go on if the
                     // unidirectional constraint allows.
-                    self.event(s.fb.position);
+                    self.event(now, s.fb.position);
                     first = 1;
                 } else {
                     // Already on the switch: start with the return leg.
@@ -40,12 +40,45 @@ impl Axis {
             }
         }
         self.state = State::Homing(Homing::new(plan, first));
+        self.enter_leg(now, s);
+    }
+
+    /// The current leg is next: it starts now, unless a coordinator holds the
+    /// axis at the barrier (`Request::hold`) and the leg would start motion
+    /// from rest; then the axis waits there, reporting how long its move home
+    /// would take at least.
+    fn enter_leg(&mut self, now: u64, s: &Sample) {
+        let State::Homing(h) = self.state else {
+            return;
+        };
+        let Some(leg) = h.current() else {
+            return;
+        };
+        let (p, v) = self.profile.sample(now);
+        if self.prev_request.hold && leg.moves() && v == 0.0 {
+            let min_move_ns = self.home_move(&h, leg, p, v).map_or(0, |(target, speed)| {
+                Profile::move_to(
+                    now,
+                    p,
+                    v,
+                    target,
+                    speed,
+                    self.cfg.home_acceleration,
+                    self.cfg.home_deceleration,
+                )
+                .duration_ns()
+            });
+            if let State::Homing(h) = &mut self.state {
+                h.run = Run::Waiting { min_move_ns };
+            }
+            return;
+        }
         self.start_leg(now, s);
     }
 
     /// Starts the current leg of the running sequence (completes it when the
     /// plan is done).
-    fn start_leg(&mut self, now: u64, s: &Sample) {
+    pub(super) fn start_leg(&mut self, now: u64, s: &Sample) {
         let State::Homing(h) = self.state else {
             return;
         };
@@ -89,29 +122,24 @@ impl Axis {
                 self.overrides = false;
                 return self.next_leg(now, s, true);
             }
-            Leg::MoveHome => {
-                let target = self.home_target_bidirectional(p);
-                let inside_stop = h
-                    .hard_stop
-                    .is_some_and(|stop| (target - stop) * self.dir > 0.0);
-                if inside_stop {
-                    // Home Position inside the hard stop: stay; homed, not at HP.
-                    return self.complete(now, false);
-                }
-                self.profile = self.move_to(now, target, self.cfg.home_return_speed);
-                Run::Profile { to_home: true }
-            }
-            Leg::Continue => {
-                let target = self.home_target_unidirectional(p, v);
-                let forward = (target - p) * self.dir >= 0.0;
-                if forward && reaches_without_reversing(p, v, target, self.cfg.home_deceleration) {
-                    self.profile = self.move_to(now, target, self.cfg.home_speed);
+            Leg::MoveHome => match self.home_move(&h, leg, p, v) {
+                // Home Position inside the hard stop: stay; homed, not at HP.
+                None => return self.complete(now, false),
+                Some((target, speed)) => {
+                    self.profile = self.home_profile(now, target, speed);
                     Run::Profile { to_home: true }
-                } else {
+                }
+            },
+            Leg::Continue => match self.home_move(&h, leg, p, v) {
+                Some((target, speed)) => {
+                    self.profile = self.home_profile(now, target, speed);
+                    Run::Profile { to_home: true }
+                }
+                None => {
                     self.profile = Profile::stop(now, p, v, self.cfg.home_deceleration);
                     Run::Profile { to_home: false }
                 }
-            }
+            },
         };
         if let State::Homing(h) = &mut self.state {
             h.run = run;
@@ -128,7 +156,7 @@ impl Axis {
         if h.leg >= h.plan.len() {
             return self.complete(now, pc);
         }
-        self.start_leg(now, s);
+        self.enter_leg(now, s);
     }
 
     /// The current search leg found its goal at raw position `at`.
@@ -142,7 +170,7 @@ impl Axis {
         }
         match find_at(h.plan, h.leg) {
             Find::Rough => h.rough_marker = Some(at),
-            Find::Event => self.event(at),
+            Find::Event => self.event(now, at),
             Find::Waypoint => {}
         }
         self.next_leg(now, s, true);
@@ -159,10 +187,54 @@ impl Axis {
 
     /// The home event at raw position `e`: redefine the axis position so the
     /// event point reads Home Position − Home Offset (spec §3).
-    pub(super) fn event(&mut self, e: f64) {
+    pub(super) fn event(&mut self, now: u64, e: f64) {
         self.status.event_raw = Some(e);
+        self.status.event_command = Some(self.profile.sample(now).0);
         self.offset = self.cfg.home_position - self.cfg.home_offset - e;
         self.latches.disarm();
+    }
+
+    /// The move to Home Position that leg `leg` (move home or continue)
+    /// makes from command state `(p, v)`: target (raw) and speed. `None`: no
+    /// move — Home Position lies inside the hard stop (torque sequences), or
+    /// a unidirectional axis cannot reach it without reversing (it stops).
+    fn home_move(&self, h: &Homing, leg: Leg, p: f64, v: f64) -> Option<(f64, f64)> {
+        match leg {
+            Leg::MoveHome => {
+                let target = self.home_target_bidirectional(p);
+                let inside_stop = h
+                    .hard_stop
+                    .is_some_and(|stop| (target - stop) * self.dir > 0.0);
+                (!inside_stop).then_some((target, self.cfg.home_return_speed))
+            }
+            Leg::Continue => {
+                let target = self.home_target_unidirectional(p, v);
+                let forward = (target - p) * self.dir >= 0.0;
+                (forward && reaches_without_reversing(p, v, target, self.cfg.home_deceleration))
+                    .then_some((target, self.cfg.home_speed))
+            }
+            _ => None,
+        }
+    }
+
+    /// The move to Home Position: time-optimal, or from rest lasting exactly
+    /// `Request::move_duration_ns` when a coordinator asks for it.
+    fn home_profile(&self, now: u64, target: f64, speed: f64) -> Profile {
+        let (p, v) = self.profile.sample(now);
+        let duration = self.prev_request.move_duration_ns;
+        if duration > 0 && v == 0.0 {
+            Profile::move_to_in(
+                now,
+                p,
+                target,
+                duration,
+                speed,
+                self.cfg.home_acceleration,
+                self.cfg.home_deceleration,
+            )
+        } else {
+            self.move_to(now, target, speed)
+        }
     }
 
     /// Home Position of a bidirectional sequence, raw: event + offset, the

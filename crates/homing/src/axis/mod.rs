@@ -167,9 +167,34 @@ impl Axis {
             Some(s) => self.advance(now_ns, &s),
             None => self.advance_blind(now_ns),
         }
+        self.report(now_ns);
+        self.output(now_ns)
+    }
+
+    /// The status fields that describe the state after this step.
+    fn report(&mut self, now: u64) {
         self.status.phase = self.state.phase();
         self.status.stopping = matches!(self.state, State::Stopping { .. });
-        self.output(now_ns)
+        self.status.waiting = false;
+        self.status.min_move_ns = 0;
+        let State::Homing(h) = self.state else {
+            return;
+        };
+        self.status.leg = u8::try_from(h.leg).unwrap_or(u8::MAX);
+        match (h.run, h.current()) {
+            (Run::Waiting { min_move_ns }, _) => {
+                self.status.waiting = true;
+                self.status.min_move_ns = min_move_ns;
+            }
+            (Run::Search(search), Some(Leg::Watch(_))) => {
+                let actual = self.last.map_or(search.start, |s| s.fb.position);
+                self.status.search_travel = (actual - search.start).abs();
+            }
+            (Run::Search(search), _) => {
+                self.status.search_travel = (self.profile.sample(now).0 - search.start).abs();
+            }
+            (Run::Profile { .. }, _) => {}
+        }
     }
 
     // ------------------------------------------------------------------
@@ -187,12 +212,10 @@ impl Axis {
             self.status.homed = false;
         }
         if req.stop && !prev.stop && self.status.ip {
-            self.fail(
-                now,
-                ERR_SERVO_MESSAGE,
-                EX_TERMINATED_ON_REQUEST,
-                Abort::Controlled,
-            );
+            let (err, exerr) = req
+                .stop_code
+                .unwrap_or((ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST));
+            self.fail(now, err, exerr, Abort::Controlled);
         }
         if req.home && !prev.home {
             self.start(now, req.shutdown);
@@ -313,6 +336,8 @@ impl Axis {
                 }
                 Run::Profile { to_home } if done => self.profile_done(now, s, to_home),
                 Run::Profile { .. } => {}
+                Run::Waiting { .. } if !self.prev_request.hold => self.start_leg(now, s),
+                Run::Waiting { .. } => {}
             },
             State::Stopping { released } if done => {
                 if self.overrides && !released {

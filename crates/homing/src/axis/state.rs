@@ -41,6 +41,10 @@ pub(super) struct Homing {
 /// What the current leg is doing.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Run {
+    /// At rest, held at the barrier (`Request::hold`) before the leg starts.
+    /// `min_move_ns`: the shortest the leg's move to Home Position can take
+    /// (0 for other legs).
+    Waiting { min_move_ns: u64 },
     /// Searching for the leg's goal.
     Search(Search),
     /// Following the leg's profile to its end. `to_home`: the profile ends at
@@ -73,7 +77,8 @@ impl State {
             State::Enabling { .. } => Phase::Enabling,
             State::Stopping { .. } => Phase::Stopping,
             State::Homing(h) => {
-                let to_home = matches!(h.run, Run::Profile { to_home: true });
+                // Waiting before a continue leg: it will move to Home Position.
+                let to_home = matches!(h.run, Run::Profile { to_home: true } | Run::Waiting { .. });
                 phase_of(h.plan, h.leg, to_home)
             }
         }
