@@ -267,6 +267,7 @@ fn parse_axis(
         marker: r.bool("marker", false),
         marker_latch: r.bool("marker_latch", true),
         registration: r.bool("registration", false),
+        absolute: r.bool("absolute", false),
         travel_limits: r.pair("travel_limits"),
         home_mode: r.choice("home_mode", names::HOME_MODES, HM::Active),
         home_direction: r.choice(

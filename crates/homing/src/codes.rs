@@ -15,7 +15,7 @@
 //! | 12   | 42    | *ours* drive did not report enabled within `enable_timeout` |
 //! | 12   | 43    | *ours* hardware overtravel input tripped during homing |
 //! | 12   | 44    | *ours* feedback implausible: position jump larger than `max_speed` allows between two samples (a forged or corrupt frame; never an event) |
-//! | 41   | 4     | home sequence incompatible with home mode / axis (passive torque, virtual axis moving sequence) |
+//! | 41   | 4     | home sequence incompatible with home mode / axis (passive torque, virtual axis moving sequence, absolute mode with a sequence other than immediate) |
 //! | 41   | 6     | home speed zero |
 //! | 41   | 7     | home return speed zero |
 //! | 41   | 20    | *ours* active home mode on a feedback-only axis |
@@ -31,6 +31,7 @@
 //! | 41   | 30    | *ours* conversion constant not positive |
 //! | 41   | 31    | *ours* home position outside the travel limits |
 //! | 41   | 32    | *ours* travel limits empty or reversed |
+//! | 41   | 33    | *ours* absolute home mode on a non-absolute feedback device |
 //! | 41   | 34    | *ours* a homing speed the sequence commands is above `max_speed` |
 //! | 1014 | 0     | homing interrupted externally: the wrapper's code, kept for tools that map it; this engine reports every interruption it sees more precisely (a stop request or the supervisor shutting down: 12/1, a shutdown: 12/12, lost feedback: 12/40) |
 //! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
@@ -83,4 +84,5 @@ pub const EX_UNWIND: u16 = 29;
 pub const EX_CONVERSION_CONSTANT: u16 = 30;
 pub const EX_HOME_POSITION_LIMITS: u16 = 31;
 pub const EX_TRAVEL_LIMITS: u16 = 32;
+pub const EX_ABSOLUTE_NOT_ABSOLUTE: u16 = 33;
 pub const EX_ABOVE_MAX_SPEED: u16 = 34;

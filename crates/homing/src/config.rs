@@ -31,11 +31,16 @@ pub enum TravelMode {
     Cyclic,
 }
 
-/// Home Mode attribute: 0 Passive, 1 Active.
+/// Home Mode attribute: 0 Passive, 1 Active; and the MAH instruction's
+/// Absolute mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HomeMode {
     Passive,
     Active,
+    /// An absolute feedback device: sequence Immediate only, no motion; the
+    /// reference (the raw → axis offset) is stored by the supervisor and
+    /// restored at start-up with [`Axis::restore_reference`](crate::Axis::restore_reference).
+    Absolute,
 }
 
 /// Home Direction attribute (0..=3 in CIP order).
@@ -113,6 +118,10 @@ pub struct AxisConfig {
     pub marker_latch: bool,
     /// The drive latches its position on the home switch edge (registration).
     pub registration: bool,
+    /// The feedback device keeps its position over power cycles (an absolute
+    /// encoder): a stored reference stays valid, and Absolute home mode is
+    /// possible.
+    pub absolute: bool,
     /// Maximum negative / positive travel in axis coordinates, if known.
     pub travel_limits: Option<(f64, f64)>,
 
@@ -187,6 +196,7 @@ impl Default for AxisConfig {
             marker: false,
             marker_latch: true,
             registration: false,
+            absolute: false,
             travel_limits: None,
             home_mode: HomeMode::Active,
             home_direction: HomeDirection::BidirectionalForward,

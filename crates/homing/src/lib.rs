@@ -23,7 +23,7 @@ pub mod profile;
 pub mod status;
 pub mod validate;
 
-pub use axis::Axis;
+pub use axis::{Axis, RestoreRefusal};
 pub use config::*;
 pub use io::*;
 pub use status::{Implausible, Phase, Status};

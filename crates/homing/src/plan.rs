@@ -14,8 +14,8 @@
 //! | torque then marker | seek torque, stop, release, return to marker (event), stop, restore, move home |
 //! | unidirectional switch / marker / switch then marker | seek event, continue (on to Home Position, or stop) |
 //!
-//! A passive sequence watches for its event (one leg); Immediate (and
-//! Absolute) have no legs at all.
+//! A passive sequence watches for its event (one leg); Immediate, and the
+//! Absolute home mode (immediate only), have no legs at all.
 //!
 //! **Creep** (the seek / back-off / creep scheme, for drives without a marker
 //! latch): a marker found at speed is only *rough*; the plan stops past it
@@ -162,10 +162,11 @@ const TORQUE_MARKER_CREEP: &[Leg] = &[
 /// torque) still get a plan, so the function is total; they never run.
 pub fn plan(seq: HomeSequence, dir: HomeDirection, mode: HomeMode, creep: bool) -> &'static [Leg] {
     use HomeSequence as S;
-    if seq == S::Immediate {
+    if seq == S::Immediate || mode == HomeMode::Absolute {
         return &[];
     }
     match mode {
+        HomeMode::Absolute => &[],
         HomeMode::Passive => match seq {
             S::Switch => PASSIVE_SWITCH,
             S::SwitchThenMarker => PASSIVE_SWITCH_MARKER,

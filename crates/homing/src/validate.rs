@@ -155,6 +155,24 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
 
     let seq = cfg.home_sequence;
     let active = cfg.home_mode == HomeMode::Active;
+    let passive = cfg.home_mode == HomeMode::Passive;
+
+    if cfg.home_mode == HomeMode::Absolute {
+        if seq != HomeSequence::Immediate {
+            p.add(
+                "home_sequence",
+                EX_SEQUENCE_INCOMPATIBLE,
+                "absolute home mode takes the immediate sequence only".into(),
+            );
+        }
+        if !cfg.absolute {
+            p.add(
+                "home_mode",
+                EX_ABSOLUTE_NOT_ABSOLUTE,
+                "absolute home mode on a non-absolute feedback device (absolute = false)".into(),
+            );
+        }
+    }
 
     if active && cfg.configuration == AxisConfiguration::FeedbackOnly {
         p.add(
@@ -170,7 +188,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
             "a virtual axis has no switch, marker or drive: only immediate homing applies".into(),
         );
     }
-    if !active && seq.uses_torque() {
+    if passive && seq.uses_torque() {
         p.add(
             "home_sequence",
             EX_SEQUENCE_INCOMPATIBLE,

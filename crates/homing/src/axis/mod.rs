@@ -31,6 +31,7 @@ mod latches;
 mod legs;
 mod loss;
 mod plausible;
+mod reference;
 mod state;
 
 use crate::codes::*;
@@ -45,6 +46,7 @@ use intake::Sample;
 use latches::Latches;
 use loss::FeedbackLoss;
 use plausible::Plausibility;
+pub use reference::RestoreRefusal;
 use state::{Run, State};
 
 /// How an abort treats the axis.
@@ -253,14 +255,18 @@ impl Axis {
         self.status.homing = true;
         self.status.homed = false;
 
-        if self.cfg.home_sequence == HomeSequence::Immediate {
+        if self.cfg.home_sequence == HomeSequence::Immediate
+            || self.cfg.home_mode == HomeMode::Absolute
+        {
             // Actual and command position become Home Position: nothing moves,
-            // the reference is redefined. Home Offset does not apply.
+            // the reference is redefined from the raw (encoder) position —
+            // never from the axis position, so homing again never adds an
+            // offset twice. Home Offset does not apply.
             self.offset = self.cfg.home_position - s.fb.position;
             return self.complete(now, true);
         }
         match self.cfg.home_mode {
-            HomeMode::Passive => self.begin(now, &s),
+            HomeMode::Passive | HomeMode::Absolute => self.begin(now, &s),
             HomeMode::Active => {
                 self.enable = true;
                 if s.fb.drive.enabled && !s.fb.drive.fault {
