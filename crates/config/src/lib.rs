@@ -298,6 +298,8 @@ fn parse_axis(
         feedback_loss_drain: d.feedback_loss_drain,
         max_position: r.f64("max_position", d.max_position),
         max_speed: d.max_speed,
+        marker_min_distance: d.marker_min_distance,
+        refuse_ambiguous_marker: d.refuse_ambiguous_marker,
     };
     let sim_table = r.table("sim");
     r.finish();

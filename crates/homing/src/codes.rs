@@ -37,6 +37,7 @@
 //! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
 //! | 1016 | leg | *ours* search limit: a search leg travelled farther than `search_limit`; EXERR names the leg: 2 seek, 5 return, 10 creep (an explicit mapping, kept equal to the numbers these legs' phases had when the code was introduced) |
 //! | 1017 | 0     | *ours* gantry skew: the sides of a gantry found their events further apart than `max_skew` (reported by the coordinator through `Request::stop_code`) |
+//! | 1018 | 0     | *ours* ambiguous marker: switch then marker found its marker closer than `marker_min_distance` to the switch edge, and `refuse_ambiguous_marker` is set (axis stopped, not homed) |
 
 /// Servo message failure.
 pub const ERR_SERVO_MESSAGE: u16 = 12;
@@ -51,6 +52,8 @@ pub const ERR_SEARCH_LIMIT: u16 = 1016;
 /// Gantry sides' events further apart than `max_skew` (ours; reported by the
 /// machine coordinator as a stop code).
 pub const ERR_GANTRY_SKEW: u16 = 1017;
+/// Marker too close to the switch edge, refused (ours).
+pub const ERR_AMBIGUOUS_MARKER: u16 = 1018;
 
 // EXERR under ERR 1016: which search leg went too far.
 pub const EX_SEARCH_SEEK: u16 = 2;

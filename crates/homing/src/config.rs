@@ -181,6 +181,15 @@ pub struct AxisConfig {
     /// sequence commands; a sequence that commands none (passive, immediate)
     /// then gets no plausibility check. See `validate::effective_max_speed`.
     pub max_speed: f64,
+    /// Switch-then-marker: a marker closer than this (units) to the switch
+    /// edge is ambiguous — with the edge's sampling error (and switch
+    /// repeatability) it may be the marker before or after the one intended,
+    /// which moves the reference by a whole marker spacing from one homing to
+    /// the next. `0.0` = no check. See `refuse_ambiguous_marker`.
+    pub marker_min_distance: f64,
+    /// An ambiguous marker fails homing (ERR 1018) instead of completing with
+    /// the `Status::ambiguous_marker` warning.
+    pub refuse_ambiguous_marker: bool,
 }
 
 impl Default for AxisConfig {
@@ -222,6 +231,8 @@ impl Default for AxisConfig {
             feedback_loss_drain: 0.25,
             max_position: 1.0e9,
             max_speed: 0.0,
+            marker_min_distance: 0.0,
+            refuse_ambiguous_marker: false,
         }
     }
 }

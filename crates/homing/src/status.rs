@@ -99,6 +99,10 @@ pub struct Status {
     /// Raw position of the switch edge found by a switch-then-marker
     /// sequence (the marker beyond it is the event).
     pub switch_edge_raw: Option<f64>,
+    /// Warning: the marker of a switch-then-marker sequence lay closer than
+    /// `marker_min_distance` to the switch edge (homing completed; with
+    /// `refuse_ambiguous_marker` it fails with ERR 1018 instead).
+    pub ambiguous_marker: bool,
     /// Index of the current leg in the sequence's [plan](crate::plan) (the
     /// last one reached, once homing has ended).
     pub leg: u8,

@@ -95,6 +95,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
     p.number("enable_timeout", cfg.enable_timeout, true);
     p.number("feedback_loss_drain", cfg.feedback_loss_drain, true);
     let max_speed_ok = p.number("max_speed", cfg.max_speed, true);
+    p.number("marker_min_distance", cfg.marker_min_distance, true);
     if p.number("max_position", cfg.max_position, true) && cfg.max_position == 0.0 {
         p.add("max_position", EX_BAD_NUMBER, "must be positive".into());
     }

@@ -12,7 +12,8 @@
 
 use super::intake::Sample;
 use super::state::{Homing, Run, State};
-use super::Axis;
+use super::{Abort, Axis};
+use crate::codes::ERR_AMBIGUOUS_MARKER;
 use crate::config::{HomeMode, TravelMode};
 use crate::plan::{find_at, first_return, plan_for, Find, Goal, Leg};
 use crate::position::{ahead_cyclic, nearest_cyclic};
@@ -170,10 +171,29 @@ impl Axis {
         }
         match find_at(h.plan, h.leg) {
             Find::Rough => h.rough_marker = Some(at),
+            Find::Event if self.refuses_marker(at) => {
+                return self.fail(now, ERR_AMBIGUOUS_MARKER, 0, Abort::Controlled);
+            }
             Find::Event => self.event(now, at),
             Find::Waypoint => {}
         }
         self.next_leg(now, s, true);
+    }
+
+    /// Switch then marker: a marker closer than `marker_min_distance` to the
+    /// switch edge is ambiguous (the edge's own uncertainty could put the
+    /// neighbouring marker first). Sets the warning; true when the
+    /// configuration refuses it.
+    fn refuses_marker(&mut self, marker: f64) -> bool {
+        let Some(edge) = self.status.switch_edge_raw else {
+            return false;
+        };
+        let min = self.cfg.marker_min_distance;
+        if !(min > 0.0 && (marker - edge).abs() < min) {
+            return false;
+        }
+        self.status.ambiguous_marker = true;
+        self.cfg.refuse_ambiguous_marker
     }
 
     /// The current profile leg reached its end.
