@@ -6,12 +6,17 @@
 //! is tested cycle by cycle against the plant model in `motion-plant`.
 //!
 //! * [`config`]: the homing attributes (spec §2) and axis facts.
-//! * [`validate`]: every configuration problem at once, with CIP codes.
+//! * [`validate`](mod@validate): every configuration problem at once, with CIP codes.
 //! * [`plan`]: every sequence as one ordered list of legs.
-//! * [`axis`]: the state machine that runs a plan, for every active and passive sequence.
+//! * [`axis`]: the state machine that runs a plan, for every active and
+//!   passive sequence; feedback trust (loss in time, plausibility); the
+//!   stored reference of absolute axes.
 //! * [`profile`]: jog / stop / trapezoid profiles that never exceed their limits.
 //! * [`codes`]: the ERR / EXERR table.
-//! * [`io`]: the per-cycle feedback, command and request types.
+//! * [`io`]: the per-cycle feedback, command and request types (with the
+//!   coordination hooks a machine coordinator uses for gantries and home
+//!   order: barrier, timed final move, stop code).
+//! * [`status`]: the instruction's and the axis's status after a cycle.
 
 pub mod axis;
 pub mod codes;

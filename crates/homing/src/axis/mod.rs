@@ -6,21 +6,31 @@
 //! commands, so a test can drive it cycle by cycle against a plant model.
 //!
 //! The machine runs the legs of its sequence's [plan](crate::plan) in order;
-//! its [`State`](state::State) carries only what the current phase needs.
+//! its state (`state.rs`) carries only what the current phase needs.
 //! Where the rest lives:
 //!
-//! * [`intake`]: which feedback may be used at all;
-//! * [`detect`]: finding a search leg's goal (events and their precision);
-//! * [`legs`]: starting each leg, what its find means, what follows it;
-//! * this file: requests (start, stop, shutdown), aborts, completion, and the
-//!   command written each cycle.
+//! * `intake`: which feedback may be used at all, with `loss` (the
+//!   feedback-loss rule, a leaky bucket in time) and `plausible` (forged or
+//!   corrupt frames never become an event);
+//! * `detect`: finding a search leg's goal (events and their precision);
+//! * `legs`: starting each leg (or holding at a coordinator's barrier),
+//!   what its find means, what follows it;
+//! * `reference`: the stored reference of an absolute axis;
+//! * this file: requests (start, stop, shutdown), aborts, completion, the
+//!   status and the command written each cycle.
 //!
 //! Design notes a reviewer will look for:
 //!
 //! * **Commands never come from unchecked feedback.** The command is sampled
 //!   from a profile planned from the previous command state; the actual
 //!   position only enters as a hold / release target after validation.
-//! * **Aborts** (stop, timeout, search limit, lost or invalid feedback) stop
+//! * **Coordination.** Each axis is its own engine; a coordinator (gantry
+//!   sides, home order) synchronises them only through `Request::hold` (a
+//!   barrier at rest before each leg that moves), `move_duration_ns` (a
+//!   final move of a given length) and `stop_code`, and reads `Status::leg`,
+//!   `waiting`, `min_move_ns`. Nothing here knows about other axes.
+//! * **Aborts** (stop, timeout, search limit, lost, invalid or implausible
+//!   feedback, an ambiguous marker when refused) stop
 //!   the axis at Home Deceleration with the overrides still in force, release
 //!   if needed, then restore. A drive fault or shutdown cannot be stopped by
 //!   us: the drive is disabled and the overrides restored at once.
