@@ -72,6 +72,8 @@ impl Axis {
             if let State::Homing(h) = &mut self.state {
                 h.run = Run::Waiting { min_move_ns };
             }
+            // At rest: hold exactly here, whatever profile brought the axis.
+            self.profile = Profile::hold(now, p);
             return;
         }
         self.start_leg(now, s);
