@@ -44,7 +44,8 @@ pub struct SupervisorConfig {
     pub io: IoMode,
     pub service_prefix: String,
     /// Missing-feedback cycles tolerated during homing (engine
-    /// `feedback_timeout_ns` = this × the cycle).
+    /// `feedback_timeout_ns` = the larger of its 10 ms default and this × the
+    /// cycle).
     pub stale_cycles: u32,
     /// Missing-command cycles after which `motion-io` stops every axis.
     pub io_watchdog_cycles: u32,
@@ -293,8 +294,11 @@ fn parse_axis(
         position_error_tolerance: r.f64("position_error_tolerance", 0.0),
         velocity_error_tolerance: r.f64("velocity_error_tolerance", 0.0),
         enable_timeout: r.f64("enable_timeout", d.enable_timeout),
-        // `stale_cycles` keeps its meaning: that many cycles of missing feedback.
-        feedback_timeout_ns: u64::from(sup.stale_cycles) * sup.cycle_ns(),
+        // The engine's rule is in time (default 10 ms at any rate); a larger
+        // `stale_cycles` still makes it at least that many cycles tolerant.
+        feedback_timeout_ns: d
+            .feedback_timeout_ns
+            .max(u64::from(sup.stale_cycles) * sup.cycle_ns()),
         feedback_loss_drain: d.feedback_loss_drain,
         max_position: r.f64("max_position", d.max_position),
         max_speed: d.max_speed,
