@@ -14,7 +14,7 @@
 //! | 12   | 41    | *ours* feedback invalid: non-finite or absurd value (the status names the attribute) |
 //! | 12   | 42    | *ours* drive did not report enabled within `enable_timeout` |
 //! | 12   | 43    | *ours* hardware overtravel input tripped during homing |
-//! | 12   | 44    | *ours* feedback implausible: position jump larger than `max_speed` allows between two samples (a forged or corrupt frame; never an event) |
+//! | 12   | 44    | *ours* feedback implausible: a position further than `max_speed` allows from where the axis was last seen or has been commanded since (a forged or corrupt frame; never an event) |
 //! | 41   | 4     | home sequence incompatible with home mode / axis (passive torque, virtual axis moving sequence, absolute mode with a sequence other than immediate) |
 //! | 41   | 6     | home speed zero |
 //! | 41   | 7     | home return speed zero |

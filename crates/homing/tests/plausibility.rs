@@ -303,3 +303,42 @@ fn max_speed_derivation_and_validation() {
         [("max_speed", 41, EX_BAD_NUMBER)]
     );
 }
+
+#[test]
+fn lagging_feedback_catching_up_and_a_stalled_cycle_are_plausible() {
+    // The engine only knows when it steps, not when a frame was sampled.
+    // Bidirectional switch seek at V = 20 (0.02 per cycle), max_speed 40.
+    //
+    // 1. A lagging peer: steps 1000..=1008 get frames still showing the
+    //    plant as at step 999, step 1009 the current one: 10 cycles of travel
+    //    (0.2) in 1 ms, against 40 x 0.001 x 1.5 + 0.002 = 0.062 from the
+    //    last sample; but every position on the way was commanded.
+    // 2. A stalled cycle: step 2000 comes 10 ms after step 1999, so the
+    //    command jumps 0.2 and the plant follows in that step; step 2001 (1 ms
+    //    later) sees it.
+    let cfg = axis(HomeSequence::Switch, HomeDirection::BidirectionalForward);
+    let mut axis = Axis::new(cfg);
+    let mut plant = Plant::new(machine());
+    let req = Request {
+        home: true,
+        ..Request::default()
+    };
+    let mut frames = vec![plant.feedback()];
+    let mut now = 0;
+    for k in 0..8000usize {
+        now += if k == 2000 { 10 * MS } else { MS };
+        let seen = if (1000..1009).contains(&k) {
+            frames[999]
+        } else {
+            frames[k]
+        };
+        let cmd = axis.step(now, Some(&seen), &req);
+        frames.push(plant.step(&cmd, 0.001));
+        if k == 1009 {
+            assert!((seen.position - frames[999].position - 0.2).abs() < 1e-9);
+        }
+    }
+    let s = axis.status();
+    assert_eq!(s.implausible, Implausible::default(), "{s:?}");
+    assert!(s.pc && s.event_raw.unwrap().abs() <= 0.001 + 1e-9, "{s:?}");
+}

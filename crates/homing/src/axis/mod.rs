@@ -502,6 +502,7 @@ impl Axis {
             },
         };
         self.last_command = cmd;
+        self.plausible.commanded(cmd.position);
         cmd
     }
 }

@@ -4,16 +4,23 @@
 //! cannot move faster than `max_speed` (see
 //! [`effective_max_speed`](crate::validate::effective_max_speed)), so:
 //!
-//! * **Jumps.** A position that moved further since the last plausible sample
-//!   than `max_speed × elapsed × 1.5 + 2 counts` is refused: the sample is not
-//!   used (it counts as missing feedback), HomedStatus is cleared, and homing
-//!   aborts with ERR 12 / EXERR 44. The reference stays the last *plausible*
-//!   sample, so one forged frame does not make the genuine next one look like
-//!   a jump back; `elapsed` runs from that sample, so a gap widens the bound
-//!   as it should. The 1.5 and the 2 counts absorb frame-timing jitter and
-//!   quantisation. A real jump (an encoder re-referenced by its drive) looks
-//!   the same: its samples are refused until the bound has grown past it, and
-//!   meanwhile the feedback-loss rule trips; the axis must be homed again.
+//! * **Jumps.** A position further than `max_speed × elapsed × 1.5 + 2 counts`
+//!   from where the axis can be is refused: the sample is not used (it counts
+//!   as missing feedback), HomedStatus is cleared, and homing aborts with ERR
+//!   12 / EXERR 44. *Where the axis can be* is the last plausible sample and,
+//!   for an axis that follows its command, every position commanded since:
+//!   feedback answers an earlier command with a lag that varies (a starved
+//!   I/O process catches up by several cycles in one, a stalled cycle makes
+//!   the command itself jump), so the pure sample-to-sample bound would
+//!   refuse genuine frames — it did, in the end-to-end runs. A frame that
+//!   claims a place the axis was neither seen at nor sent to is still
+//!   refused. `elapsed` runs from the last plausible sample, so a gap widens
+//!   the bound as it should, and one forged frame does not make the genuine
+//!   next one look like a jump back. The 1.5 and the 2 counts absorb timing
+//!   jitter and quantisation. A real jump (an encoder re-referenced by its
+//!   drive) looks the same: its samples are refused until the bound has
+//!   grown past it, and meanwhile the feedback-loss rule trips; the axis must
+//!   be homed again.
 //! * **Latches.** A latched position must lie on the travel seen since the
 //!   latch was armed, give or take one step of travel at `max_speed` (plus 2
 //!   counts); one that does not is counted and ignored (see `detect`).
@@ -30,8 +37,13 @@ pub(super) struct Plausibility {
     max_speed: Option<f64>,
     /// Two counts, in units.
     quantum: f64,
-    /// Position and time (ns) of the last plausible sample.
-    reference: Option<(f64, u64)>,
+    /// Time (ns) of the last plausible sample.
+    since: Option<u64>,
+    /// Where the axis can have been since then: the last plausible sample's
+    /// position and every command sent from the one before it on.
+    span: Option<(f64, f64)>,
+    /// The last command sent.
+    last_command: Option<f64>,
 }
 
 impl Plausibility {
@@ -44,21 +56,35 @@ impl Plausibility {
         Self {
             max_speed: effective_max_speed(cfg),
             quantum,
-            reference: None,
+            since: None,
+            span: None,
+            last_command: None,
         }
     }
 
-    /// Checks a (finite) position sampled at `now`; a plausible one becomes
-    /// the new reference.
+    /// Checks a (finite) position sampled at `now`; a plausible one starts
+    /// the span anew.
     pub fn position(&mut self, p: f64, now: u64) -> bool {
-        if let (Some(v), Some((p0, t0))) = (self.max_speed, self.reference) {
+        if let (Some(v), Some(t0), Some((lo, hi))) = (self.max_speed, self.since, self.span) {
             let elapsed = now.saturating_sub(t0) as f64 * 1e-9;
-            if (p - p0).abs() > v * elapsed * 1.5 + self.quantum {
+            let bound = v * elapsed * 1.5 + self.quantum;
+            if p < lo - bound || p > hi + bound {
                 return false;
             }
         }
-        self.reference = Some((p, now));
+        self.since = Some(now);
+        let c = self.last_command.unwrap_or(p);
+        self.span = Some((p.min(c), p.max(c)));
         true
+    }
+
+    /// A command was sent: the axis may go there.
+    pub fn commanded(&mut self, c: f64) {
+        self.last_command = Some(c);
+        if let Some((lo, hi)) = &mut self.span {
+            *lo = lo.min(c);
+            *hi = hi.max(c);
+        }
     }
 
     /// How far a latch may lie outside the travel seen since its arming,
@@ -95,6 +121,27 @@ mod tests {
         assert!(c.position(0.0169 + 0.0171, 3 * MS));
         assert!(!c.position(1.0, 4 * MS));
         assert!(c.position(0.034 + 0.0169, 4 * MS), "back on track");
+    }
+
+    #[test]
+    fn commanded_positions_are_plausible_whatever_the_lag() {
+        // Feedback lagging 9 cycles behind a 90 u/s command, then catching up
+        // in one: 0.81 in 1 ms, far beyond 180 x 0.001 x 1.5 + 0.002 = 0.272,
+        // but the command went there.
+        let mut c = checker(180.0);
+        c.commanded(0.0);
+        assert!(c.position(0.0, 0));
+        for k in 1..=9 {
+            c.commanded(0.09 * f64::from(k));
+        }
+        assert!(c.position(0.81, MS));
+        // A place neither seen nor commanded is refused.
+        c.commanded(0.9);
+        assert!(!c.position(5.0, 2 * MS));
+        // The span starts anew from each plausible sample (here 0.9, also the
+        // last command): 0.3 further in 1 ms is above 0.272.
+        assert!(c.position(0.9, 3 * MS));
+        assert!(!c.position(1.2, 4 * MS));
     }
 
     #[test]
