@@ -121,9 +121,25 @@ pub(crate) fn parse(
         position_error_tolerance: r.f64_in("position_error_tolerance", 0.0, 0.0, POSITION, "units"),
         velocity_error_tolerance: r.f64_in("velocity_error_tolerance", 0.0, 0.0, SPEED, "units/s"),
         enable_timeout: r.f64_in("enable_timeout", d.enable_timeout, 1e-3, SHORT_TIME_S, "s"),
-        stale_limit: (sup.feedback_timeout_ms / cycle_ms).ceil().max(1.0) as u32,
+        feedback_timeout_ns: sup.feedback_timeout_ns(),
+        feedback_loss_drain: sup.feedback_loss_drain,
         max_position,
+        absolute: r.bool("absolute", false),
+        max_speed: r.f64_in("max_speed", 0.0, 0.0, SPEED, "units/s"),
+        marker_min_distance: 0.0,
+        refuse_ambiguous_marker: r.bool("refuse_ambiguous_marker", false),
     };
+    let mut engine = engine;
+    // A switch edge sampled once per cycle is known to a cycle of travel at
+    // return speed; a marker closer than two such cycles to it is ambiguous.
+    // The default check uses exactly that distance.
+    engine.marker_min_distance = r.f64_in(
+        "marker_min_distance",
+        2.0 * engine.home_return_speed * cycle_ms / 1000.0,
+        0.0,
+        POSITION,
+        "units",
+    );
     let ethercat = parse_ethercat(&mut r, &engine, ios.get(io));
     let sim_table = r.table("sim");
     r.finish();

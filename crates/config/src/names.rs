@@ -17,7 +17,11 @@ pub const CONTROL_MODES: &[(&str, CM)] = &[
     ("torque", CM::Torque),
 ];
 pub const TRAVEL_MODES: &[(&str, TM)] = &[("linear", TM::Linear), ("cyclic", TM::Cyclic)];
-pub const HOME_MODES: &[(&str, HM)] = &[("active", HM::Active), ("passive", HM::Passive)];
+pub const HOME_MODES: &[(&str, HM)] = &[
+    ("active", HM::Active),
+    ("passive", HM::Passive),
+    ("absolute", HM::Absolute),
+];
 pub const HOME_DIRECTIONS: &[(&str, HD)] = &[
     ("unidirectional_forward", HD::UnidirectionalForward),
     ("bidirectional_forward", HD::BidirectionalForward),

@@ -31,11 +31,16 @@ pub enum TravelMode {
     Cyclic,
 }
 
-/// Home Mode attribute: 0 Passive, 1 Active.
+/// Home Mode attribute: 0 Passive, 1 Active; and the MAH instruction's
+/// Absolute mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HomeMode {
     Passive,
     Active,
+    /// An absolute feedback device: sequence Immediate only, no motion; the
+    /// reference (the raw → axis offset) is stored by the supervisor and
+    /// restored at start-up with [`Axis::restore_reference`](crate::Axis::restore_reference).
+    Absolute,
 }
 
 /// Home Direction attribute (0..=3 in CIP order).
@@ -113,6 +118,10 @@ pub struct AxisConfig {
     pub marker_latch: bool,
     /// The drive latches its position on the home switch edge (registration).
     pub registration: bool,
+    /// The feedback device keeps its position over power cycles (an absolute
+    /// encoder): a stored reference stays valid, and Absolute home mode is
+    /// possible.
+    pub absolute: bool,
     /// Maximum negative / positive travel in axis coordinates, if known.
     pub travel_limits: Option<(f64, f64)>,
 
@@ -153,10 +162,34 @@ pub struct AxisConfig {
     pub velocity_error_tolerance: f64,
     /// Time the drive gets to report "enabled" after an active start (s).
     pub enable_timeout: f64,
-    /// Consecutive cycles without fresh feedback tolerated during homing.
-    pub stale_limit: u32,
+    /// Feedback-loss rule, stated in time so it means the same at any cycle
+    /// rate: a leaky bucket of missing-feedback time. Every step without a
+    /// fresh valid sample adds the time since the previous step; every step
+    /// with one drains `feedback_loss_drain` x that time. The rule trips when
+    /// the bucket holds more than this (ns): a dead peer trips within this
+    /// plus one cycle, an isolated gap shorter than this never trips.
+    pub feedback_timeout_ns: u64,
+    /// Drain rate of the feedback-loss bucket per unit of time with fresh
+    /// feedback. With `d`, sustained loss of more than `d / (1 + d)` of the
+    /// cycles trips eventually (0.25: above 20 %).
+    pub feedback_loss_drain: f64,
     /// Raw positions beyond ±this (units) are treated as absurd feedback.
     pub max_position: f64,
+    /// The fastest the axis can physically move, units/s: feedback that
+    /// implies more is implausible (a forged or corrupt frame), never an
+    /// event. `0.0` = derive 2 × the fastest homing speed the configured
+    /// sequence commands; a sequence that commands none (passive, immediate)
+    /// then gets no plausibility check. See `validate::effective_max_speed`.
+    pub max_speed: f64,
+    /// Switch-then-marker: a marker closer than this (units) to the switch
+    /// edge is ambiguous — with the edge's sampling error (and switch
+    /// repeatability) it may be the marker before or after the one intended,
+    /// which moves the reference by a whole marker spacing from one homing to
+    /// the next. `0.0` = no check. See `refuse_ambiguous_marker`.
+    pub marker_min_distance: f64,
+    /// An ambiguous marker fails homing (ERR 1018) instead of completing with
+    /// the `Status::ambiguous_marker` warning.
+    pub refuse_ambiguous_marker: bool,
 }
 
 impl Default for AxisConfig {
@@ -172,6 +205,7 @@ impl Default for AxisConfig {
             marker: false,
             marker_latch: true,
             registration: false,
+            absolute: false,
             travel_limits: None,
             home_mode: HomeMode::Active,
             home_direction: HomeDirection::BidirectionalForward,
@@ -193,8 +227,12 @@ impl Default for AxisConfig {
             position_error_tolerance: 0.0,
             velocity_error_tolerance: 0.0,
             enable_timeout: 1.0,
-            stale_limit: 3,
+            feedback_timeout_ns: 10_000_000,
+            feedback_loss_drain: 0.25,
             max_position: 1.0e9,
+            max_speed: 0.0,
+            marker_min_distance: 0.0,
+            refuse_ambiguous_marker: false,
         }
     }
 }

@@ -101,4 +101,22 @@ pub struct Request {
     /// Shutdown (MASD): aborts with ERR 12 / EXERR 12, disables the drive,
     /// clears HomedStatus. Level: the axis stays shut down while set.
     pub shutdown: bool,
+
+    // --- coordination (gantries, home order); the defaults coordinate nothing
+    /// Barrier: while set, an axis that has finished a leg waits at rest
+    /// before starting its next leg that moves (`Status::waiting`), and
+    /// starts it in the first cycle `hold` is clear. A coordinator keeps it
+    /// set and clears it for one cycle when every axis it synchronises
+    /// waits: their legs then start in the same cycle. Legs that begin in
+    /// motion (the stop after an event, a unidirectional continue) never wait.
+    pub hold: bool,
+    /// If non-zero when the move to Home Position starts from rest, that move
+    /// lasts exactly this long (ns): the trapezoid is slowed down, never made
+    /// faster than its own minimum (`Status::min_move_ns`). Gantry sides whose
+    /// offsets differ thus start and end their final move together.
+    pub move_duration_ns: u64,
+    /// The ERR / EXERR a stop rising edge reports instead of 12 / 1 (e.g. 12 /
+    /// 1 for "home-all aborted because another axis failed", or 1017 / 0 for
+    /// gantry skew).
+    pub stop_code: Option<(u16, u16)>,
 }

@@ -6,23 +6,32 @@
 //! is tested cycle by cycle against the plant model in `motion-plant`.
 //!
 //! * [`config`]: the homing attributes (spec §2) and axis facts.
-//! * [`validate`]: every configuration problem at once, with CIP codes.
-//! * [`axis`]: the state machine for every active and passive sequence.
+//! * [`validate`](mod@validate): every configuration problem at once, with CIP codes.
+//! * [`plan`]: every sequence as one ordered list of legs.
+//! * [`axis`]: the state machine that runs a plan, for every active and
+//!   passive sequence; feedback trust (loss in time, plausibility); the
+//!   stored reference of absolute axes.
 //! * [`profile`]: jog / stop / trapezoid profiles that never exceed their limits.
 //! * [`codes`]: the ERR / EXERR table.
-//! * [`io`]: the per-cycle feedback, command and request types.
+//! * [`io`]: the per-cycle feedback, command and request types (with the
+//!   coordination hooks a machine coordinator uses for gantries and home
+//!   order: barrier, timed final move, stop code).
+//! * [`status`]: the instruction's and the axis's status after a cycle.
 
 pub mod axis;
 pub mod codes;
 pub mod config;
 pub mod io;
+pub mod plan;
 pub mod position;
 pub mod profile;
 pub mod status;
 pub mod validate;
 
-pub use axis::Axis;
+pub use axis::{Axis, RestoreRefusal};
 pub use config::*;
 pub use io::*;
-pub use status::{Phase, Status};
-pub use validate::{advisories, effective_search_limit, validate, ConfigError};
+pub use status::{Implausible, Phase, Status};
+pub use validate::{
+    advisories, effective_max_speed, effective_search_limit, validate, ConfigError,
+};

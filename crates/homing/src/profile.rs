@@ -195,6 +195,54 @@ impl Profile {
         b.finish(now_ns, End::Hold(target), 0.0)
     }
 
+    /// From rest at `p0` to rest at `target` in exactly `duration_ns`: the
+    /// trapezoid of [`Profile::move_to`] slowed down to a lower cruise speed
+    /// (same acceleration and deceleration), so that axes whose moves differ
+    /// in length (gantry sides with different offsets) start and end
+    /// together. Never faster than its own minimum: a duration shorter than
+    /// the time-optimal move gives the time-optimal move.
+    ///
+    /// With cruise speed `vc`, acceleration `a`, deceleration `d` and
+    /// `k = (1/a + 1/d) / 2`, a trapezoid covers `x = vc T - k vc²` in `T`,
+    /// so `vc = 2x / (T + sqrt(T² - 4kx))`; `T` above the minimum keeps the
+    /// root real and `vc` at or below `vmax`. At `now_ns + duration_ns` the
+    /// sample is `target` exactly, and not done before.
+    pub fn move_to_in(
+        now_ns: u64,
+        p0: f64,
+        target: f64,
+        duration_ns: u64,
+        vmax: f64,
+        acc: f64,
+        dec: f64,
+    ) -> Self {
+        let fastest = Self::move_to(now_ns, p0, 0.0, target, vmax, acc, dec);
+        let t = duration_ns as f64 * 1e-9;
+        if t <= fastest.t_end {
+            return fastest;
+        }
+        let s = if target >= p0 { 1.0 } else { -1.0 };
+        let x = (target - p0) * s;
+        let k = 0.5 * (1.0 / acc + 1.0 / dec);
+        let vc = (2.0 * x / (t + (t * t - 4.0 * k * x).max(0.0).sqrt())).min(vmax);
+        let mut b = Builder::new(p0, 0.0);
+        let (ta, td) = (vc / acc, vc / dec);
+        b.push(s * acc, ta);
+        b.push(0.0, t - ta - td);
+        b.push(-s * dec, td);
+        let mut p = b.finish(now_ns, End::Hold(target), 0.0);
+        // Ends at the requested time exactly (the segment sum may differ in
+        // the last bit).
+        p.t_end = t;
+        p
+    }
+
+    /// Time until a stop or move is done, rounded up to whole ns (0 for a
+    /// hold; a jog is never done and reports its acceleration time).
+    pub fn duration_ns(&self) -> u64 {
+        (self.t_end * 1e9).ceil().min(u64::MAX as f64) as u64
+    }
+
     fn t(&self, now_ns: u64) -> f64 {
         now_ns.saturating_sub(self.start_ns) as f64 * 1e-9
     }
@@ -397,6 +445,57 @@ mod tests {
         assert_eq!(p.sample(10 * T * 1000).0, p.end_position());
         assert!((p.end_position() - 0.5).abs() < 1e-12);
         assert!(!Profile::jog(0, 0.0, 0.0, 1.0, 1.0, 1.0).is_done(u64::MAX));
+    }
+
+    #[test]
+    fn timed_move_takes_exactly_its_time_within_the_limits() {
+        // 10 units, vmax 20, acc 500, dec 250: fastest 0.56 s (see above).
+        // In 1 s: k = (1/500 + 1/250) / 2 = 0.003,
+        // vc = 20 / (1 + sqrt(1 - 0.12)) = 10.3196 u/s (below 20).
+        let p = Profile::move_to_in(0, 0.0, 10.0, 1_000 * T, 20.0, 500.0, 250.0);
+        let vc = 20.0 / (1.0 + 0.88f64.sqrt());
+        assert!((p.sample(500 * T).1 - vc).abs() < 1e-9);
+        let xs = run(&p, 1200);
+        check_limits(&xs, vc, 500.0, 250.0);
+        assert_eq!(p.sample(1_000 * T), (10.0, 0.0));
+        assert!(p.sample(999 * T).0 < 10.0);
+        assert!(p.is_done(1_000 * T) && !p.is_done(1_000 * T - 1));
+        assert_eq!(p.duration_ns(), 1_000 * T);
+        assert!(xs.windows(2).all(|w| w[1].0 >= w[0].0), "never reverses");
+    }
+
+    #[test]
+    fn timed_move_is_never_faster_than_its_minimum() {
+        let fastest = Profile::move_to(0, 0.0, 0.0, 10.0, 20.0, 500.0, 250.0);
+        let p = Profile::move_to_in(0, 0.0, 10.0, 300 * T, 20.0, 500.0, 250.0);
+        assert_eq!(p, fastest);
+        assert_eq!(p.duration_ns(), 560 * T);
+    }
+
+    #[test]
+    fn timed_moves_of_any_length_and_time() {
+        for (x, ms) in [
+            (-0.1, 40),
+            (-0.1, 1000),
+            (3.0, 200),
+            (250.0, 20_000),
+            (1e-6, 7),
+        ] {
+            let min = Profile::move_to(0, 5.0, 0.0, 5.0 + x, 20.0, 500.0, 400.0);
+            let p = Profile::move_to_in(0, 5.0, 5.0 + x, ms * T, 20.0, 500.0, 400.0);
+            let end = (ms * T).max(min.duration_ns());
+            let xs = run(&p, (end / T) as usize + 3);
+            check_limits(&xs, 20.0, 500.0, 400.0);
+            assert_eq!(p.sample(end), (5.0 + x, 0.0), "{x} in {ms} ms");
+            assert!(p.is_done(end) && !p.is_done(end - 1), "{x} in {ms} ms");
+        }
+    }
+
+    #[test]
+    fn timed_zero_length_move_holds_until_its_time() {
+        let p = Profile::move_to_in(0, 3.0, 3.0, 500 * T, 1.0, 1.0, 1.0);
+        assert_eq!(p.sample(250 * T), (3.0, 0.0));
+        assert!(!p.is_done(499 * T) && p.is_done(500 * T));
     }
 
     #[test]

@@ -1,8 +1,10 @@
 //! The Motion Axis Home instruction's status (EN, DN, ER, IP, PC, ERR, EXERR)
 //! and the axis status bits homing drives (HomingStatus, HomedStatus).
 
-/// Where the engine is in a sequence. The number is reported as EXERR of a
-/// search-limit failure (1016), so it is part of the interface.
+/// Where the engine is in a sequence, derived from the state machine's state
+/// (the leg of the plan it runs). Names ([`Phase::name`]) are shown to
+/// operators and the numbers are kept stable; the EXERR of a search-limit
+/// failure has its own explicit mapping in [`codes`](crate::codes).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[repr(u16)]
 pub enum Phase {
@@ -49,6 +51,22 @@ impl Phase {
     }
 }
 
+/// Feedback refused as implausible, by kind, counted over the axis's life.
+/// Each one is a frame that was forged, corrupt, or from a broken encoder;
+/// none ever became an event.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Implausible {
+    /// Samples whose position moved further since the previous plausible
+    /// one than `max_speed` allows (not used; ERR 12 / EXERR 44 while homing).
+    pub jumps: u32,
+    /// Marker latch positions outside the travel since the latch was armed
+    /// (ignored, latch re-armed).
+    pub marker_latches: u32,
+    /// Registration (switch) latch positions outside the travel since arming
+    /// (ignored: the sampled edge is used).
+    pub switch_latches: u32,
+}
+
 /// Instruction and axis status after a cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Status {
@@ -75,11 +93,48 @@ pub struct Status {
     pub phase: Phase,
     /// Raw position of the home event, once found.
     pub event_raw: Option<f64>,
+    /// Command position (raw) in the cycle the event was detected: where the
+    /// axis latched in the common command frame of a coordinated machine.
+    pub event_command: Option<f64>,
+    /// Raw position of the switch edge found by a switch-then-marker
+    /// sequence (the marker beyond it is the event).
+    pub switch_edge_raw: Option<f64>,
+    /// Warning: the marker of a switch-then-marker sequence lay closer than
+    /// `marker_min_distance` to the switch edge (homing completed; with
+    /// `refuse_ambiguous_marker` it fails with ERR 1018 instead).
+    pub ambiguous_marker: bool,
+    /// Index of the current leg in the sequence's [plan](crate::plan) (the
+    /// last one reached, once homing has ended).
+    pub leg: u8,
+    /// At rest at a barrier (`Request::hold`), ready to start leg `leg`.
+    pub waiting: bool,
+    /// While waiting before the move to Home Position: the shortest that move
+    /// can take, ns (0 otherwise, and when there is no move to make).
+    pub min_move_ns: u64,
+    /// Distance travelled in the current (or last) search leg, units: the
+    /// command's for a commanded search, checked against the search limit;
+    /// the actual position's for a passive watch.
+    pub search_travel: f64,
     /// The feedback attribute that was invalid (ERR 12 / EXERR 41).
     pub bad_attribute: Option<&'static str>,
     /// Monotonic time homing started and finished, ns.
     pub started_ns: u64,
     pub finished_ns: Option<u64>,
-    /// Feedback is fresh and valid (not stale beyond `stale_limit`).
+    /// Feedback is usable: the feedback-loss rule has not tripped since the
+    /// last fresh valid sample.
     pub feedback_ok: bool,
+    /// Length of the current feedback gap: time since the last step with a
+    /// fresh valid sample, ns (0 in a step that had one).
+    pub feedback_gap_ns: u64,
+    /// Content of the feedback-loss bucket (missing time not yet drained),
+    /// ns; the rule trips above `feedback_timeout_ns`. Next to
+    /// `feedback_gap_ns` it tells a dead peer (both large) from intermittent
+    /// loss (a short gap on a full bucket).
+    pub feedback_loss_ns: u64,
+    /// When the feedback-loss rule tripped (HomedStatus cleared, ERR 12 /
+    /// EXERR 40 while homing): the gap at that moment, ns. Cleared when
+    /// homing starts.
+    pub lost_after_ns: Option<u64>,
+    /// Implausible feedback refused so far.
+    pub implausible: Implausible,
 }

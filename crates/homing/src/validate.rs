@@ -5,6 +5,7 @@
 
 use crate::codes::*;
 use crate::config::*;
+use crate::plan::creeps;
 use std::fmt;
 
 /// One configuration problem.
@@ -92,6 +93,9 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
         true,
     );
     p.number("enable_timeout", cfg.enable_timeout, true);
+    p.number("feedback_loss_drain", cfg.feedback_loss_drain, true);
+    let max_speed_ok = p.number("max_speed", cfg.max_speed, true);
+    p.number("marker_min_distance", cfg.marker_min_distance, true);
     if p.number("max_position", cfg.max_position, true) && cfg.max_position == 0.0 {
         p.add("max_position", EX_BAD_NUMBER, "must be positive".into());
     }
@@ -152,6 +156,24 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
 
     let seq = cfg.home_sequence;
     let active = cfg.home_mode == HomeMode::Active;
+    let passive = cfg.home_mode == HomeMode::Passive;
+
+    if cfg.home_mode == HomeMode::Absolute {
+        if seq != HomeSequence::Immediate {
+            p.add(
+                "home_sequence",
+                EX_SEQUENCE_INCOMPATIBLE,
+                "absolute home mode takes the immediate sequence only".into(),
+            );
+        }
+        if !cfg.absolute {
+            p.add(
+                "home_mode",
+                EX_ABSOLUTE_NOT_ABSOLUTE,
+                "absolute home mode on a non-absolute feedback device (absolute = false)".into(),
+            );
+        }
+    }
 
     if active && cfg.configuration == AxisConfiguration::FeedbackOnly {
         p.add(
@@ -167,7 +189,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
             "a virtual axis has no switch, marker or drive: only immediate homing applies".into(),
         );
     }
-    if !active && seq.uses_torque() {
+    if passive && seq.uses_torque() {
         p.add(
             "home_sequence",
             EX_SEQUENCE_INCOMPATIBLE,
@@ -227,6 +249,21 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
                 "home deceleration is zero: the axis could never stop".into(),
             );
         }
+        if max_speed_ok && cfg.max_speed > 0.0 {
+            for (key, v) in commanded_speeds(cfg) {
+                if v > cfg.max_speed {
+                    p.add(
+                        key,
+                        EX_ABOVE_MAX_SPEED,
+                        format!(
+                            "{v} units/s is above max_speed {} units/s, the fastest the axis \
+                             can move: its own feedback would be refused as implausible",
+                            cfg.max_speed
+                        ),
+                    );
+                }
+            }
+        }
         if seq.uses_torque() && lvl_ok && thr_ok {
             let (lvl, thr) = (cfg.home_torque_level, cfg.home_torque_threshold);
             if lvl == 0.0 || lvl > 100.0 {
@@ -248,6 +285,37 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
         }
     }
     p.0
+}
+
+/// The homing speeds the configured sequence commands, by TOML key: Home
+/// Speed; Home Return Speed where a leg after the first or the move home
+/// uses it; the creep speed where a creep leg runs. None for a sequence that
+/// commands no motion.
+fn commanded_speeds(cfg: &AxisConfig) -> impl Iterator<Item = (&'static str, f64)> {
+    let m = moves(cfg);
+    let uses_return = !cfg.home_direction.is_unidirectional() || cfg.home_sequence.uses_torque();
+    [
+        ("home_speed", cfg.home_speed, m),
+        ("home_return_speed", cfg.home_return_speed, m && uses_return),
+        ("home_creep_speed", cfg.home_creep_speed, m && creeps(cfg)),
+    ]
+    .into_iter()
+    .filter(|&(_, v, used)| used && v.is_finite() && v > 0.0)
+    .map(|(k, v, _)| (k, v))
+}
+
+/// The fastest plausible speed, units/s, for the feedback plausibility check:
+/// `max_speed` when set, else twice the fastest speed the sequence commands
+/// (the axis never moves faster than its command, and twice leaves room for
+/// a lagging frame). `None` = no check: a passive or immediate axis commands
+/// nothing, and its homing speeds (which CIP defines for active homing only)
+/// say nothing about how fast something else may move it.
+pub fn effective_max_speed(cfg: &AxisConfig) -> Option<f64> {
+    if cfg.max_speed.is_finite() && cfg.max_speed > 0.0 {
+        return Some(cfg.max_speed);
+    }
+    let fastest = commanded_speeds(cfg).map(|(_, v)| v).fold(0.0, f64::max);
+    (fastest > 0.0).then_some(2.0 * fastest)
 }
 
 /// Search limit in force: explicit, else derived from the travel limits

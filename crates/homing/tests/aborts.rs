@@ -158,27 +158,33 @@ fn drive_fault_disables_and_restores_at_once() {
 }
 
 #[test]
-fn feedback_lost_aborts_after_stale_limit() {
+fn feedback_lost_aborts_after_the_timeout_plus_one_cycle() {
     let cfg = switch_axis();
     let o = run_with(cfg, machine(), T, 60.0, |k, _, fb, _| {
         (k < 1200).then_some(fb)
     });
     assert_aborted(&o, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST);
     assert!(!o.status.feedback_ok);
-    // stale_limit = 3: frames 1200, 1201, 1202 tolerated, the 4th missing aborts.
-    assert_eq!(o.status.finished_ns, Some(1203 * 1_000_000));
+    // feedback_timeout_ns = 10 ms. The last frame is seen at step 1199;
+    // steps 1200..=1209 fill the bucket to exactly 10 ms (not above), step
+    // 1210 to 11 ms: the gap is then 1210 - 1199 = 11 ms.
+    assert_eq!(o.status.finished_ns, Some(1210 * 1_000_000));
+    assert_eq!(o.status.lost_after_ns, Some(11_000_000));
 }
 
 #[test]
-fn stale_frames_within_the_limit_are_tolerated() {
+fn a_tenth_of_the_frames_lost_is_tolerated() {
     let cfg = switch_axis();
-    // Every other frame lost: homing still completes, the switch error bound
-    // doubles because the samples around the edge are two cycles apart.
+    // Every 10th frame lost: +1 ms, then 9 x 0.25 ms drained, so the bucket
+    // never holds more than 1 ms. Homing completes; the switch error bound
+    // doubles where the samples around the edge are two cycles apart:
+    // R x 2T / 2 = 2 x 0.002 / 2 = 0.002.
     let o = run_with(cfg, machine(), T, 60.0, |k, _, fb, _| {
-        (k % 2 == 0).then_some(fb)
+        (k % 10 != 9).then_some(fb)
     });
     assert!(o.status.pc, "{:?}", o.status);
     assert!(o.status.event_raw.unwrap().abs() <= 2.0 * 0.001 * 2.0 / 2.0 + 1e-9);
+    assert_eq!(o.status.lost_after_ns, None);
 }
 
 #[test]
@@ -267,14 +273,17 @@ fn feedback_loss_clears_homed_when_idle() {
         home: true,
         ..Request::default()
     };
+    const MS: u64 = 1_000_000;
     axis.step(0, Some(&fb), &home);
     assert!(axis.status().homed && axis.status().pc);
-    for k in 1..=3 {
-        axis.step(k, None, &home);
-        assert!(axis.status().homed, "within stale_limit");
+    // 1 ms steps: ten missing steps make exactly the 10 ms timeout, tolerated.
+    for k in 1..=10 {
+        axis.step(k * MS, None, &home);
+        assert!(axis.status().homed, "within the timeout at {k} ms");
     }
-    axis.step(4, None, &home);
+    axis.step(11 * MS, None, &home);
     assert!(!axis.status().homed);
+    assert_eq!(axis.status().lost_after_ns, Some(11 * MS));
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! The engine step never touches the heap: counted with a wrapping global
-//! allocator over complete homing runs of every sequence.
+//! allocator over complete homing runs of every sequence, and over the
+//! coordination, feedback-trouble and stored-reference paths.
 
 use motion_homing::*;
 use motion_plant::{Plant, PlantConfig};
@@ -82,6 +83,154 @@ fn engine_step_makes_no_allocation() {
     }
     assert!(steps == 100_000);
     assert_eq!(during, 0, "allocator calls inside Axis::step");
+}
+
+/// Counts allocator calls inside `f`.
+fn counted(f: impl FnOnce()) -> u64 {
+    let before = calls();
+    f();
+    calls() - before
+}
+
+#[test]
+fn coordination_feedback_trouble_and_references_make_no_allocation() {
+    const T: u64 = 1_000_000;
+    let stm = AxisConfig {
+        counts_per_unit: 1000.0,
+        marker: true,
+        home_sequence: HomeSequence::SwitchThenMarker,
+        home_speed: 20.0,
+        home_return_speed: 2.0,
+        home_acceleration: 500.0,
+        home_deceleration: 500.0,
+        marker_min_distance: 0.5,
+        ..AxisConfig::default()
+    };
+    let plant = |rack: f64, marker_at: f64| {
+        Plant::new(PlantConfig {
+            start: -20.0,
+            switch: Some((rack, 5.0 + rack)),
+            marker_every: 10.0,
+            marker_at: marker_at + rack,
+            ..PlantConfig::default()
+        })
+    };
+    let mut during = 0;
+
+    // Two gantry sides under a hold / move-duration coordinator, with lost
+    // frames, one implausible jump and one forged marker latch; then a third
+    // axis whose marker is refused as ambiguous, and a coordinator stop.
+    let mut axes = [
+        Axis::new(stm),
+        Axis::new(AxisConfig {
+            home_offset: 0.5,
+            ..stm
+        }),
+        Axis::new(AxisConfig {
+            refuse_ambiguous_marker: true,
+            ..stm
+        }),
+    ];
+    let mut plants = [plant(0.0, 2.5), plant(0.3, 2.5), plant(0.0, -0.1)];
+    let mut fb = [
+        plants[0].feedback(),
+        plants[1].feedback(),
+        plants[2].feedback(),
+    ];
+    let (mut hold, mut duration) = (true, 0);
+    let mut forged = [false; 3];
+    for k in 0..20_000u64 {
+        let req = Request {
+            home: k >= 1000,
+            hold,
+            move_duration_ns: duration,
+            stop: k == 19_000,
+            stop_code: Some((codes::ERR_GANTRY_SKEW, 0)),
+            ..Request::default()
+        };
+        for i in 0..3 {
+            let mut seen = Some(fb[i]);
+            if k % 7 == 3 {
+                seen = None;
+            }
+            if k == 500 {
+                seen = Some(Feedback {
+                    position: 40.0,
+                    ..fb[i]
+                });
+            }
+            let armed = axes[i].last_command().marker_arm.id;
+            if armed != 0 && !forged[i] {
+                if let Some(f) = seen.as_mut() {
+                    forged[i] = true;
+                    f.marker_latch = LatchFeedback {
+                        id: armed,
+                        latched: true,
+                        position: 77.0,
+                    };
+                }
+            }
+            let mut cmd = Command::default();
+            during += counted(|| {
+                cmd = axes[i].step(k * T, seen.as_ref(), &req);
+            });
+            fb[i] = plants[i].step(&cmd, 0.001);
+        }
+        let all_wait = axes[..2].iter().all(|a| a.status().waiting);
+        hold = !all_wait;
+        duration = if all_wait {
+            axes[..2]
+                .iter()
+                .map(|a| a.status().min_move_ns)
+                .max()
+                .unwrap()
+        } else {
+            0
+        };
+    }
+    assert!(
+        axes[0].status().pc && axes[1].status().pc,
+        "{:?}",
+        axes[0].status()
+    );
+    assert_eq!(axes[2].status().err, codes::ERR_AMBIGUOUS_MARKER);
+    for a in &axes {
+        let n = a.status().implausible;
+        assert_eq!((n.jumps, n.marker_latches), (1, 1), "{n:?}");
+    }
+
+    // Absolute homing, the stored reference, a restart and its restore
+    // (accepted and refused).
+    let abs = AxisConfig {
+        absolute: true,
+        home_mode: HomeMode::Absolute,
+        home_position: 10.0,
+        travel_limits: Some((-50.0, 150.0)),
+        ..AxisConfig::default()
+    };
+    let fb = Feedback {
+        position: 123.4,
+        ..Feedback::default()
+    };
+    let home = Request {
+        home: true,
+        ..Request::default()
+    };
+    let mut a = Axis::new(abs);
+    let mut b = Axis::new(abs);
+    let mut results = [Ok(()); 3];
+    during += counted(|| {
+        a.step(0, Some(&fb), &home);
+        let offset = a.reference_offset().unwrap();
+        b.step(0, Some(&fb), &Request::default());
+        results = [
+            b.restore_reference(0, offset),
+            b.restore_reference(0, offset),
+            b.restore_reference(0, 500.0),
+        ];
+    });
+    assert!(results[0].is_ok() && results[1].is_ok() && results[2].is_err());
+    assert_eq!(during, 0, "allocator calls inside the engine");
 }
 
 #[test]

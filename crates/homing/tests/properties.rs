@@ -278,6 +278,7 @@ fn bidirectional_ends_at_home_position() {
             let o = run(cfg, m.plant(), m.cycle_s, 400.0);
             let st = o.status;
             prop_assert!(st.pc && st.homed && !st.er, "{st:?}");
+            prop_assert_eq!(st.implausible, Implausible::default());
             let e = st.event_raw.unwrap();
             prop_assert!(
                 (e - truth).abs() <= tol,
@@ -332,6 +333,7 @@ fn unidirectional_never_reverses() {
             let o = run(cfg, plant, m.cycle_s, 400.0);
             let st = o.status;
             prop_assert!(st.homed && !st.er && !st.ip, "{st:?}");
+            prop_assert_eq!(st.implausible, Implausible::default());
             for w in o.commands.windows(2) {
                 prop_assert!(
                     (w[1].position - w[0].position) * s >= -1e-12,

@@ -694,6 +694,13 @@ fn check(c: &Case) -> Result<(), String> {
             o.final_axis, c.cfg.home_position
         ));
     }
+    // A healthy machine's feedback is never refused as implausible.
+    if s.implausible != Implausible::default() {
+        problems.push(format!(
+            "feedback refused as implausible: {:?}",
+            s.implausible
+        ));
+    }
     // Overridden drive values are always restored at the end.
     let last = o.commands.last().unwrap();
     if last.torque_limit_positive != c.cfg.torque_limit

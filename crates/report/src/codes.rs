@@ -13,7 +13,23 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         (ERR_SERVO_MESSAGE, EX_FEEDBACK_INVALID) => "invalid feedback (non-finite or absurd)",
         (ERR_SERVO_MESSAGE, EX_ENABLE_TIMEOUT) => "drive did not enable in time",
         (ERR_SERVO_MESSAGE, EX_OVERTRAVEL) => "hardware overtravel during homing",
+        (ERR_SERVO_MESSAGE, EX_FEEDBACK_IMPLAUSIBLE) => {
+            "implausible feedback: a position the axis cannot have reached (never a home event)"
+        }
+        (ERR_ILLEGAL_HOMING_CONFIG, EX_ACTIVE_ON_FEEDBACK_ONLY) => {
+            "illegal homing configuration: active homing on a feedback-only axis"
+        }
+        (ERR_ILLEGAL_HOMING_CONFIG, EX_ABSOLUTE_NOT_ABSOLUTE) => {
+            "illegal homing configuration: absolute home mode needs an absolute feedback device"
+        }
+        (ERR_ILLEGAL_HOMING_CONFIG, EX_ABOVE_MAX_SPEED) => {
+            "illegal homing configuration: a homing speed above max_speed"
+        }
         (ERR_ILLEGAL_HOMING_CONFIG, _) => "illegal homing configuration",
+        (ERR_GANTRY_SKEW, _) => "gantry sides latched their events further apart than max_skew",
+        (ERR_AMBIGUOUS_MARKER, _) => {
+            "the marker lies too close to the switch edge to tell which one is meant"
+        }
         (ERR_INTERRUPTED, _) => "homing interrupted externally",
         (ERR_TIMEOUT, _) => "home timeout exceeded",
         (ERR_SEARCH_LIMIT, _) => "search travelled beyond the search limit",

@@ -48,6 +48,7 @@ pub fn fill(m: &MachineConfig, snap: &Snapshot, uptime_ns: u64, f: &mut StatusFr
         e.home_mode = match cfg.engine.home_mode {
             HomeMode::Passive => 0,
             HomeMode::Active => 1,
+            HomeMode::Absolute => 2,
         };
         e.home_sequence = cfg.engine.home_sequence as u8;
         e.home_direction = cfg.engine.home_direction as u8;

@@ -1,0 +1,160 @@
+//! Feedback intake: what of a cycle's feedback the engine may use.
+//!
+//! Feedback is validated before anything looks at it (finite, within
+//! `max_position`); corrupt feedback clears HomedStatus and aborts homing
+//! with ERR 12 / EXERR 41, naming the attribute. A finite position that
+//! jumped further than the axis can move is refused too
+//! ([`plausible`](super::plausible), ERR 12 / EXERR 44). A step without a usable
+//! sample counts towards feedback loss ([`loss`](super::loss), a leaky
+//! bucket in time); when that rule trips, HomedStatus is cleared and homing
+//! aborts with ERR 12 / EXERR 40 (`Status::lost_after_ns` says how long the
+//! gap was).
+//!
+//! # During a tolerated gap
+//!
+//! The engine takes no decision on old data: nothing is detected until a
+//! fresh sample arrives (no event from a stale sample), and no profile is
+//! changed: the planned profile just runs on, so a leg that ends by time (a
+//! stop ramp) reaches its end, and the next leg starts on the next fresh
+//! sample. When feedback returns, a sampled switch edge found across the gap
+//! is placed at the midpoint of the samples around it, so its precision
+//! degrades from speed × cycle / 2 to **speed × (gap + cycle) / 2**. Drive
+//! latches (markers, registration) are exact whatever the gap. An index
+//! pulse reported without a latch (`marker_latch = false`) falls in the frame
+//! that was lost: a marker search across a gap can miss it, which is why
+//! such drives should home with a latch or slowly.
+
+use super::{Abort, Axis};
+use crate::codes::*;
+use crate::config::AxisConfiguration;
+use crate::io::{DriveState, Feedback};
+
+/// A validated feedback sample.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Sample {
+    pub fb: Feedback,
+    /// Logical switch state: actuated, whatever the wiring.
+    pub switch_active: bool,
+    /// Time since the previous usable sample, ns (0 for the first).
+    pub dt_ns: u64,
+}
+
+impl Axis {
+    /// This cycle's usable sample, if any.
+    pub(super) fn intake(&mut self, now: u64, feedback: Option<&Feedback>) -> Option<Sample> {
+        let dt = self.loss.tick(now);
+        let sample = self.sample(now, feedback);
+        match sample {
+            Some(_) => self.loss.fresh(now, dt, self.cfg.feedback_loss_drain),
+            None => self.missing(now, dt),
+        }
+        self.status.feedback_gap_ns = self.loss.gap(now);
+        self.status.feedback_loss_ns = self.loss.bucket();
+        sample
+    }
+
+    /// The usable sample of this step's feedback, if any.
+    fn sample(&mut self, now: u64, feedback: Option<&Feedback>) -> Option<Sample> {
+        if self.cfg.configuration == AxisConfiguration::Virtual {
+            // No hardware: the command is the position.
+            let (p, v) = self.profile.sample(now);
+            let fb = Feedback {
+                position: p,
+                velocity: v,
+                drive: DriveState {
+                    enabled: true,
+                    fault: false,
+                },
+                ..Feedback::default()
+            };
+            return Some(self.accept(now, fb));
+        }
+        match feedback {
+            None => None,
+            Some(fb) => match check_feedback(fb, self.cfg.max_position) {
+                Ok(()) if !self.plausible.position(fb.position, now) => {
+                    // A forged or corrupt frame: never used, never an event.
+                    let n = &mut self.status.implausible.jumps;
+                    *n = n.saturating_add(1);
+                    self.status.homed = false;
+                    if self.status.ip {
+                        self.fail(
+                            now,
+                            ERR_SERVO_MESSAGE,
+                            EX_FEEDBACK_IMPLAUSIBLE,
+                            Abort::Controlled,
+                        );
+                    }
+                    None
+                }
+                Ok(()) => Some(self.accept(now, *fb)),
+                Err(attribute) => {
+                    self.status.bad_attribute = Some(attribute);
+                    // Corrupt feedback: the reference can no longer be trusted.
+                    self.status.homed = false;
+                    if self.status.ip {
+                        self.fail(
+                            now,
+                            ERR_SERVO_MESSAGE,
+                            EX_FEEDBACK_INVALID,
+                            Abort::Controlled,
+                        );
+                    }
+                    None
+                }
+            },
+        }
+    }
+
+    fn accept(&mut self, now: u64, fb: Feedback) -> Sample {
+        let s = Sample {
+            fb,
+            switch_active: fb.home_switch != self.cfg.home_switch_normally_closed,
+            dt_ns: self.last_sample_ns.map_or(0, |t| now.saturating_sub(t)),
+        };
+        self.last_sample_ns = Some(now);
+        self.latches.seen_at(fb.position);
+        self.status.feedback_ok = true;
+        self.prev = self.last;
+        self.last = Some(s);
+        s
+    }
+
+    /// A step without a usable sample, `dt` after the previous step.
+    fn missing(&mut self, now: u64, dt: u64) {
+        if self.loss.missing(dt, self.cfg.feedback_timeout_ns) {
+            self.status.feedback_ok = false;
+            self.status.homed = false;
+            self.status.lost_after_ns = Some(self.loss.gap(now));
+            // Edges across a gap of unknown length mean nothing.
+            self.prev = None;
+            self.last = None;
+            if self.status.ip {
+                self.fail(now, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, Abort::Controlled);
+            }
+        }
+    }
+}
+
+/// Rejects feedback that must not reach the engine; names the attribute.
+fn check_feedback(fb: &Feedback, max_position: f64) -> Result<(), &'static str> {
+    let bad = |x: f64, limit: f64| !x.is_finite() || x.abs() > limit;
+    if bad(fb.position, max_position) {
+        return Err("feedback.position");
+    }
+    // A speed of more than `max_position` units per second is not a reading either.
+    if bad(fb.velocity, max_position) {
+        return Err("feedback.velocity");
+    }
+    // More than ten times rated torque is not a reading, it is a broken frame.
+    if bad(fb.torque, 1000.0) {
+        return Err("feedback.torque");
+    }
+    if fb.marker_latch.latched && bad(fb.marker_latch.position, max_position) {
+        return Err("feedback.marker_latch.position");
+    }
+    if fb.switch_latch.latched && bad(fb.switch_latch.position, max_position) {
+        return Err("feedback.switch_latch.position");
+    }
+    Ok(())
+}

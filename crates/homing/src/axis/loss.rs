@@ -1,0 +1,143 @@
+//! The feedback-loss rule: a leaky bucket of missing-feedback time.
+//!
+//! Counting consecutive missing cycles would mean something different at 1
+//! and at 8 kHz, would forgive a peer that drops every other frame forever,
+//! and would trip on one late frame at a high rate. The bucket is stated in
+//! time instead:
+//!
+//! * a step without a fresh valid sample adds the time since the previous
+//!   step;
+//! * a step with one drains `feedback_loss_drain` × that time;
+//! * the rule trips when the bucket holds more than `feedback_timeout_ns`.
+//!
+//! So a dead peer trips within the timeout plus one cycle, an isolated gap
+//! shorter than the timeout never trips, and sustained loss of more than
+//! `drain / (1 + drain)` of the cycles (20 % at 0.25) trips eventually.
+//!
+//! Once tripped the loss has been reported; the first fresh sample after it
+//! starts a new connection with an empty bucket.
+
+/// Bucket state. Times in ns.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct FeedbackLoss {
+    /// Missing time not yet drained.
+    bucket: u64,
+    /// Time of the previous step, once there was one.
+    prev_step: Option<u64>,
+    /// Time of the last step with a fresh valid sample (or of the first step,
+    /// before any): where the current gap began.
+    gap_since: Option<u64>,
+    /// Tripped, and no fresh sample since.
+    tripped: bool,
+}
+
+impl FeedbackLoss {
+    /// Start of a step at `now`: the time elapsed since the previous step.
+    pub fn tick(&mut self, now: u64) -> u64 {
+        let dt = self.prev_step.map_or(0, |t| now.saturating_sub(t));
+        self.prev_step = Some(now);
+        self.gap_since.get_or_insert(now);
+        dt
+    }
+
+    /// This step had a fresh valid sample.
+    pub fn fresh(&mut self, now: u64, dt: u64, drain: f64) {
+        if self.tripped {
+            self.tripped = false;
+            self.bucket = 0;
+        } else {
+            // Saturating float → integer cast: a huge drain empties the bucket.
+            let d = (drain.max(0.0) * dt as f64) as u64;
+            self.bucket = self.bucket.saturating_sub(d);
+        }
+        self.gap_since = Some(now);
+    }
+
+    /// This step had no usable sample. True when the rule trips now (once
+    /// per loss).
+    pub fn missing(&mut self, dt: u64, timeout_ns: u64) -> bool {
+        self.bucket = self.bucket.saturating_add(dt);
+        if self.bucket > timeout_ns && !self.tripped {
+            self.tripped = true;
+            return true;
+        }
+        false
+    }
+
+    /// Length of the current gap at `now` (0 right after a fresh sample).
+    pub fn gap(&self, now: u64) -> u64 {
+        self.gap_since.map_or(0, |t| now.saturating_sub(t))
+    }
+
+    pub fn bucket(&self) -> u64 {
+        self.bucket
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MS: u64 = 1_000_000;
+
+    /// Steps at 1 ms; `pattern(k)` says whether step k had fresh feedback.
+    /// Returns the step at which the rule tripped first.
+    fn trips_at(pattern: impl Fn(u64) -> bool, steps: u64) -> Option<u64> {
+        let mut l = FeedbackLoss::default();
+        for k in 0..steps {
+            let dt = l.tick(k * MS);
+            if pattern(k) {
+                l.fresh(k * MS, dt, 0.25);
+            } else if l.missing(dt, 10 * MS) {
+                return Some(k);
+            }
+        }
+        None
+    }
+
+    #[test]
+    fn dead_peer_trips_after_timeout_plus_one_cycle() {
+        // Last fresh at 99; missing from 100: 10 ms at 109 (not above), 11 ms at 110.
+        assert_eq!(trips_at(|k| k < 100, 1000), Some(110));
+    }
+
+    #[test]
+    fn isolated_gap_below_the_timeout_never_trips() {
+        // 10 missing steps = exactly 10 ms: not above the timeout.
+        assert_eq!(trips_at(|k| !(100..110).contains(&k), 10_000), None);
+        // Such gaps every 50 ms: 10 ms in, 40 x 0.25 = 10 ms out.
+        assert_eq!(trips_at(|k| k % 50 >= 10, 10_000), None);
+    }
+
+    #[test]
+    fn half_loss_trips_tenth_and_fifth_do_not() {
+        // Odd steps missing: after step 2n+1 the bucket holds 1 + 0.75 n ms,
+        // above 10 ms first at n = 13: step 27.
+        assert_eq!(trips_at(|k| k % 2 == 0, 10_000), Some(27));
+        assert_eq!(trips_at(|k| k % 10 != 9, 100_000), None);
+        // 20 %: one missing (+1 ms), four fresh (-4 x 0.25 ms): break-even.
+        assert_eq!(trips_at(|k| k % 5 != 4, 100_000), None);
+        // 25 %: +1 - 3 x 0.25 = +0.25 ms per 4 steps: 1 + 0.25 n > 10 at n = 37.
+        assert_eq!(trips_at(|k| k % 4 != 3, 100_000), Some(3 + 4 * 37));
+    }
+
+    #[test]
+    fn gap_and_reset_after_a_trip() {
+        let mut l = FeedbackLoss::default();
+        let dt = l.tick(0);
+        l.fresh(0, dt, 0.25);
+        for k in 1..=11 {
+            let dt = l.tick(k * MS);
+            assert_eq!(l.missing(dt, 10 * MS), k == 11, "{k}");
+        }
+        assert_eq!(l.gap(11 * MS), 11 * MS);
+        assert_eq!(l.bucket(), 11 * MS);
+        // Still lost: reported once.
+        let dt = l.tick(12 * MS);
+        assert!(!l.missing(dt, 10 * MS));
+        // Back: a new connection, empty bucket, no gap.
+        let dt = l.tick(13 * MS);
+        l.fresh(13 * MS, dt, 0.25);
+        assert_eq!((l.bucket(), l.gap(13 * MS)), (0, 0));
+    }
+}

@@ -1,0 +1,561 @@
+//! The per-axis homing state machine, stepped once per cycle.
+//!
+//! `step(now, feedback, request) -> Command`: the feedback is the drive's
+//! answer to an earlier command, `now` is the cycle's monotonic time. No
+//! clock, thread, allocation or I/O in here: the same inputs give the same
+//! commands, so a test can drive it cycle by cycle against a plant model.
+//!
+//! The machine runs the legs of its sequence's [plan](crate::plan) in order;
+//! its state (`state.rs`) carries only what the current phase needs.
+//! Where the rest lives:
+//!
+//! * `intake`: which feedback may be used at all, with `loss` (the
+//!   feedback-loss rule, a leaky bucket in time) and `plausible` (forged or
+//!   corrupt frames never become an event);
+//! * `detect`: finding a search leg's goal (events and their precision);
+//! * `legs`: starting each leg (or holding at a coordinator's barrier),
+//!   what its find means, what follows it;
+//! * `reference`: the stored reference of an absolute axis;
+//! * this file: requests (start, stop, shutdown), aborts, completion, the
+//!   status and the command written each cycle.
+//!
+//! Design notes a reviewer will look for:
+//!
+//! * **Commands never come from unchecked feedback.** The command is sampled
+//!   from a profile planned from the previous command state; the actual
+//!   position only enters as a hold / release target after validation.
+//! * **Coordination.** Each axis is its own engine; a coordinator (gantry
+//!   sides, home order) synchronises them only through `Request::hold` (a
+//!   barrier at rest before each leg that moves), `move_duration_ns` (a
+//!   final move of a given length) and `stop_code`, and reads `Status::leg`,
+//!   `waiting`, `min_move_ns`. Nothing here knows about other axes.
+//! * **Aborts** (stop, timeout, search limit, lost, invalid or implausible
+//!   feedback, an ambiguous marker when refused) stop
+//!   the axis at Home Deceleration with the overrides still in force, release
+//!   if needed, then restore. A drive fault or shutdown cannot be stopped by
+//!   us: the drive is disabled and the overrides restored at once.
+
+mod detect;
+mod intake;
+mod latches;
+mod legs;
+mod loss;
+mod plausible;
+mod reference;
+mod state;
+
+use crate::codes::*;
+use crate::config::*;
+use crate::io::*;
+use crate::plan::Leg;
+use crate::position::wrap;
+use crate::profile::Profile;
+use crate::status::Status;
+use crate::validate::{effective_search_limit, validate, ConfigError};
+use intake::Sample;
+use latches::Latches;
+use loss::FeedbackLoss;
+use plausible::Plausibility;
+pub use reference::RestoreRefusal;
+use state::{Run, State};
+
+/// How an abort treats the axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Abort {
+    /// We still control the drive: decelerate, release, restore.
+    Controlled,
+    /// The drive is faulted or shut down: disable, restore at once.
+    Disable,
+}
+
+/// One axis's homing engine.
+#[derive(Clone, Debug)]
+pub struct Axis {
+    cfg: AxisConfig,
+    /// EXERR of the first configuration problem, reported at start.
+    config_error: Option<u16>,
+    search_limit: f64,
+    /// Home Direction as ±1.
+    dir: f64,
+    status: Status,
+    prev_request: Request,
+    state: State,
+    profile: Profile,
+    /// The power stage is requested on.
+    enable: bool,
+    /// Torque limits and error tolerances overridden (torque sequences).
+    overrides: bool,
+    latches: Latches,
+    /// Last two valid samples (`last` is the newest).
+    prev: Option<Sample>,
+    last: Option<Sample>,
+    /// Time of the last usable sample, ns.
+    last_sample_ns: Option<u64>,
+    loss: FeedbackLoss,
+    plausible: Plausibility,
+    /// axis position = raw + offset (wrapped on a cyclic axis).
+    offset: f64,
+    last_command: Command,
+}
+
+impl Axis {
+    /// Builds the engine. An invalid configuration is accepted here and
+    /// reported by the instruction (ER, ERR 41) at start, as a controller
+    /// does; [`Axis::config_errors`] lists every problem up front.
+    pub fn new(cfg: AxisConfig) -> Self {
+        let errors = validate(&cfg);
+        let cmd = Command {
+            torque_limit_positive: finite_or(cfg.torque_limit, 0.0),
+            torque_limit_negative: finite_or(cfg.torque_limit, 0.0),
+            position_error_tolerance: finite_or(cfg.position_error_tolerance, 0.0),
+            velocity_error_tolerance: finite_or(cfg.velocity_error_tolerance, 0.0),
+            ..Command::default()
+        };
+        Self {
+            config_error: errors.first().map(|e| e.exerr),
+            search_limit: effective_search_limit(&cfg),
+            dir: cfg.home_direction.sign(),
+            cfg,
+            status: Status::default(),
+            prev_request: Request::default(),
+            state: State::Idle,
+            profile: Profile::hold(0, 0.0),
+            enable: false,
+            overrides: false,
+            latches: Latches::default(),
+            prev: None,
+            last: None,
+            last_sample_ns: None,
+            loss: FeedbackLoss::default(),
+            plausible: Plausibility::new(&cfg),
+            offset: 0.0,
+            last_command: cmd,
+        }
+    }
+
+    pub fn config(&self) -> &AxisConfig {
+        &self.cfg
+    }
+
+    /// Every configuration problem (empty when valid).
+    pub fn config_errors(&self) -> Vec<ConfigError> {
+        validate(&self.cfg)
+    }
+
+    pub fn status(&self) -> &Status {
+        &self.status
+    }
+
+    /// Axis position of a raw position under the current reference.
+    pub fn to_axis(&self, raw: f64) -> f64 {
+        let x = raw + self.offset;
+        match self.cfg.travel {
+            TravelMode::Cyclic if self.cfg.unwind > 0.0 => wrap(x, self.cfg.unwind),
+            _ => x,
+        }
+    }
+
+    /// Raw actual position from the newest valid feedback.
+    pub fn raw_position(&self) -> Option<f64> {
+        self.last.map(|s| s.fb.position)
+    }
+
+    /// Axis actual position from the newest valid feedback.
+    pub fn axis_position(&self) -> Option<f64> {
+        self.raw_position().map(|r| self.to_axis(r))
+    }
+
+    /// The last command produced.
+    pub fn last_command(&self) -> &Command {
+        &self.last_command
+    }
+
+    /// One cycle. `feedback` is `None` when no fresh frame arrived for this
+    /// axis this cycle; `now_ns` is monotonic.
+    /// EXERR of the first configuration problem (ERR 41), if any: what a
+    /// Home request would be refused with. No allocation.
+    pub fn config_error(&self) -> Option<u16> {
+        self.config_error
+    }
+
+    /// Operator's "unhome": clears HomedStatus. Refused (`false`) while
+    /// homing is in process — stop first.
+    pub fn clear_homed(&mut self) -> bool {
+        if self.status.ip {
+            return false;
+        }
+        self.status.homed = false;
+        true
+    }
+
+    /// The drive connection was re-established (its I/O process restarted
+    /// or re-attached): HomedStatus is cleared (CIP: reconnection clears it),
+    /// samples and the plausibility anchor from before are forgotten, and
+    /// homing in process is aborted with ERR 12 / EXERR 40 — the feedback it
+    /// relied on was interrupted.
+    pub fn reconnected(&mut self, now_ns: u64) {
+        self.prev = None;
+        self.last = None;
+        self.last_sample_ns = None;
+        self.plausible = Plausibility::new(&self.cfg);
+        self.status.homed = false;
+        if self.status.ip {
+            self.fail(
+                now_ns,
+                ERR_SERVO_MESSAGE,
+                EX_FEEDBACK_LOST,
+                Abort::Controlled,
+            );
+        }
+    }
+
+    pub fn step(&mut self, now_ns: u64, feedback: Option<&Feedback>, request: &Request) -> Command {
+        let fresh = self.intake(now_ns, feedback);
+        self.requests(now_ns, request);
+        match fresh {
+            Some(s) => self.advance(now_ns, &s),
+            None => self.advance_blind(now_ns),
+        }
+        self.report(now_ns);
+        self.output(now_ns)
+    }
+
+    /// The status fields that describe the state after this step.
+    fn report(&mut self, now: u64) {
+        self.status.phase = self.state.phase();
+        self.status.stopping = matches!(self.state, State::Stopping { .. });
+        self.status.waiting = false;
+        self.status.min_move_ns = 0;
+        let State::Homing(h) = self.state else {
+            return;
+        };
+        self.status.leg = u8::try_from(h.leg).unwrap_or(u8::MAX);
+        match (h.run, h.current()) {
+            (Run::Waiting { min_move_ns }, _) => {
+                self.status.waiting = true;
+                self.status.min_move_ns = min_move_ns;
+            }
+            (Run::Search(search), Some(Leg::Watch(_))) => {
+                let actual = self.last.map_or(search.start, |s| s.fb.position);
+                self.status.search_travel = (actual - search.start).abs();
+            }
+            (Run::Search(search), _) => {
+                self.status.search_travel = (self.profile.sample(now).0 - search.start).abs();
+            }
+            (Run::Profile { .. }, _) => {}
+        }
+    }
+
+    // ------------------------------------------------------------------
+    // Requests and start
+    // ------------------------------------------------------------------
+
+    fn requests(&mut self, now: u64, req: &Request) {
+        let prev = self.prev_request;
+        self.prev_request = *req;
+        if req.shutdown {
+            if self.status.ip {
+                self.fail(now, ERR_SERVO_MESSAGE, EX_AXIS_SHUTDOWN, Abort::Disable);
+            }
+            self.enable = false;
+            self.status.homed = false;
+        }
+        if req.stop && !prev.stop && self.status.ip {
+            let (err, exerr) = req
+                .stop_code
+                .unwrap_or((ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST));
+            self.fail(now, err, exerr, Abort::Controlled);
+        }
+        if req.home && !prev.home {
+            self.start(now, req.shutdown);
+        }
+        if !req.home && (self.status.dn || self.status.er) {
+            self.status.en = false;
+        }
+    }
+
+    fn start(&mut self, now: u64, shutdown: bool) {
+        if self.status.ip {
+            // Re-triggering a running instruction changes nothing.
+            return;
+        }
+        self.status = Status {
+            en: true,
+            homed: self.status.homed,
+            feedback_ok: self.status.feedback_ok,
+            feedback_gap_ns: self.status.feedback_gap_ns,
+            feedback_loss_ns: self.status.feedback_loss_ns,
+            implausible: self.status.implausible,
+            started_ns: now,
+            ..Status::default()
+        };
+        if let Some(exerr) = self.config_error {
+            return self.fail(now, ERR_ILLEGAL_HOMING_CONFIG, exerr, Abort::Controlled);
+        }
+        if shutdown {
+            return self.fail(now, ERR_SERVO_MESSAGE, EX_AXIS_SHUTDOWN, Abort::Controlled);
+        }
+        let Some(s) = self.last else {
+            return self.fail(now, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, Abort::Controlled);
+        };
+        self.status.ip = true;
+        self.status.homing = true;
+        self.status.homed = false;
+
+        if self.cfg.home_sequence == HomeSequence::Immediate
+            || self.cfg.home_mode == HomeMode::Absolute
+        {
+            // Actual and command position become Home Position: nothing moves,
+            // the reference is redefined from the raw (encoder) position —
+            // never from the axis position, so homing again never adds an
+            // offset twice. Home Offset does not apply.
+            self.offset = self.cfg.home_position - s.fb.position;
+            return self.complete(now, true);
+        }
+        match self.cfg.home_mode {
+            HomeMode::Passive | HomeMode::Absolute => self.begin(now, &s),
+            HomeMode::Active => {
+                self.enable = true;
+                if s.fb.drive.enabled && !s.fb.drive.fault {
+                    self.begin(now, &s);
+                } else {
+                    self.state = State::Enabling { since: now };
+                }
+            }
+        }
+    }
+
+    // ------------------------------------------------------------------
+    // Per-cycle progress
+    // ------------------------------------------------------------------
+
+    fn advance(&mut self, now: u64, s: &Sample) {
+        let moving = self.state.commands_motion();
+        let stopping = matches!(self.state, State::Stopping { .. });
+        if !moving && !stopping && !s.fb.drive.enabled {
+            // Nobody holds the axis: follow it, so enabling never jumps.
+            self.profile = Profile::hold(now, s.fb.position);
+        }
+        if matches!(self.state, State::Idle) && s.fb.drive.fault {
+            self.enable = false;
+        }
+        if moving {
+            if s.fb.drive.fault {
+                return self.fail(now, ERR_SERVO_MESSAGE, EX_DRIVE_FAULT, Abort::Disable);
+            }
+            if !s.fb.drive.enabled {
+                return self.fail(
+                    now,
+                    ERR_SERVO_MESSAGE,
+                    EX_TERMINATED_ON_REQUEST,
+                    Abort::Disable,
+                );
+            }
+            let v = self.profile.sample(now).1;
+            if (v > 0.0 && s.fb.overtravel_positive) || (v < 0.0 && s.fb.overtravel_negative) {
+                return self.fail(now, ERR_SERVO_MESSAGE, EX_OVERTRAVEL, Abort::Controlled);
+            }
+        }
+        if self.check_timeout(now) {
+            return;
+        }
+        if self.check_search_limit(now) {
+            return;
+        }
+        let done = self.profile.is_done(now);
+        match self.state {
+            State::Idle => {}
+            State::Enabling { since } => {
+                if s.fb.drive.enabled && !s.fb.drive.fault {
+                    self.begin(now, s);
+                } else if s.fb.drive.fault && self.enable {
+                    // Fault reset: enable must go low before it goes high again.
+                    self.enable = false;
+                } else if now.saturating_sub(since) > secs_to_ns(self.cfg.enable_timeout) {
+                    self.fail(now, ERR_SERVO_MESSAGE, EX_ENABLE_TIMEOUT, Abort::Controlled);
+                } else {
+                    self.enable = true;
+                }
+            }
+            State::Homing(h) => match h.run {
+                Run::Search(mut search) => {
+                    let found = self.detect(now, s, &mut search);
+                    if let State::Homing(h) = &mut self.state {
+                        h.run = Run::Search(search);
+                    }
+                    if let Some(at) = found {
+                        self.found(now, s, at);
+                    }
+                }
+                Run::Profile { to_home } if done => self.profile_done(now, s, to_home),
+                Run::Profile { .. } => {}
+                Run::Waiting { .. } if !self.prev_request.hold => self.start_leg(now, s),
+                Run::Waiting { .. } => {}
+            },
+            State::Stopping { released } if done => {
+                if self.overrides && !released {
+                    self.state = State::Stopping { released: true };
+                    self.profile = self.release_profile(now, s.fb.position);
+                } else {
+                    self.overrides = false;
+                    self.state = State::Idle;
+                }
+            }
+            State::Stopping { .. } => {}
+        }
+    }
+
+    /// A cycle without valid feedback: profiles run on, nothing is detected.
+    /// An abort's stop still finishes; a release (which needs the actual
+    /// position) waits for feedback, keeping the reduced torque limits.
+    fn advance_blind(&mut self, now: u64) {
+        self.check_timeout(now);
+        if matches!(self.state, State::Stopping { .. })
+            && !self.overrides
+            && self.profile.is_done(now)
+        {
+            self.state = State::Idle;
+        }
+    }
+
+    fn check_timeout(&mut self, now: u64) -> bool {
+        let t = self.cfg.home_timeout;
+        if self.status.ip && t > 0.0 && now.saturating_sub(self.status.started_ns) > secs_to_ns(t) {
+            self.fail(now, ERR_TIMEOUT, 0, Abort::Controlled);
+            return true;
+        }
+        false
+    }
+
+    /// A commanded search leg that travelled beyond the search limit fails
+    /// with ERR 1016 and the leg's EXERR (see `codes`).
+    fn check_search_limit(&mut self, now: u64) -> bool {
+        let State::Homing(h) = self.state else {
+            return false;
+        };
+        let (Run::Search(search), Some(leg)) = (h.run, h.current()) else {
+            return false;
+        };
+        let exerr = match leg {
+            Leg::Seek(_) => EX_SEARCH_SEEK,
+            Leg::Return(_) => EX_SEARCH_RETURN,
+            Leg::Creep => EX_SEARCH_CREEP,
+            _ => return false,
+        };
+        let p = self.profile.sample(now).0;
+        if (p - search.start).abs() > self.search_limit {
+            self.fail(now, ERR_SEARCH_LIMIT, exerr, Abort::Controlled);
+            return true;
+        }
+        false
+    }
+
+    // ------------------------------------------------------------------
+    // Endings
+    // ------------------------------------------------------------------
+
+    fn complete(&mut self, now: u64, pc: bool) {
+        self.status.ip = false;
+        self.status.dn = true;
+        self.status.pc = pc;
+        self.status.homing = false;
+        self.status.homed = true;
+        self.status.finished_ns = Some(now);
+        self.overrides = false;
+        self.latches.disarm();
+        self.state = State::Idle;
+    }
+
+    fn fail(&mut self, now: u64, err: u16, exerr: u16, how: Abort) {
+        self.status.er = true;
+        self.status.pc = false;
+        self.status.err = err;
+        self.status.exerr = exerr;
+        self.latches.disarm();
+        if !self.status.ip {
+            // Refused at start: nothing was started, nothing to stop.
+            return;
+        }
+        self.status.ip = false;
+        self.status.dn = true;
+        self.status.homing = false;
+        self.status.homed = false;
+        self.status.finished_ns = Some(now);
+        match how {
+            Abort::Controlled => {
+                let (p, v) = self.profile.sample(now);
+                self.profile = Profile::stop(now, p, v, self.cfg.home_deceleration);
+                self.state = State::Stopping { released: false };
+            }
+            Abort::Disable => {
+                self.enable = false;
+                self.overrides = false;
+                let hold = self
+                    .last
+                    .map_or(self.profile.sample(now).0, |s| s.fb.position);
+                self.profile = Profile::hold(now, hold);
+                self.state = State::Idle;
+            }
+        }
+    }
+
+    // ------------------------------------------------------------------
+    // Output
+    // ------------------------------------------------------------------
+
+    fn output(&mut self, now: u64) -> Command {
+        let (mut p, mut v) = self.profile.sample(now);
+        if !p.is_finite() || !v.is_finite() {
+            // Unreachable by construction; never let it out if it happens.
+            p = self.last_command.position;
+            v = 0.0;
+            self.profile = Profile::hold(now, p);
+        }
+        let servo = self.cfg.configuration == AxisConfiguration::Servo;
+        let (torque, ptol, vtol) = if self.overrides {
+            (self.cfg.home_torque_level, 0.0, 0.0)
+        } else {
+            (
+                self.cfg.torque_limit,
+                self.cfg.position_error_tolerance,
+                self.cfg.velocity_error_tolerance,
+            )
+        };
+        let cmd = Command {
+            enable: self.enable && servo,
+            position: p,
+            velocity: v,
+            torque_limit_positive: finite_or(torque, 0.0),
+            torque_limit_negative: finite_or(torque, 0.0),
+            position_error_tolerance: finite_or(ptol, 0.0),
+            velocity_error_tolerance: finite_or(vtol, 0.0),
+            marker_arm: LatchArm {
+                id: self.latches.marker_id,
+                edge: Edge::Rising,
+            },
+            switch_arm: LatchArm {
+                id: self.latches.switch_id,
+                edge: self.latches.switch_edge,
+            },
+        };
+        self.last_command = cmd;
+        self.plausible.commanded(cmd.position);
+        cmd
+    }
+}
+
+fn finite_or(x: f64, fallback: f64) -> f64 {
+    if x.is_finite() {
+        x
+    } else {
+        fallback
+    }
+}
+
+fn secs_to_ns(s: f64) -> u64 {
+    if s.is_finite() && s > 0.0 {
+        (s * 1e9).min(u64::MAX as f64) as u64
+    } else {
+        0
+    }
+}
