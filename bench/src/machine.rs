@@ -29,7 +29,7 @@ pub fn demo_with(s: &Supervisor) -> Result<(String, MachineConfig), String> {
          priority = {}\n\
          io = \"sim\"\n\
          service_prefix = \"{}\"\n\
-         stale_cycles = 10\n\
+         feedback_timeout_ms = 10\n\
          io_watchdog_cycles = 50\n\
          cpu_dma_latency_us = 0\n\n",
         s.cycle_us, s.cpu, s.priority, s.service_prefix
@@ -64,7 +64,20 @@ mod tests {
         })
         .unwrap();
         let demo = motion_config::parse(DEMO_TOML).unwrap();
-        assert_eq!(m.axes, demo.axes);
+        // The axes are the demo's; only what is stated per cycle differs:
+        // the ambiguous-marker distance is two cycles of return travel.
+        let same = |a: &[motion_config::AxisEntry]| {
+            let mut a = a.to_vec();
+            for x in &mut a {
+                x.engine.marker_min_distance = 0.0;
+            }
+            a
+        };
+        assert_eq!(same(&m.axes), same(&demo.axes));
+        assert_eq!(
+            m.axes[1].engine.feedback_timeout_ns, 10_000_000,
+            "the same time at 8 kHz"
+        );
         assert_eq!(m.supervisor.cycle_us, 125);
         assert_eq!(m.supervisor.cpu, 0);
         assert_eq!(m.supervisor.priority, 70);

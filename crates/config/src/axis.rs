@@ -123,6 +123,7 @@ pub(crate) fn parse(
         enable_timeout: r.f64_in("enable_timeout", d.enable_timeout, 1e-3, SHORT_TIME_S, "s"),
         feedback_timeout_ns: sup.feedback_timeout_ns(),
         feedback_loss_drain: sup.feedback_loss_drain,
+        cycle_ns: sup.cycle_ns(),
         max_position,
         absolute: r.bool("absolute", false),
         max_speed: r.f64_in("max_speed", 0.0, 0.0, SPEED, "units/s"),

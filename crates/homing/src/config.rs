@@ -173,6 +173,10 @@ pub struct AxisConfig {
     /// feedback. With `d`, sustained loss of more than `d / (1 + d)` of the
     /// cycles trips eventually (0.25: above 20 %).
     pub feedback_loss_drain: f64,
+    /// The nominal time between steps (the controller cycle), ns; 0 = none.
+    /// A step that comes later counts one cycle toward the feedback-loss
+    /// bucket: a stall of the controller is not the peer's silence.
+    pub cycle_ns: u64,
     /// Raw positions beyond ±this (units) are treated as absurd feedback.
     pub max_position: f64,
     /// The fastest the axis can physically move, units/s: feedback that
@@ -229,6 +233,7 @@ impl Default for AxisConfig {
             enable_timeout: 1.0,
             feedback_timeout_ns: 10_000_000,
             feedback_loss_drain: 0.25,
+            cycle_ns: 0,
             max_position: 1.0e9,
             max_speed: 0.0,
             marker_min_distance: 0.0,

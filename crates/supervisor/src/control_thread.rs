@@ -83,6 +83,7 @@ struct ControlThread {
     cache: Option<(u32, u32, String, Vec<u8>)>,
     hlog: Option<HlogFile>,
     attached: Vec<bool>,
+    attachments: Vec<u64>,
     all_mask: u64,
 }
 
@@ -103,6 +104,7 @@ impl ControlThread {
         let all_mask = crate::core::sequence::Sequencer::new(&orders).all_mask();
         Self {
             attached: vec![false; s.machine.ios.len()],
+            attachments: vec![0; s.machine.ios.len()],
             s,
             shared,
             hub,
@@ -184,7 +186,12 @@ impl ControlThread {
         if let Some(snap) = hub.snapshot.as_deref() {
             for (k, io) in self.s.machine.ios.iter().enumerate() {
                 let now = snap.ios[k].attached;
-                if now != self.attached[k] {
+                // Attachments counted, not just the state seen: a detach and
+                // re-attach between two snapshots is reported too.
+                let attachments = snap.ios[k].attachments;
+                let bounced = now && self.attached[k] && attachments > self.attachments[k];
+                self.attachments[k] = attachments;
+                if now != self.attached[k] || bounced {
                     self.attached[k] = now;
                     if now {
                         let axes = self.s.machine.axes_of(k);

@@ -42,7 +42,7 @@ pub(super) struct Sample {
 impl Axis {
     /// This cycle's usable sample, if any.
     pub(super) fn intake(&mut self, now: u64, feedback: Option<&Feedback>) -> Option<Sample> {
-        let dt = self.loss.tick(now);
+        let dt = self.loss.tick(now, self.cfg.cycle_ns);
         let sample = self.sample(now, feedback);
         match sample {
             Some(_) => self.loss.fresh(now, dt, self.cfg.feedback_loss_drain),

@@ -6,7 +6,11 @@
 //! time instead:
 //!
 //! * a step without a fresh valid sample adds the time since the previous
-//!   step;
+//!   step — at most one nominal cycle (`cycle_ns`): a step that comes late
+//!   because the *supervisor* stalled (its thread preempted, the whole VM
+//!   descheduled) is one missed answer, not the peer's silence for the
+//!   whole stall — so only time in which the peer could have answered and
+//!   did not fills the bucket;
 //! * a step with one drains `feedback_loss_drain` × that time;
 //! * the rule trips when the bucket holds more than `feedback_timeout_ns`.
 //!
@@ -32,9 +36,13 @@ pub(super) struct FeedbackLoss {
 }
 
 impl FeedbackLoss {
-    /// Start of a step at `now`: the time elapsed since the previous step.
-    pub fn tick(&mut self, now: u64) -> u64 {
-        let dt = self.prev_step.map_or(0, |t| now.saturating_sub(t));
+    /// Start of a step at `now`: the time elapsed since the previous step,
+    /// at most `cycle_ns` (when non-zero).
+    pub fn tick(&mut self, now: u64, cycle_ns: u64) -> u64 {
+        let mut dt = self.prev_step.map_or(0, |t| now.saturating_sub(t));
+        if cycle_ns > 0 {
+            dt = dt.min(cycle_ns);
+        }
         self.prev_step = Some(now);
         self.gap_since.get_or_insert(now);
         dt
@@ -85,7 +93,7 @@ mod tests {
     fn trips_at(pattern: impl Fn(u64) -> bool, steps: u64) -> Option<u64> {
         let mut l = FeedbackLoss::default();
         for k in 0..steps {
-            let dt = l.tick(k * MS);
+            let dt = l.tick(k * MS, MS);
             if pattern(k) {
                 l.fresh(k * MS, dt, 0.25);
             } else if l.missing(dt, 10 * MS) {
@@ -93,6 +101,26 @@ mod tests {
             }
         }
         None
+    }
+
+    #[test]
+    fn a_stall_of_the_supervisor_is_one_missed_answer() {
+        // Steps at 1 ms, then the supervisor itself stalls 30 ms: its next
+        // step (no fresh sample yet) adds one cycle, not 30 ms.
+        let mut l = FeedbackLoss::default();
+        for k in 0..10 {
+            let dt = l.tick(k * MS, MS);
+            l.fresh(k * MS, dt, 0.25);
+        }
+        let dt = l.tick(40 * MS, MS);
+        assert_eq!(dt, MS);
+        assert!(!l.missing(dt, 10 * MS));
+        assert_eq!(l.bucket(), MS);
+        // Without a nominal cycle the whole stall counts (and trips).
+        let mut l = FeedbackLoss::default();
+        l.tick(0, 0);
+        let dt = l.tick(30 * MS, 0);
+        assert!(l.missing(dt, 10 * MS));
     }
 
     #[test]
@@ -124,19 +152,19 @@ mod tests {
     #[test]
     fn gap_and_reset_after_a_trip() {
         let mut l = FeedbackLoss::default();
-        let dt = l.tick(0);
+        let dt = l.tick(0, MS);
         l.fresh(0, dt, 0.25);
         for k in 1..=11 {
-            let dt = l.tick(k * MS);
+            let dt = l.tick(k * MS, MS);
             assert_eq!(l.missing(dt, 10 * MS), k == 11, "{k}");
         }
         assert_eq!(l.gap(11 * MS), 11 * MS);
         assert_eq!(l.bucket(), 11 * MS);
         // Still lost: reported once.
-        let dt = l.tick(12 * MS);
+        let dt = l.tick(12 * MS, MS);
         assert!(!l.missing(dt, 10 * MS));
         // Back: a new connection, empty bucket, no gap.
-        let dt = l.tick(13 * MS);
+        let dt = l.tick(13 * MS, MS);
         l.fresh(13 * MS, dt, 0.25);
         assert_eq!((l.bucket(), l.gap(13 * MS)), (0, 0));
     }

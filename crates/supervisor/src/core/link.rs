@@ -42,6 +42,8 @@ pub struct IoLink {
     /// Send time per sequence (ring).
     sent_ns: [u64; SENT_RING],
     window: u64,
+    /// Nominal cycle: a late step counts one cycle toward the bucket.
+    cycle_ns: u64,
     /// Leaky bucket, ns.
     bucket_ns: u64,
     limit_ns: u64,
@@ -77,6 +79,7 @@ impl IoLink {
             last_sent: 0,
             sent_ns: [0; SENT_RING],
             window,
+            cycle_ns: cycle_ns.max(1),
             bucket_ns: limit_ns,
             limit_ns,
             drain: if drain.is_finite() {
@@ -108,7 +111,12 @@ impl IoLink {
     /// One cycle: `frame` is the newest frame received this cycle, if any.
     pub fn step(&mut self, now_ns: u64, frame: Option<&FeedbackFrame>) -> LinkCycle {
         let mut out = LinkCycle::default();
-        let elapsed = self.last_step_ns.map_or(0, |t| now_ns.saturating_sub(t));
+        // A step later than the cycle is one missed answer: the supervisor's
+        // own stall is not the peer's silence (the engines count the same way).
+        let elapsed = self
+            .last_step_ns
+            .map_or(0, |t| now_ns.saturating_sub(t))
+            .min(self.cycle_ns);
         self.last_step_ns = Some(now_ns);
 
         let mut usable = None;
@@ -159,7 +167,8 @@ impl IoLink {
             }
             None => {
                 self.snap.frames_missing += 1;
-                if self.last_sent > 0 {
+                // Before the process first attached there is no gap to count.
+                if self.ever_attached {
                     self.gap += 1;
                 }
                 self.bucket_ns = self.bucket_ns.saturating_add(elapsed);
@@ -278,6 +287,20 @@ mod tests {
         wrong.header.axis_count = 3;
         assert!(!l.step(22 * MS, Some(&wrong)).fresh);
         assert_eq!(l.snap().frames_refused, 2);
+    }
+
+    #[test]
+    fn a_stall_of_the_supervisor_does_not_detach() {
+        let mut l = link();
+        for k in 1..20 {
+            run(&mut l, k, true, 7);
+        }
+        // The supervisor sleeps through 40 ms; the answer is not there yet at
+        // its next step (the peer was stalled too), then it is.
+        let f = frame(19, 7);
+        assert!(!l.step(60 * MS, None).fresh);
+        assert!(l.attached(), "one late step is one missed answer");
+        assert!(l.step(61 * MS, Some(&f)).fresh);
     }
 
     #[test]
