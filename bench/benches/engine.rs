@@ -159,6 +159,7 @@ fn machine(n: usize) -> MachineConfig {
         supervisor: d.supervisor.clone(),
         ios: d.ios.clone(),
         axes,
+        gantries: Vec::new(),
         warnings: Vec::new(),
     }
 }

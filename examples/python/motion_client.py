@@ -120,6 +120,7 @@ class AxisStatusEntry(ctypes.Structure):
         ("search_travel", ctypes.c_double),
         ("search_limit", ctypes.c_double),
         ("lost_after_s", ctypes.c_double),
+        ("skew", ctypes.c_double),
     ]
 
 

@@ -61,6 +61,7 @@ pub(crate) fn parse(
     let home_order = r
         .has("home_order")
         .then(|| r.u32_in("home_order", 0, 0, 1000));
+    let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
     let d = AxisConfig::default();
     use motion_homing::{
         AxisConfiguration as AC, ControlMode as CM, HomeDirection as HD, HomeMode as HM,
@@ -160,6 +161,7 @@ pub(crate) fn parse(
         name,
         io,
         home_order,
+        drift_limit,
         engine,
         sim,
         ethercat,

@@ -13,6 +13,7 @@
 pub mod args;
 mod axis;
 pub mod file;
+mod gantry;
 mod io;
 mod keys;
 pub mod limits;
@@ -20,6 +21,7 @@ pub mod names;
 mod problem;
 mod supervisor;
 
+pub use gantry::{GantryConfig, MAX_SIDES};
 use keys::Reader;
 pub use problem::Problem;
 
@@ -191,6 +193,9 @@ pub struct SupervisorConfig {
     /// Where the supervisor publishes how to reach it (its session file) and
     /// keeps iceoryx2's files; `None`: the default (`/run/motion` for root).
     pub runtime_dir: Option<PathBuf>,
+    /// Where the homing references of absolute axes and the homing record
+    /// live (`/var/lib/motion` for root, else `$HOME/.local/state/motion`).
+    pub state_dir: PathBuf,
 }
 
 impl SupervisorConfig {
@@ -214,6 +219,10 @@ pub struct AxisEntry {
     /// parallel. `None`: see interface.md (config order when no axis has
     /// one; only when named when some have one).
     pub home_order: Option<u32>,
+    /// Warn when a home event lands further than this (units) from the
+    /// median of the axis's recent events (switch wear, coupling slip);
+    /// 0 = off.
+    pub drift_limit: f64,
     pub engine: AxisConfig,
     pub sim: PlantConfig,
     /// Its drive, on an EtherCAT I/O process (`None` elsewhere and for a
@@ -227,11 +236,18 @@ pub struct MachineConfig {
     /// Every I/O process; at least one.
     pub ios: Vec<IoConfig>,
     pub axes: Vec<AxisEntry>,
+    /// Axes homed as one machine axis.
+    pub gantries: Vec<GantryConfig>,
     /// Things that are accepted but probably not meant (printed at start).
     pub warnings: Vec<String>,
 }
 
 impl MachineConfig {
+    /// The gantry axis `i` is a side of, if any.
+    pub fn gantry_of(&self, i: usize) -> Option<usize> {
+        self.gantries.iter().position(|g| g.axes.contains(&i))
+    }
+
     /// Index of the axis called `name`.
     pub fn axis_index(&self, name: &str) -> Option<usize> {
         self.axes.iter().position(|a| a.name == name)
@@ -270,6 +286,7 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
     let sup_table = top.table("supervisor");
     let io_tables = top.array_of_tables("io");
     let axis_tables = top.array_of_tables("axis");
+    let gantry_tables = top.array_of_tables("gantry");
     top.finish();
 
     let supervisor = supervisor::parse(sup_table.as_ref(), &mut problems, &mut warnings);
@@ -300,6 +317,7 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
         }
     }
     ethercat_checks(&ios, &axes, &mut problems);
+    let gantries = gantry::parse(&gantry_tables, &axes, &mut problems);
     for (k, io) in ios.iter().enumerate() {
         if !axes.iter().any(|a| a.io == k) && problems.is_empty() {
             warnings.push(format!("I/O process {} drives no axis", io.name));
@@ -310,6 +328,7 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
             supervisor,
             ios,
             axes,
+            gantries,
             warnings,
         })
     } else {

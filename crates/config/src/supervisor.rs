@@ -111,6 +111,21 @@ pub(crate) fn parse(
         }
         std::path::PathBuf::from(d)
     });
+    let state_dir = if r.has("state_dir") {
+        let d = r.string("state_dir", "");
+        if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
+            r.problem(
+                "state_dir",
+                format!(
+                    "{} must be an absolute path of at most 200 characters without \"..\"",
+                    names::shown(&d)
+                ),
+            );
+        }
+        std::path::PathBuf::from(d)
+    } else {
+        default_state_dir()
+    };
     r.finish();
     SupervisorConfig {
         cycle_us,
@@ -126,5 +141,18 @@ pub(crate) fn parse(
         io_cpu,
         cpu_dma_latency_us,
         runtime_dir,
+        state_dir,
+    }
+}
+
+/// `/var/lib/motion` for root (systemd's `StateDirectory=motion`), else
+/// `$HOME/.local/state/motion`.
+pub fn default_state_dir() -> std::path::PathBuf {
+    if nix::unistd::geteuid().is_root() {
+        return "/var/lib/motion".into();
+    }
+    match std::env::var_os("HOME") {
+        Some(h) => std::path::Path::new(&h).join(".local/state/motion"),
+        None => format!("/tmp/motion-state-{}", nix::unistd::geteuid()).into(),
     }
 }

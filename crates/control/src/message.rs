@@ -255,6 +255,9 @@ pub struct AxisStatusEntry {
     /// With `SX_LOST_HOMED`: seconds after homing ended that HomedStatus
     /// was lost.
     pub lost_after_s: f64,
+    /// A gantry side: the largest skew of its gantry's last homing (how far
+    /// apart the sides found their events), units; NaN otherwise.
+    pub skew: f64,
 }
 
 /// One I/O process of the status frame.
@@ -411,7 +414,7 @@ const _: () = {
     assert!(offset_of!(ControlResponse, data) == 56 + MESSAGE_LEN + 40 * MAX_AXES);
     assert!(size_of::<ControlResponse>() == 56 + MESSAGE_LEN + 40 * MAX_AXES + DATA_LEN);
 
-    assert!(size_of::<AxisStatusEntry>() == 144);
+    assert!(size_of::<AxisStatusEntry>() == 152);
     assert!(offset_of!(AxisStatusEntry, io) == 48);
     assert!(offset_of!(AxisStatusEntry, bits) == 50);
     assert!(offset_of!(AxisStatusEntry, drive_error_code) == 56);
@@ -426,8 +429,8 @@ const _: () = {
     assert!(offset_of!(IoStatusEntry, gap_cycles) == 112);
 
     assert!(offset_of!(StatusFrame, axes) == 48);
-    assert!(offset_of!(StatusFrame, ios) == 48 + 144 * MAX_AXES);
-    assert!(size_of::<StatusFrame>() == 48 + 144 * MAX_AXES + 120 * MAX_IOS);
+    assert!(offset_of!(StatusFrame, ios) == 48 + 152 * MAX_AXES);
+    assert!(size_of::<StatusFrame>() == 48 + 152 * MAX_AXES + 120 * MAX_IOS);
 };
 
 #[cfg(test)]

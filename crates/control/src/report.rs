@@ -112,6 +112,7 @@ impl AxisStatusEntry {
             final_raw: r6(self.has(ST_FEEDBACK).then_some(self.raw).and_then(finite)),
             duration_s: done.then(|| motion_report::round(self.elapsed_s, 3)),
             error: self.error_text(names),
+            skew: finite(self.skew).map(|x| motion_report::round(x, 6)),
             warnings: Vec::new(),
         }
     }
@@ -167,6 +168,7 @@ impl StatusFrame {
                         enabled: a.has(ST_ENABLED),
                         fault: a.has(ST_FAULT),
                         drive_error_code: a.drive_error_code,
+                        skew: finite(a.skew).map(|x| motion_report::round(x, 6)),
                         error: a.error_text(&names),
                     }
                 })

@@ -30,6 +30,10 @@ pub struct AxisResult {
     /// What went wrong, in words (absent when nothing did).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// A gantry side: how far apart the gantry's sides found their events
+    /// (the largest skew of the homing), units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skew: Option<f64>,
     /// Warnings that do not fail homing (ambiguous marker, drift, ...).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,

@@ -42,6 +42,9 @@ pub struct AxisStatus {
     pub fault: bool,
     /// The drive's error code (CiA 402 0x603F) while it reports a fault.
     pub drive_error_code: u16,
+    /// A gantry side: the skew of the gantry's last homing, units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skew: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
 }

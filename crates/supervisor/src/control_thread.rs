@@ -250,11 +250,18 @@ impl ControlThread {
         }
     }
 
-    /// Names → a mask; `Err(unknown names)`.
+    /// Names → a mask (a gantry's name stands for its sides);
+    /// `Err(unknown names)`.
     fn resolve(&self, names: &[String]) -> Result<u64, Vec<String>> {
         let mut mask = 0u64;
         let mut unknown = Vec::new();
         for n in names {
+            if let Some(g) = self.s.machine.gantries.iter().find(|g| &g.name == n) {
+                for &i in &g.axes {
+                    mask |= 1 << i;
+                }
+                continue;
+            }
             match self.s.machine.axis_index(n) {
                 Some(i) => mask |= 1 << i,
                 None => unknown.push(n.clone()),
@@ -335,6 +342,51 @@ impl ControlThread {
                 return;
             }
         };
+        if req.kind == REQ_HOME {
+            // A gantry is homed as one machine axis: all its sides or none.
+            let mut partial = Vec::new();
+            for g in &self.s.machine.gantries {
+                let named = g.axes.iter().filter(|&&i| mask & (1 << i) != 0).count();
+                if named > 0 && named < g.axes.len() {
+                    partial.push(g);
+                }
+            }
+            if !partial.is_empty() {
+                r.result = RESULT_REFUSED;
+                let mut k = 0;
+                let mut why = Vec::new();
+                for g in partial {
+                    for &i in &g.axes {
+                        if mask & (1 << i) != 0 && k < MAX_AXES {
+                            put_str(&mut r.axes[k].name, &self.s.machine.axes[i].name);
+                            r.axes[k].reason = REASON_GANTRY;
+                            k += 1;
+                        }
+                    }
+                    let sides: Vec<&str> = g
+                        .axes
+                        .iter()
+                        .map(|&i| self.s.machine.axes[i].name.as_str())
+                        .collect();
+                    why.push(format!(
+                        "{} is a side of gantry {} (sides {}): home {} or all its sides",
+                        self.s
+                            .machine
+                            .axes
+                            .iter()
+                            .enumerate()
+                            .find(|(i, _)| mask & (1 << i) != 0 && g.axes.contains(i))
+                            .map_or("an axis", |(_, a)| a.name.as_str()),
+                        g.name,
+                        sides.join(", "),
+                        g.name
+                    ));
+                }
+                r.axis_count = k as u32;
+                put_str(&mut r.message, &why.join("; "));
+                return;
+            }
+        }
         if req.kind == REQ_TRACE && mask.count_ones() != 1 {
             r.result = RESULT_BAD_REQUEST;
             put_str(&mut r.message, "trace needs exactly one axis");

@@ -130,6 +130,8 @@ pub struct AxisSnap {
     pub aborted_by: Option<u8>,
     /// The sequence's `timeout_ns` ran out and the axis was stopped.
     pub timed_out: bool,
+    /// A gantry side: the largest skew of its gantry's last homing, units.
+    pub skew: Option<f64>,
     /// A sequence has started, or will start, this axis.
     pub in_sequence: bool,
     /// A trace of this axis's next homing is armed or recording.

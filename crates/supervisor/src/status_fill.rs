@@ -75,7 +75,8 @@ pub fn fill(m: &MachineConfig, snap: &Snapshot, uptime_ns: u64, f: &mut StatusFr
             0.0
         };
         e.timeout_s = cfg.engine.home_timeout;
-        e.search_travel = 0.0;
+        e.search_travel = s.search_travel;
+        e.skew = a.skew.unwrap_or(f64::NAN);
         e.lost_after_s = match (a.lost_homed_ns, s.finished_ns) {
             (Some(l), Some(f)) => l.saturating_sub(f) as f64 * 1e-9,
             _ => 0.0,

@@ -10,18 +10,22 @@
 //! * [`sequence`] — home order and the failure of a home sequence.
 //! * [`trace`] — recording one homing cycle by cycle.
 
+pub mod gantry;
 pub mod link;
 pub mod sequence;
 pub mod trace;
 
 use crate::shared::{Ack, AxisAck, AxisSnap, Control, Snapshot, TraceRecord};
+use gantry::GantryCoord;
 use link::IoLink;
 use motion_config::MachineConfig;
 use motion_control::{
     REASON_ALREADY_HOMING, REASON_BUSY, REASON_EXITING, REASON_INSTRUCTION, REASON_IO_NOT_ATTACHED,
 };
 use motion_frames::{axis_to_feedback, command_to_axis, CommandFrame, FeedbackFrame, SW_NO_DATA};
-use motion_homing::codes::{ERR_ILLEGAL_HOMING_CONFIG, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST};
+use motion_homing::codes::{
+    ERR_ILLEGAL_HOMING_CONFIG, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, EX_TERMINATED_ON_REQUEST,
+};
 use motion_homing::{Axis, Command, Feedback, Phase, Request};
 use sequence::{Action, AxisView, Sequencer};
 use trace::Tracer;
@@ -67,6 +71,11 @@ pub struct Core {
     drive_error: Vec<u16>,
     links: Vec<IoLink>,
     seq: Sequencer,
+    gantries: Vec<GantryCoord>,
+    /// Per axis: its gantry (index), if a side of one.
+    gantry_of: Vec<Option<usize>>,
+    /// Per axis: the gantry side whose failure stopped it.
+    gantry_aborted_by: Vec<Option<u8>>,
     tracer: Tracer,
     trace_out: Option<TraceRecord>,
     exiting: bool,
@@ -89,7 +98,14 @@ impl Core {
             })
             .collect();
         let orders: Vec<Option<u32>> = m.axes.iter().map(|a| a.home_order).collect();
-        let seq = Sequencer::new(&orders);
+        let together: Vec<Vec<usize>> = m.gantries.iter().map(|g| g.axes.clone()).collect();
+        let seq = Sequencer::with_groups(&orders, &together);
+        let cfgs: Vec<motion_homing::AxisConfig> = m.axes.iter().map(|a| a.engine).collect();
+        let gantries: Vec<GantryCoord> = m
+            .gantries
+            .iter()
+            .map(|g| GantryCoord::new(g, &cfgs, sup.cycle_ns()))
+            .collect();
         Self {
             axes: m.axes.iter().map(|a| Axis::new(a.engine)).collect(),
             counts_per_unit: m.axes.iter().map(|a| a.engine.counts_per_unit).collect(),
@@ -102,6 +118,9 @@ impl Core {
             links,
             all_mask: seq.all_mask(),
             seq,
+            gantries,
+            gantry_of: (0..n).map(|i| m.gantry_of(i)).collect(),
+            gantry_aborted_by: vec![None; n],
             tracer: Tracer::default(),
             trace_out: None,
             exiting: false,
@@ -339,9 +358,29 @@ impl Core {
         for i in 0..n {
             if starts & (1 << i) != 0 && !self.exiting {
                 self.arm_rung(i);
+                self.gantry_aborted_by[i] = None;
             }
             if stops & (1 << i) != 0 {
                 self.rungs[i].request.stop = true;
+                self.rungs[i].request.stop_code =
+                    Some((ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST));
+            }
+        }
+        // Gantries: the barrier per phase, the final moves, skew, one side
+        // failing stops all (decided on the previous step's state).
+        for g in &mut self.gantries {
+            let d = g.step(&self.axes, &self.commands);
+            for (j, &i) in g.sides().iter().enumerate() {
+                let r = &mut self.rungs[i].request;
+                r.hold = d.hold;
+                r.move_duration_ns = d.move_duration_ns;
+                if let Some(code) = d.stop[j] {
+                    r.stop = true;
+                    r.stop_code = Some(code);
+                    if let Some(f) = d.failed_side {
+                        self.gantry_aborted_by[i] = Some(f as u8);
+                    }
+                }
             }
         }
 
@@ -381,6 +420,7 @@ impl Core {
             }
             // Stop is a one-cycle pulse (the engine takes its rising edge).
             self.rungs[i].request.stop = false;
+            self.rungs[i].request.stop_code = None;
             let s = self.axes[i].status();
             let rung = &mut self.rungs[i];
             if started {
@@ -479,7 +519,8 @@ impl Core {
                 cmd_velocity: c.velocity,
                 enable: c.enable,
                 homes_started: r.homes_started,
-                aborted_by: self.seq.aborted_by(i),
+                aborted_by: self.seq.aborted_by(i).or(self.gantry_aborted_by[i]),
+                skew: self.gantry_of[i].and_then(|g| self.gantries[g].skew()),
                 timed_out: self.seq.timed_out(i),
                 in_sequence: busy & (1 << i) != 0 || r.pending > 0,
                 traced: self.tracer.armed() == Some(i),

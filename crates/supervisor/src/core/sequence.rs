@@ -75,8 +75,14 @@ pub struct Sequencer {
 }
 
 impl Sequencer {
-    /// `orders[i]`: axis `i`'s `home_order`, if it has one.
+    /// `orders[i]`: axis `i`'s `home_order`, if it has one; `together`:
+    /// groups of axes that always start in the same cycle (the sides of a
+    /// gantry).
     pub fn new(orders: &[Option<u32>]) -> Self {
+        Self::with_groups(orders, &[])
+    }
+
+    pub fn with_groups(orders: &[Option<u32>], together: &[Vec<usize>]) -> Self {
         let has_orders = orders.iter().any(Option::is_some);
         let key = orders
             .iter()
@@ -86,7 +92,17 @@ impl Sequencer {
                 (true, None) => UNORDERED + i as u32,
                 (false, _) => i as u32,
             })
-            .collect();
+            .collect::<Vec<u32>>();
+        let mut key = key;
+        for g in together {
+            if let Some(k) = g.iter().filter_map(|&i| key.get(i).copied()).min() {
+                for &i in g {
+                    if let Some(x) = key.get_mut(i) {
+                        *x = k;
+                    }
+                }
+            }
+        }
         Self {
             key,
             has_orders,

@@ -5,7 +5,7 @@
 use super::*;
 use motion_control::REASON_IO_NOT_ATTACHED;
 use motion_frames::feedback_to_axis;
-use motion_homing::codes::*;
+
 use motion_plant::Plant;
 
 const MS: u64 = 1_000_000;
@@ -293,4 +293,170 @@ fn trace_records_one_homing() {
     assert!(recs.last().unwrap().end);
     b.run(10);
     assert!(b.core.trace_record().is_none(), "disarmed after one homing");
+}
+
+/// A racked gantry: Y1's switch at 0, Y2's 0.3 further (`rack`); markers
+/// 0.3 apart too; each side with its own offset. Switch then marker,
+/// bidirectional forward, V = 20, R = 2, acceleration = deceleration = 500.
+/// Expected, worked out by hand: Y1 detects its switch at 0, Y2 at 0.3, then
+/// each returns to its first marker beyond its switch edge: Y1 -7.5, Y2 -7.2
+/// (latched: exact); skew in the seek (switch) leg = 0.3, in the return
+/// (marker) leg = 0.3 too; final raw positions -7.5 + 1.0 = -6.5 and
+/// -7.2 + 1.5 = -5.7. X (home_order 1) homes after the gantry (order 0).
+fn gantry_toml(rack: f64, max_skew: f64, fault_y2: bool) -> String {
+    let side = |name: &str, offset: f64, at: f64| {
+        format!(
+            r#"
+[[axis]]
+name = "{name}"
+home_order = 0
+counts_per_unit = 1000.0
+marker = true
+home_sequence = "switch_then_marker"
+home_speed = 20.0
+home_return_speed = 2.0
+home_acceleration = 500.0
+home_deceleration = 500.0
+home_offset = {offset}
+travel_limits = [-100.0, 100.0]
+[axis.sim]
+start = -20.0
+switch = [{at}, {sw_hi}]
+marker_every = 10.0
+marker_at = {marker}
+hard_stop = [-110.0, 110.0]
+"#,
+            sw_hi = at + 5.0,
+            marker = 2.5 + at
+        )
+    };
+    let _ = fault_y2;
+    format!(
+        "[supervisor]\ncycle_us = 1000\ncpu = 0\n{}{}{}\n[[gantry]]\nname = \"Y\"\naxes = [\"Y1\", \"Y2\"]\nmax_skew = {max_skew}\n",
+        side("Y1", 1.0, 0.0),
+        side("Y2", 1.5, rack),
+        r#"
+[[axis]]
+name = "X"
+home_order = 1
+home_sequence = "switch"
+home_speed = 20.0
+home_return_speed = 2.0
+home_acceleration = 500.0
+home_deceleration = 500.0
+[axis.sim]
+start = -10.0
+switch = [0.0, 5.0]
+"#
+    )
+}
+
+#[test]
+fn a_racked_gantry_is_squared_by_its_own_switches_and_markers() {
+    let mut b = Bench::new(&gantry_toml(0.3, 1.0, false));
+    b.run(5);
+    let ack = b.home(b.core.all_mask(), false);
+    assert!(ack.axes[..3].iter().all(|a| a.accepted));
+    let mut started = [None; 3];
+    for _ in 0..20_000 {
+        b.cycle();
+        let s = b.snap();
+        for (i, st) in started.iter_mut().enumerate() {
+            if st.is_none() && s.axes[i].status.phase == motion_homing::Phase::Seek {
+                *st = Some(b.k);
+            }
+        }
+        if (0..3).all(|i| s.axes[i].settled()) && !s.axes[2].in_sequence {
+            break;
+        }
+    }
+    let s = b.snap();
+    let (y1, y2, x) = (s.axes[0], s.axes[1], s.axes[2]);
+    assert!(
+        y1.status.pc && y2.status.pc && x.status.pc,
+        "{y1:?}\n{y2:?}\n{x:?}"
+    );
+    // Each side's own marker, exactly.
+    assert!((y1.status.event_raw.unwrap() + 7.5).abs() < 1e-9);
+    assert!((y2.status.event_raw.unwrap() + 7.2).abs() < 1e-9);
+    // Each side's own offset applied: both at Home Position 0.
+    assert!(
+        (b.plants[0].position() + 6.5).abs() < 1e-9,
+        "{}",
+        b.plants[0].position()
+    );
+    assert!(
+        (b.plants[1].position() + 5.7).abs() < 1e-9,
+        "{}",
+        b.plants[1].position()
+    );
+    // The seek leg started in the same cycle on both sides.
+    assert_eq!(started[0], started[1]);
+    // Skew measured: the sides found their events 0.3 apart (± two cycles
+    // of travel at the leg's speed: 2 × 0.02).
+    let skew = y1.skew.unwrap();
+    assert!((skew - 0.3).abs() <= 0.04 + 1e-9, "skew {skew}");
+    assert_eq!(y2.skew, y1.skew);
+    // X (order 1) started only after the gantry had finished.
+    assert!(started[2].unwrap() > y1.status.finished_ns.unwrap() / MS);
+}
+
+#[test]
+fn a_gantry_racked_beyond_max_skew_fails_on_both_sides_before_squaring() {
+    // Racked 2.0 with max_skew 0.5: Y1 finds its switch; Y2 may travel 0.5
+    // further, then both stop with ERR 1017.
+    let mut b = Bench::new(&gantry_toml(2.0, 0.5, false));
+    b.run(5);
+    b.home(b.core.all_mask(), false);
+    let mut y1_switch_at_stop = None;
+    for _ in 0..20_000 {
+        b.cycle();
+        let s = b.snap();
+        if y1_switch_at_stop.is_none() && s.axes[0].status.er {
+            y1_switch_at_stop = Some(b.plants[1].position());
+        }
+        if (0..3).all(|i| !s.axes[i].status.ip && !s.axes[i].in_sequence) && b.k > 100 {
+            break;
+        }
+    }
+    let s = b.snap();
+    for i in 0..2 {
+        let st = s.axes[i].status;
+        assert!(st.er && !st.homed, "{st:?}");
+        assert_eq!(
+            (st.err, st.exerr),
+            (motion_homing::codes::ERR_GANTRY_SKEW, 0)
+        );
+    }
+    // Y2 never reached its switch (at 2.0): it came to rest within max_skew
+    // + the stopping distance (20²/1000 = 0.4) + four cycles of travel at
+    // 20 (0.08: Y1's detection lag of up to two cycles, the decision's
+    // cycle, the stop's first cycle) past Y1's event at 0.
+    let y2 = b.plants[1].position();
+    assert!(y2 <= 0.5 + 0.4 + 0.08 + 1e-9, "{y2}");
+    assert!(y2 < 2.0, "never reached its own switch");
+    assert!(s.axes[0].skew.unwrap() >= 0.5);
+    // X of the later order was never started: the sequence failed.
+    assert_eq!(s.axes[2].homes_started, 0);
+    assert_eq!(s.axes[2].aborted_by, Some(0));
+}
+
+#[test]
+fn a_side_faulting_mid_phase_stops_every_side() {
+    let mut b = Bench::new(&gantry_toml(0.3, 1.0, false));
+    b.run(5);
+    b.home(0b011, false);
+    b.run(300); // both seeking
+    b.plants[1].inject_fault();
+    b.run(2000);
+    let s = b.snap();
+    let (y1, y2) = (s.axes[0].status, s.axes[1].status);
+    assert_eq!((y2.err, y2.exerr), (12, 16), "{y2:?}");
+    assert_eq!((y1.err, y1.exerr), (12, 1), "{y1:?}");
+    assert_eq!(
+        s.axes[0].aborted_by,
+        Some(1),
+        "Y1 names the side that failed"
+    );
+    assert!(!y1.homed && !y2.homed);
 }
