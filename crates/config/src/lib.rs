@@ -31,6 +31,9 @@ use std::path::{Path, PathBuf};
 
 /// The built-in default machine (`deploy/demo.toml`).
 pub const DEMO_TOML: &str = include_str!("../../../deploy/demo.toml");
+/// The shipped gantry example (`deploy/gantry.toml`): home order, a racked
+/// gantry, an absolute axis.
+pub const GANTRY_TOML: &str = include_str!("../../../deploy/gantry.toml");
 
 /// Most axes one supervisor drives (the frame layout's fixed capacity).
 pub const MAX_AXES: usize = 64;
