@@ -101,7 +101,11 @@ pub fn status(r: &crate::StatusReport) -> String {
             b(a.er, "ER"),
             b(a.ip, "IP"),
             b(a.pc, "PC"),
-            if a.homed { "yes" } else { "no" },
+            match (a.homed, a.restored) {
+                (true, true) => "stored",
+                (true, false) => "yes",
+                _ => "no",
+            },
             format!("{}/{}", a.err, a.exerr),
             f(a.position, 4, 12),
             f(a.raw, 4, 12),
@@ -126,6 +130,9 @@ pub fn status(r: &crate::StatusReport) -> String {
         );
         if let Some(e) = &a.error {
             s += &format!("  └ {e}\n");
+        }
+        for wrn in &a.warnings {
+            s += &format!("  └ warning: {wrn}\n");
         }
     }
     for io in &r.io {
