@@ -187,8 +187,8 @@ pub struct SupervisorConfig {
     /// SCHED_FIFO priority of a spawned `motion-io` (0: normal scheduling).
     /// Default: 10 below the cycle, still above the kernel's IRQ threads (50).
     pub io_priority: i32,
-    /// CPU a spawned `motion-io` is pinned to; `None`: another CPU than the
-    /// cycle's, if the machine has one.
+    /// CPU a spawned `motion-io` is pinned to; `None`: the cycle's CPU (it
+    /// answers while the cycle sleeps; see `motion_supervisor::session`).
     pub io_cpu: Option<usize>,
     /// Hold `/dev/cpu_dma_latency` at this many µs while running (default 0,
     /// as cyclictest does); negative: leave the idle states alone.
