@@ -537,3 +537,15 @@ fn the_gantry_example_has_orders_a_gantry_and_an_absolute_axis() {
     assert_eq!(w.home_mode, motion_homing::HomeMode::Absolute);
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
 }
+
+/// The README's ranges table is the one the code enforces.
+#[test]
+fn the_readme_prints_every_range() {
+    let readme = include_str!("../../../README.md");
+    for (key, ..) in crate::limits::TABLE {
+        assert!(
+            readme.contains(&format!("| `{key}` |")),
+            "README.md lacks the range of {key}"
+        );
+    }
+}
