@@ -53,6 +53,11 @@ pub fn axis_results(rows: &[AxisResult]) -> String {
         if let Some(e) = &r.error {
             s += &format!("  └ {e}\n");
         }
+        if let Some(k) = r.skew {
+            s += &format!(
+                "  └ gantry side: skew {k:.4} (how far apart the sides latched their events)\n"
+            );
+        }
         for wrn in &r.warnings {
             s += &format!("  └ warning: {wrn}\n");
         }
