@@ -211,7 +211,8 @@ impl StatusFrame {
                         elapsed_s: motion_report::round(a.elapsed_s, 3),
                         timeout_s: a.timeout_s,
                         search_travel: motion_report::round(a.search_travel, 6),
-                        search_limit: (a.search_limit > 0.0).then_some(a.search_limit),
+                        search_limit: (a.search_limit > 0.0)
+                            .then(|| motion_report::round(a.search_limit, 6)),
                         enabled: a.has(ST_ENABLED),
                         fault: a.has(ST_FAULT),
                         drive_error_code: a.drive_error_code,

@@ -77,7 +77,7 @@ pub fn status(r: &crate::StatusReport) -> String {
         + 2;
     let b = |x: bool, c: &'static str| if x { c } else { "." };
     let mut s = format!(
-        "{:<w$}{:<8}{:<13}{:<12}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17}{:>20}\n",
+        "{:<w$}{:<8}{:<13}{:<12}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17} {:>19}\n",
         "axis",
         "io",
         "phase",
@@ -97,7 +97,7 @@ pub fn status(r: &crate::StatusReport) -> String {
             x.map_or(format!("{:>width$}", "-"), |v| format!("{v:>width$.p$}"))
         };
         s += &format!(
-            "{:<w$}{:<8}{:<13}{} {} {} {} {} {:>7}{:>10}{}{}{}{} {}{}{:>17}{:>20}\n",
+            "{:<w$}{:<8}{:<13}{} {} {} {} {} {:>7}{:>10}{}{}{}{} {}{}{:>17} {:>19}\n",
             a.name,
             a.io,
             a.phase,
@@ -130,7 +130,8 @@ pub fn status(r: &crate::StatusReport) -> String {
             format!(
                 "{:.3}/{}",
                 a.search_travel,
-                a.search_limit.map_or("-".to_string(), |l| format!("{l}"))
+                a.search_limit
+                    .map_or("-".to_string(), |l| format!("{l:.3}"))
             ),
         );
         if let Some(e) = &a.error {

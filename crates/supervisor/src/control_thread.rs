@@ -241,6 +241,8 @@ impl ControlThread {
                         } else {
                             log::info!("I/O process {} attached ({})", io.name, names.join(", "));
                         }
+                    } else if snap.exiting {
+                        log::info!("I/O process {} stopped answering (shutting down)", io.name);
                     } else {
                         log::warn!(
                             "I/O process {} detached: no fresh feedback for {} cycles; its \

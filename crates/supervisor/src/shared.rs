@@ -189,6 +189,8 @@ pub struct Snapshot {
     pub ios: [IoSnap; MAX_IOS],
     /// Every axis is at rest with nothing in process.
     pub all_at_rest: bool,
+    /// The supervisor is leaving (axes stopped, drives disabled).
+    pub exiting: bool,
 }
 
 impl Default for Snapshot {
@@ -201,6 +203,7 @@ impl Default for Snapshot {
             io_count: 0,
             ios: [IoSnap::default(); MAX_IOS],
             all_at_rest: true,
+            exiting: false,
         }
     }
 }

@@ -573,6 +573,7 @@ impl Core {
             s.ios[k] = l.snap();
         }
         s.all_at_rest = self.all_at_rest();
+        s.exiting = self.exiting;
     }
 }
 
