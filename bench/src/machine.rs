@@ -65,11 +65,13 @@ mod tests {
         .unwrap();
         let demo = motion_config::parse(DEMO_TOML).unwrap();
         // The axes are the demo's; only what is stated per cycle differs:
-        // the ambiguous-marker distance is two cycles of return travel.
+        // the ambiguous-marker distance is two cycles of return travel,
+        // and the engine is told the cycle it runs at.
         let same = |a: &[motion_config::AxisEntry]| {
             let mut a = a.to_vec();
             for x in &mut a {
                 x.engine.marker_min_distance = 0.0;
+                x.engine.cycle_ns = 0;
             }
             a
         };
