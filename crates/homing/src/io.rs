@@ -119,4 +119,8 @@ pub struct Request {
     /// 1 for "home-all aborted because another axis failed", or 1017 / 0 for
     /// gantry skew).
     pub stop_code: Option<(u16, u16)>,
+    /// The supervisor woke late for this cycle (its CPU was stalled): a
+    /// missing sample is excused, within a bound, by the feedback-loss rule
+    /// (see `axis::loss`).
+    pub stalled: bool,
 }

@@ -196,7 +196,11 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
         for (slot, p) in frames.iter_mut().zip(&pending) {
             *slot = p.as_ref().map(|s| s.payload());
         }
-        let info = core.step(wake.deadline_ns, &frames[..n_io]);
+        // Woke more than a quarter cycle late (or missed a deadline): the CPU the
+        // I/O process shares was taken away too, and this thread, of higher
+        // priority, runs first when it comes back.
+        let stalled = wake.missed > 0 || wake.latency_ns > period / 4;
+        let info = core.step(wake.deadline_ns, stalled, &frames[..n_io]);
         // Release the shared-memory samples before the next receive.
         for p in pending.iter_mut() {
             *p = None;

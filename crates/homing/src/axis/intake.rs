@@ -41,12 +41,17 @@ pub(super) struct Sample {
 
 impl Axis {
     /// This cycle's usable sample, if any.
-    pub(super) fn intake(&mut self, now: u64, feedback: Option<&Feedback>) -> Option<Sample> {
+    pub(super) fn intake(
+        &mut self,
+        now: u64,
+        feedback: Option<&Feedback>,
+        stalled: bool,
+    ) -> Option<Sample> {
         let dt = self.loss.tick(now, self.cfg.cycle_ns);
         let sample = self.sample(now, feedback);
         match sample {
             Some(_) => self.loss.fresh(now, dt, self.cfg.feedback_loss_drain),
-            None => self.missing(now, dt),
+            None => self.missing(now, dt, stalled),
         }
         self.status.feedback_gap_ns = self.loss.gap(now);
         self.status.feedback_loss_ns = self.loss.bucket();
@@ -121,8 +126,8 @@ impl Axis {
     }
 
     /// A step without a usable sample, `dt` after the previous step.
-    fn missing(&mut self, now: u64, dt: u64) {
-        if self.loss.missing(dt, self.cfg.feedback_timeout_ns) {
+    fn missing(&mut self, now: u64, dt: u64, stalled: bool) {
+        if self.loss.missing(dt, self.cfg.feedback_timeout_ns, stalled) {
             self.status.feedback_ok = false;
             self.status.homed = false;
             self.status.lost_after_ns = Some(self.loss.gap(now));

@@ -12,7 +12,16 @@
 //!   whole stall — so only time in which the peer could have answered and
 //!   did not fills the bucket;
 //! * a step with one drains `feedback_loss_drain` × that time;
-//! * the rule trips when the bucket holds more than `feedback_timeout_ns`.
+//! * the rule trips when the bucket holds more than `feedback_timeout_ns`;
+//! * a missing sample in a step the supervisor itself woke late for
+//!   ([`Request::stalled`](crate::Request::stalled): the CPU both processes
+//!   share was taken away, by the hypervisor, an SMI, a higher-priority
+//!   thread) is excused — counted as a gap, not charged — for at most
+//!   `feedback_timeout_ns` of such steps per gap. When the CPU comes back
+//!   the supervisor, of higher priority, runs before the I/O process can
+//!   answer, so a stalled machine would otherwise look like a silent peer;
+//!   the bound keeps a dead peer on a permanently overloaded machine caught
+//!   within twice the timeout.
 //!
 //! So a dead peer trips within the timeout plus one cycle, an isolated gap
 //! shorter than the timeout never trips, and sustained loss of more than
@@ -31,6 +40,8 @@ pub(super) struct FeedbackLoss {
     /// Time of the last step with a fresh valid sample (or of the first step,
     /// before any): where the current gap began.
     gap_since: Option<u64>,
+    /// Missing time excused in this gap (stalled steps), ns.
+    excused: u64,
     /// Tripped, and no fresh sample since.
     tripped: bool,
 }
@@ -59,11 +70,16 @@ impl FeedbackLoss {
             self.bucket = self.bucket.saturating_sub(d);
         }
         self.gap_since = Some(now);
+        self.excused = 0;
     }
 
-    /// This step had no usable sample. True when the rule trips now (once
-    /// per loss).
-    pub fn missing(&mut self, dt: u64, timeout_ns: u64) -> bool {
+    /// This step had no usable sample; `stalled`: the supervisor woke late
+    /// for it. True when the rule trips now (once per loss).
+    pub fn missing(&mut self, dt: u64, timeout_ns: u64, stalled: bool) -> bool {
+        if stalled && self.excused.saturating_add(dt) <= timeout_ns {
+            self.excused += dt;
+            return false;
+        }
         self.bucket = self.bucket.saturating_add(dt);
         if self.bucket > timeout_ns && !self.tripped {
             self.tripped = true;
@@ -96,7 +112,7 @@ mod tests {
             let dt = l.tick(k * MS, MS);
             if pattern(k) {
                 l.fresh(k * MS, dt, 0.25);
-            } else if l.missing(dt, 10 * MS) {
+            } else if l.missing(dt, 10 * MS, false) {
                 return Some(k);
             }
         }
@@ -114,13 +130,13 @@ mod tests {
         }
         let dt = l.tick(40 * MS, MS);
         assert_eq!(dt, MS);
-        assert!(!l.missing(dt, 10 * MS));
+        assert!(!l.missing(dt, 10 * MS, false));
         assert_eq!(l.bucket(), MS);
         // Without a nominal cycle the whole stall counts (and trips).
         let mut l = FeedbackLoss::default();
         l.tick(0, 0);
         let dt = l.tick(30 * MS, 0);
-        assert!(l.missing(dt, 10 * MS));
+        assert!(l.missing(dt, 10 * MS, false));
     }
 
     #[test]
@@ -150,19 +166,46 @@ mod tests {
     }
 
     #[test]
+    fn stalled_steps_are_excused_up_to_the_timeout() {
+        // Every other step stalled and missing, the others fresh: with the
+        // stalls charged this trips (see above); excused it never does.
+        let mut l = FeedbackLoss::default();
+        for k in 0..10_000 {
+            let dt = l.tick(k * MS, MS);
+            if k % 2 == 0 {
+                l.fresh(k * MS, dt, 0.25);
+            } else {
+                assert!(!l.missing(dt, 10 * MS, true), "{k}");
+            }
+        }
+        assert_eq!(l.bucket(), 0);
+        // A dead peer on a machine whose every step is late: 10 ms excused,
+        // then charged; trips after 21 missing steps.
+        let mut l = FeedbackLoss::default();
+        let dt = l.tick(0, MS);
+        l.fresh(0, dt, 0.25);
+        let tripped = (1..100).find(|&k| {
+            let dt = l.tick(k * MS, MS);
+            l.missing(dt, 10 * MS, true)
+        });
+        assert_eq!(tripped, Some(21));
+        assert_eq!(l.gap(21 * MS), 21 * MS);
+    }
+
+    #[test]
     fn gap_and_reset_after_a_trip() {
         let mut l = FeedbackLoss::default();
         let dt = l.tick(0, MS);
         l.fresh(0, dt, 0.25);
         for k in 1..=11 {
             let dt = l.tick(k * MS, MS);
-            assert_eq!(l.missing(dt, 10 * MS), k == 11, "{k}");
+            assert_eq!(l.missing(dt, 10 * MS, false), k == 11, "{k}");
         }
         assert_eq!(l.gap(11 * MS), 11 * MS);
         assert_eq!(l.bucket(), 11 * MS);
         // Still lost: reported once.
         let dt = l.tick(12 * MS, MS);
-        assert!(!l.missing(dt, 10 * MS));
+        assert!(!l.missing(dt, 10 * MS, false));
         // Back: a new connection, empty bucket, no gap.
         let dt = l.tick(13 * MS, MS);
         l.fresh(13 * MS, dt, 0.25);

@@ -210,7 +210,7 @@ impl Axis {
     }
 
     pub fn step(&mut self, now_ns: u64, feedback: Option<&Feedback>, request: &Request) -> Command {
-        let fresh = self.intake(now_ns, feedback);
+        let fresh = self.intake(now_ns, feedback, request.stalled);
         self.requests(now_ns, request);
         match fresh {
             Some(s) => self.advance(now_ns, &s),

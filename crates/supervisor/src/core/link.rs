@@ -16,7 +16,8 @@
 //! The process is attached while its answers satisfy the same leaky-bucket
 //! rule the engines apply to their feedback: missing time fills the bucket,
 //! fresh answers drain it, and past the time bound the process is detached
-//! (the engines abort homing on its axes by the same rule, independently).
+//! (the engines abort homing on its axes by the same rule, independently),
+//! including its excuse for steps the supervisor woke late for.
 //! When answers come back — or frames of a new *origin* arrive, i.e. the
 //! process was restarted — it (re)attaches, and its axes are told they were
 //! reconnected: HomedStatus cleared, as the CIP rules ask.
@@ -46,6 +47,8 @@ pub struct IoLink {
     cycle_ns: u64,
     /// Leaky bucket, ns.
     bucket_ns: u64,
+    /// Missing time excused in the current gap (late steps), ns.
+    excused_ns: u64,
     limit_ns: u64,
     drain: f64,
     last_step_ns: Option<u64>,
@@ -81,6 +84,7 @@ impl IoLink {
             window,
             cycle_ns: cycle_ns.max(1),
             bucket_ns: limit_ns,
+            excused_ns: 0,
             limit_ns,
             drain: if drain.is_finite() {
                 drain.clamp(0.0, 1.0)
@@ -108,8 +112,14 @@ impl IoLink {
         self.snap.frames_refused += 1;
     }
 
-    /// One cycle: `frame` is the newest frame received this cycle, if any.
-    pub fn step(&mut self, now_ns: u64, frame: Option<&FeedbackFrame>) -> LinkCycle {
+    /// One cycle: `frame` is the newest frame received this cycle, if any;
+    /// `stalled`: the supervisor woke late for it.
+    pub fn step(
+        &mut self,
+        now_ns: u64,
+        frame: Option<&FeedbackFrame>,
+        stalled: bool,
+    ) -> LinkCycle {
         let mut out = LinkCycle::default();
         // A step later than the cycle is one missed answer: the supervisor's
         // own stall is not the peer's silence (the engines count the same way).
@@ -148,6 +158,7 @@ impl IoLink {
                     self.snap.gaps.add(self.gap);
                     self.gap = 0;
                 }
+                self.excused_ns = 0;
                 self.snap.frames_received += 1;
                 self.bucket_ns = self
                     .bucket_ns
@@ -171,7 +182,13 @@ impl IoLink {
                 if self.ever_attached {
                     self.gap += 1;
                 }
-                self.bucket_ns = self.bucket_ns.saturating_add(elapsed);
+                // The machine stalled, not the peer: excused, within a bound
+                // (the engines' rule, `motion_homing` axis::loss).
+                if stalled && self.excused_ns.saturating_add(elapsed) <= self.limit_ns {
+                    self.excused_ns += elapsed;
+                } else {
+                    self.bucket_ns = self.bucket_ns.saturating_add(elapsed);
+                }
                 if self.attached && self.bucket_ns > self.limit_ns {
                     self.attached = false;
                 }
@@ -216,7 +233,7 @@ mod tests {
     /// Cycle k: publish command k, and get the answer to k-1.
     fn run(l: &mut IoLink, k: u64, answer: bool, origin: u64) -> LinkCycle {
         let f = frame(k.saturating_sub(1), origin);
-        let c = l.step(k * MS, (answer && k > 1).then_some(&f));
+        let c = l.step(k * MS, (answer && k > 1).then_some(&f), false);
         l.sent(k, k * MS);
         c
     }
@@ -261,6 +278,36 @@ mod tests {
     }
 
     #[test]
+    fn late_steps_are_excused_within_the_bound() {
+        let mut l = link();
+        for k in 1..20 {
+            run(&mut l, k, true, 7);
+        }
+        // A dead peer, and every step late: 10 ms excused, then 11 charged.
+        let mut detached_at = None;
+        for k in 20..60 {
+            let c = l.step(k * MS, None, true);
+            assert!(!c.fresh);
+            l.sent(k, k * MS);
+            if !l.attached() && detached_at.is_none() {
+                detached_at = Some(k);
+            }
+        }
+        assert_eq!(detached_at, Some(40));
+        // Late steps missing every other cycle, for ever: attached throughout,
+        // and every gap counted.
+        let mut l = link();
+        for k in 1..2000 {
+            let answer = k % 2 == 0;
+            let f = frame(k - 1, 7);
+            l.step(k * MS, answer.then_some(&f), !answer);
+            l.sent(k, k * MS);
+            assert!(k < 3 || l.attached(), "{k}");
+        }
+        assert_eq!(l.snap().gaps.one, 998);
+    }
+
+    #[test]
     fn a_restarted_peer_is_a_reconnection() {
         let mut l = link();
         for k in 1..10 {
@@ -278,14 +325,14 @@ mod tests {
             run(&mut l, k, true, 7);
         }
         let forged = frame(u64::MAX, 7);
-        assert!(!l.step(20 * MS, Some(&forged)).fresh);
+        assert!(!l.step(20 * MS, Some(&forged), false).fresh);
         assert_eq!(l.snap().frames_refused, 1);
         let old = frame(5, 7); // 14 commands old, window 10
-        assert!(!l.step(21 * MS, Some(&old)).fresh);
+        assert!(!l.step(21 * MS, Some(&old), false).fresh);
         assert_eq!(l.snap().frames_too_old, 1);
         let mut wrong = frame(19, 7);
         wrong.header.axis_count = 3;
-        assert!(!l.step(22 * MS, Some(&wrong)).fresh);
+        assert!(!l.step(22 * MS, Some(&wrong), false).fresh);
         assert_eq!(l.snap().frames_refused, 2);
     }
 
@@ -298,9 +345,9 @@ mod tests {
         // The supervisor sleeps through 40 ms; the answer is not there yet at
         // its next step (the peer was stalled too), then it is.
         let f = frame(19, 7);
-        assert!(!l.step(60 * MS, None).fresh);
+        assert!(!l.step(60 * MS, None, false).fresh);
         assert!(l.attached(), "one late step is one missed answer");
-        assert!(l.step(61 * MS, Some(&f)).fresh);
+        assert!(l.step(61 * MS, Some(&f), false).fresh);
     }
 
     #[test]
@@ -309,7 +356,7 @@ mod tests {
         l.sent(1, 5 * MS);
         let mut f = frame(1, 7);
         f.header.timestamp_ns = 5 * MS + 30_000;
-        let c = l.step(6 * MS, Some(&f));
+        let c = l.step(6 * MS, Some(&f), false);
         assert_eq!(c.roundtrip_ns, Some(30_000));
     }
 }

@@ -335,14 +335,22 @@ impl Core {
     }
 
     /// One cycle: `frames[k]` is the newest frame received from I/O process
-    /// `k` this cycle, if any.
-    pub fn step(&mut self, now_ns: u64, frames: &[Option<&FeedbackFrame>]) -> CycleInfo {
+    /// `k` this cycle, if any. `stalled`: the thread woke late for this
+    /// cycle (its CPU was taken away); a missing answer is then the
+    /// machine's stall more likely than the peer's silence, and the
+    /// feedback-loss rules excuse it within a bound.
+    pub fn step(
+        &mut self,
+        now_ns: u64,
+        stalled: bool,
+        frames: &[Option<&FeedbackFrame>],
+    ) -> CycleInfo {
         self.cycle += 1;
         let mut info = CycleInfo::default();
         let n = self.axes.len();
         for (k, link) in self.links.iter_mut().enumerate() {
             let frame = frames.get(k).copied().flatten();
-            let c = link.step(now_ns, frame);
+            let c = link.step(now_ns, frame, stalled);
             if link.attached() && !c.answered_previous {
                 info.late_replies += 1;
             }
@@ -448,7 +456,10 @@ impl Core {
             }
             // Leaving: once everything is at rest, disable the drives.
             rung.request.shutdown = at_rest;
-            let req = rung.request;
+            let req = Request {
+                stalled,
+                ..rung.request
+            };
             let fb = self.feedback[i];
             self.commands[i] = self.axes[i].step(now_ns, fb.as_ref(), &req);
             if fb.is_some() {

@@ -54,7 +54,7 @@ impl Bench {
         let frames: Vec<Option<&FeedbackFrame>> = (0..self.fb.len())
             .map(|k| (self.alive[k] && self.seq[k] > 0).then_some(&self.fb[k]))
             .collect();
-        self.core.step(now, &frames);
+        self.core.step(now, false, &frames);
         let dt = self.m.supervisor.cycle_us as f64 * 1e-6;
         for k in 0..self.cmd.len() {
             self.core.fill(k, &mut self.cmd[k]);
