@@ -14,6 +14,7 @@
 
 pub mod args;
 pub mod cyclictest;
+pub mod drive;
 pub mod ecat;
 pub mod hist;
 pub mod machine;
