@@ -486,7 +486,10 @@ fn real_main(o: &Opts) -> Result<i32, String> {
     if leftovers.is_empty() {
         line("shared memory and session files: nothing left behind".into());
     } else {
-        line(format!("LEFT BEHIND: {}", leftovers.join(", ")));
+        line(format!(
+            "left behind (then cleaned by the bench): {}",
+            leftovers.join(", ")
+        ));
     }
     print!("{text}");
     let report = json!({
@@ -714,10 +717,18 @@ fn trial(
             drive::tail(&ended.stderr, 3)
         ));
     }
-    let left = drive::leftovers(&prefix);
-    if !left.is_empty() {
-        t.problems.push(format!("left behind: {}", left.join(", ")));
-        leftovers.extend(left);
+    let (found, remaining) = drive::clean_leftovers(&prefix);
+    if !found.is_empty() {
+        t.problems.push(format!(
+            "left behind (then cleaned by the bench{}): {}",
+            if remaining.is_empty() {
+                ""
+            } else {
+                ", NOT all"
+            },
+            found.join(", ")
+        ));
+        leftovers.extend(found);
     }
     let _ = std::fs::remove_file(&cfg);
     if signalled {

@@ -1291,13 +1291,19 @@ fn last_lines(s: &str, n: usize) -> String {
     lines[lines.len().saturating_sub(n)..].join(" | ")
 }
 
-/// Shared memory the supervisor (or its motion-io) left behind.
+/// Shared memory the supervisor (or its motion-io, or a motionctl) left
+/// behind: reported, then removed if no process of the prefix lives.
 fn leftover_shm(prefix: &str, warnings: &mut BTreeSet<String>) {
-    let left = motion_frames::Domain::shm_files_of_prefix(prefix);
-    if !left.is_empty() {
+    let (found, remaining) = drive::clean_leftovers(prefix);
+    if !found.is_empty() {
         warnings.insert(format!(
-            "shared memory left in /dev/shm after a run: {}",
-            left.join(", ")
+            "left in /dev/shm after a run (then cleaned by the bench{}): {}",
+            if remaining.is_empty() {
+                ""
+            } else {
+                ", NOT all"
+            },
+            found.join(", ")
         ));
     }
 }

@@ -9,9 +9,10 @@ use motion_bench::drive::{self, Binaries, HomeRun, Tally};
 use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc;
 use motion_bench::sys;
+use motion_report::AxisResult;
 use motion_report::GapCounts;
 use serde_json::{json, Value};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -88,6 +89,13 @@ struct Opts {
     /// motion-supervisor binary (motion-io and motionctl next to it).
     #[arg(long)]
     supervisor: Option<PathBuf>,
+    /// With --via daemon: record every one-axis homing with `motionctl trace
+    /// X --home` (every cycle: phase, commanded and actual motion, fresh
+    /// feedback or not) instead of `motionctl home X`, the result read from
+    /// `motionctl status`; the traces of failed homings are kept in
+    /// OUT/soak-evidence/.
+    #[arg(long)]
+    trace: bool,
     /// Print the config of a machine (with this run's settings) and exit.
     #[arg(long, value_enum)]
     print_config: Option<Which>,
@@ -173,6 +181,7 @@ struct Ctx {
     tmp: PathBuf,
     other_cpu: usize,
     leftovers: Vec<String>,
+    not_cleaned: Vec<String>,
     seq: u32,
 }
 
@@ -183,11 +192,22 @@ impl Ctx {
         format!("mbs{}{tag}{}", std::process::id(), self.seq)
     }
 
+    /// Reports what `prefix` left behind, then cleans it (see
+    /// [`drive::clean_leftovers`]).
     fn check_leftovers(&mut self, prefix: &str) {
-        let left = drive::leftovers(prefix);
-        if !left.is_empty() {
-            eprintln!("soak: WARNING: {prefix} left {}", left.join(", "));
-            self.leftovers.extend(left);
+        let (found, remaining) = drive::clean_leftovers(prefix);
+        if !found.is_empty() {
+            eprintln!(
+                "soak: WARNING: {prefix} left {} ({})",
+                found.join(", "),
+                if remaining.is_empty() {
+                    "cleaned"
+                } else {
+                    "NOT all cleaned"
+                }
+            );
+            self.leftovers.extend(found);
+            self.not_cleaned.extend(remaining);
         }
     }
 }
@@ -243,6 +263,7 @@ fn real_main(o: &Opts) -> Result<i32, String> {
         tmp: state.clone(),
         other_cpu,
         leftovers: Vec::new(),
+        not_cleaned: Vec::new(),
         seq: 0,
     };
     let (preemption, _) = sys::preemption();
@@ -404,7 +425,7 @@ fn real_main(o: &Opts) -> Result<i32, String> {
         "{:<34}{:>9}{:>7}{:>10}{:>8}{:>10}{:>9}{:>10}{:>8}",
         "part", "homings", "ok", "12/40", "other", "not homed", "no rows", "lost betw", "time s"
     ));
-    let row = |name: &str, p: &Part| {
+    let row = |name: &str, p: &Part, between: bool| {
         format!(
             "{:<34}{:>9}{:>7}{:>10}{:>8}{:>10}{:>9}{:>10}{:>8.0}",
             name,
@@ -414,7 +435,7 @@ fn real_main(o: &Opts) -> Result<i32, String> {
             p.tally.other_errors,
             p.tally.not_homed,
             p.tally.run_failures,
-            if o.via == Via::Daemon {
+            if between && o.via == Via::Daemon {
                 p.tally.lost_between.to_string()
             } else {
                 "-".into()
@@ -422,14 +443,11 @@ fn real_main(o: &Opts) -> Result<i32, String> {
             p.seconds
         )
     };
-    let via = match o.via {
-        Via::Daemon => "motionctl home X",
-        Via::Home => "supervisor home",
-    };
-    line(row(&format!("1 axis, no load ({via})"), &unloaded));
+    line(row("1 axis, no load", &unloaded, true));
     line(row(
-        &format!("1 axis, stress-ng CPU {other_cpu} ({via})"),
+        &format!("1 axis, stress-ng on CPU {other_cpu}"),
         &stressed,
+        true,
     ));
     let mut both = Tally::default();
     both.merge(&unloaded.tally);
@@ -441,6 +459,7 @@ fn real_main(o: &Opts) -> Result<i32, String> {
             figures: RunFigures::default(),
             seconds: unloaded.seconds + stressed.seconds,
         },
+        true,
     ));
     // 64 axes: axis homings, and runs
     line(row(
@@ -450,6 +469,15 @@ fn real_main(o: &Opts) -> Result<i32, String> {
             if o.stress64 { ", stress-ng" } else { "" }
         ),
         &axes64,
+        false,
+    ));
+    line(format!(
+        "one-axis homings {}; 64 axes: each run a fresh `motion-supervisor home --parallel --json`",
+        match o.via {
+            Via::Daemon if o.trace => "through one `motion-supervisor run` per block of --block, each a `motionctl trace X --home` (result from `motionctl status`)",
+            Via::Daemon => "through one `motion-supervisor run` per block of --block, each a `motionctl home X --json`",
+            Via::Home => "each a fresh `motion-supervisor home --json`",
+        }
     ));
     line(String::new());
     line("columns: homings = axis homings (+ requests without a result); 12/40 = failed with ERR 12 / EXERR 40 (feedback lost); other = any other error; not homed = ended with HomedStatus clear (failed ones included); no rows = the command gave no result; lost betw = found not homed by `motionctl status` before the next homing".into());
@@ -506,7 +534,16 @@ fn real_main(o: &Opts) -> Result<i32, String> {
     if ctx.leftovers.is_empty() {
         line("shared memory and session files: nothing left behind".into());
     } else {
-        line(format!("LEFT BEHIND: {}", ctx.leftovers.join(", ")));
+        line(format!(
+            "left behind by {} run(s) (then cleaned by the bench{}): {}",
+            ctx.leftovers.len(),
+            if ctx.not_cleaned.is_empty() {
+                ""
+            } else {
+                "; NOT cleaned: see soak.json"
+            },
+            ctx.leftovers.join(", ")
+        ));
     }
     print!("{t}");
 
@@ -528,6 +565,7 @@ fn real_main(o: &Opts) -> Result<i32, String> {
         "axes64": axes64.json(),
         "axes64_stress": o.stress64,
         "leftovers": ctx.leftovers,
+        "leftovers_not_cleaned": ctx.not_cleaned,
         "interrupted": interrupted,
     });
     let path = o.out.join("soak.json");
@@ -618,6 +656,8 @@ fn one_axis_daemon_block(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Re
         ));
     }
     let mut interrupted = false;
+    let mut failed_in_block = false;
+    let t_block = Instant::now();
     for i in 0..n {
         if proc::stop_requested() {
             interrupted = true;
@@ -645,17 +685,33 @@ fn one_axis_daemon_block(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Re
                     .note(format!("{prefix} before homing {}: no status", i + 1)),
             }
         }
-        let run = drive::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?;
+        let csv = ctx.tmp.join(format!("{prefix}-{}.csv", i + 1));
+        let run = if o.trace {
+            traced_home(&ctx.b.motionctl, &prefix, &csv, o.timeout)?
+        } else {
+            drive::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?
+        };
         if run.ended.interrupted {
             interrupted = true;
             break;
         }
-        if !part.tally.add(&format!("{prefix} homing {}", i + 1), &run) && !daemon.running() {
-            part.tally.note(format!("{prefix}: the daemon ended"));
-            break;
+        let what = format!("{prefix} homing {}", i + 1);
+        if !part.tally.add(&what, &run) {
+            failed_in_block = true;
+            keep_evidence(o, ctx, &prefix, i + 1, t_block, &run, &csv);
+            if !daemon.running() {
+                part.tally.note(format!("{prefix}: the daemon ended"));
+                break;
+            }
         }
+        let _ = std::fs::remove_file(&csv);
     }
     let ended = drive::stop_run(daemon, Duration::from_secs(30));
+    if failed_in_block {
+        let dir = o.out.join("soak-evidence");
+        let _ = std::fs::write(dir.join(format!("{prefix}.stderr")), &ended.stderr);
+        let _ = std::fs::write(dir.join(format!("{prefix}.run.json")), &ended.stdout);
+    }
     match drive::last_json(&ended.stdout) {
         Some(v) => {
             part.figures.add(&v);
@@ -676,6 +732,97 @@ fn one_axis_daemon_block(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Re
     ctx.check_leftovers(&prefix);
     let _ = std::fs::remove_file(&cfg);
     Ok(interrupted)
+}
+
+/// One homing of X recorded by `motionctl trace X --home --out CSV`; its
+/// result row from `motionctl status` once the trace has ended.
+fn traced_home(
+    motionctl: &Path,
+    prefix: &str,
+    csv: &Path,
+    timeout: f64,
+) -> Result<HomeRun, String> {
+    let mut cmd = Command::new(motionctl);
+    cmd.args([
+        "--service-prefix",
+        prefix,
+        "trace",
+        "X",
+        "--home",
+        "--json",
+        "--out",
+    ])
+    .arg(csv)
+    .args(["--timeout", &format!("{timeout}")]);
+    let mut run = drive::home_run(
+        &mut cmd,
+        "motionctl trace",
+        Duration::from_secs_f64(timeout + 30.0),
+    )?;
+    let status = drive::status(motionctl, prefix);
+    let a = status.as_ref().map(|v| &v["axes"][0]);
+    run.rows = match a {
+        Some(a) if a.is_object() => vec![AxisResult {
+            name: a["name"].as_str().unwrap_or("X").into(),
+            pc: a["pc"].as_bool().unwrap_or(false),
+            er: a["er"].as_bool().unwrap_or(false),
+            err: a["err"].as_u64().unwrap_or(0) as u16,
+            exerr: a["exerr"].as_u64().unwrap_or(0) as u16,
+            homed: a["homed"].as_bool().unwrap_or(false),
+            error: a["error"].as_str().map(str::to_string),
+            duration_s: a["elapsed_s"].as_f64(),
+            ..AxisResult::default()
+        }],
+        _ => Vec::new(),
+    };
+    if let Some(st) = status {
+        let trace = run.json.take();
+        run.json = Some(json!({"trace": trace, "status": st}));
+    }
+    Ok(run)
+}
+
+/// Keeps what tells why homing `i` of `prefix` failed: its row, when it
+/// happened, `motionctl status` and `stats` right after, and its trace.
+fn keep_evidence(
+    o: &Opts,
+    ctx: &Ctx,
+    prefix: &str,
+    i: u32,
+    t_block: Instant,
+    run: &HomeRun,
+    csv: &Path,
+) {
+    let dir = o.out.join("soak-evidence");
+    if std::fs::create_dir_all(&dir).is_err() {
+        return;
+    }
+    let stats = Command::new(&ctx.b.motionctl)
+        .args(["--service-prefix", prefix, "stats", "--json"])
+        .output()
+        .ok()
+        .and_then(|x| serde_json::from_slice::<Value>(&x.stdout).ok());
+    let status = drive::status(&ctx.b.motionctl, prefix);
+    let v = json!({
+        "prefix": prefix,
+        "homing": i,
+        "seconds_into_block": t_block.elapsed().as_secs_f64(),
+        "seconds_this_homing": run.seconds,
+        "rows": run.rows,
+        "output": run.json,
+        "ended": run.ended.describe(),
+        "stderr_tail": drive::tail(&run.ended.stderr, 20),
+        "status_after": status,
+        "stats_after": stats,
+        "loadavg": sys::loadavg(),
+    });
+    let _ = std::fs::write(
+        dir.join(format!("{prefix}-h{i}.json")),
+        serde_json::to_string_pretty(&v).unwrap_or_default() + "\n",
+    );
+    if csv.exists() {
+        let _ = std::fs::copy(csv, dir.join(format!("{prefix}-h{i}.csv")));
+    }
 }
 
 /// Removes a directory on drop.
