@@ -19,5 +19,6 @@ pub mod ecat;
 pub mod hist;
 pub mod machine;
 pub mod proc;
+pub mod spy;
 pub mod svg;
 pub mod sys;

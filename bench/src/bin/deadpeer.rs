@@ -12,20 +12,18 @@
 //! motion-io published (its own timestamp) shows when the silence began.
 
 use clap::{Parser, ValueEnum};
-use iceoryx2::prelude::ServiceName;
 use motion_bench::drive::{self, Binaries};
 use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc::{self, Running};
+use motion_bench::spy::{Cmd, Recording, Spy};
 use motion_bench::sys;
-use motion_frames::ports::{MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED};
-use motion_frames::wait::ppoll_until;
-use motion_frames::{monotonic_ns, CommandFrame, Domain, FeedbackFrame, IoServiceNames, CW_ENABLE};
+use motion_frames::{monotonic_ns, CW_ENABLE};
 use serde::Serialize;
 use serde_json::json;
 use std::path::PathBuf;
 use std::process::Command;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{mpsc, Arc};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// `bench/out` of the source tree, wherever the bench is started from.
@@ -106,36 +104,15 @@ struct Opts {
     supervisor: Option<PathBuf>,
 }
 
-/// One command frame as the spy saw it.
-#[derive(Clone, Copy, Debug)]
-struct Cmd {
-    seq: u64,
-    /// The supervisor's CLOCK_MONOTONIC right before sending.
-    ts: u64,
-    velocity: f64,
-    control_word: u16,
-}
-
 /// What the spy thread shares with the main thread while it runs.
 #[derive(Default)]
 struct Shared {
-    /// The spy is to end.
-    stop: AtomicBool,
     /// Send time of the first frame of the current run of cruise frames (0: not cruising).
     cruise_since: AtomicU64,
     /// CLOCK_MONOTONIC right before kill(2) (0: not yet).
     signal_ns: AtomicU64,
     /// Send time of the first stopping frame after the signal (0: none yet).
     stop_seen: AtomicU64,
-}
-
-/// What the spy recorded.
-#[derive(Default)]
-struct Recording {
-    cmds: Vec<Cmd>,
-    /// (motion-io's send time, the command sequence it answers) of every feedback frame.
-    fbs: Vec<(u64, u64)>,
-    error: Option<String>,
 }
 
 /// A command is a stopping one: slower than the cruise or the power stage off.
@@ -145,147 +122,6 @@ fn stopping(c: &Cmd, cruise: f64) -> bool {
 
 fn cruising(c: &Cmd, cruise: f64) -> bool {
     (c.velocity.abs() - cruise).abs() <= cruise * 1e-6 && c.control_word & CW_ENABLE != 0
-}
-
-fn service(name: &str) -> Result<ServiceName, String> {
-    ServiceName::new(name).map_err(|e| format!("service name {name:?}: {e:?}"))
-}
-
-/// The spy thread: subscribes to the command and feedback topics of I/O
-/// process `io` under `prefix`, waits on `command_ready` and records every
-/// frame until told to stop.
-fn spy(
-    prefix: String,
-    cpu: usize,
-    priority: i32,
-    cruise: f64,
-    shared: Arc<Shared>,
-    ready: mpsc::Sender<Result<(), String>>,
-) -> Recording {
-    let mut rec = Recording {
-        cmds: Vec::with_capacity(200_000),
-        fbs: Vec::with_capacity(200_000),
-        error: None,
-    };
-    let warnings = sys::enter_rt(Some(cpu), (priority > 0).then_some(priority));
-    for w in warnings {
-        eprintln!("deadpeer: spy: warning: {w}");
-    }
-    let setup = || -> Result<_, String> {
-        let domain = Domain::join(&prefix, None).map_err(|e| e.to_string())?;
-        let node = domain.create_node("mb-spy").map_err(|e| e.to_string())?;
-        let n = IoServiceNames::new(&prefix, "io");
-        let cmd_topic = node
-            .service_builder(&service(&n.command)?)
-            .publish_subscribe::<CommandFrame>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(0)
-            .max_publishers(1)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open()
-            .map_err(|e| format!("open {}: {e:?}", n.command))?;
-        let fb_topic = node
-            .service_builder(&service(&n.feedback)?)
-            .publish_subscribe::<FeedbackFrame>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(0)
-            .max_publishers(1)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open()
-            .map_err(|e| format!("open {}: {e:?}", n.feedback))?;
-        let event = node
-            .service_builder(&service(&n.command_ready)?)
-            .event()
-            .open()
-            .map_err(|e| format!("open {}: {e:?}", n.command_ready))?;
-        let cmd_sub = cmd_topic
-            .subscriber_builder()
-            .buffer_size(SUBSCRIBER_BUFFER)
-            .create()
-            .map_err(|e| format!("command subscriber: {e:?}"))?;
-        let fb_sub = fb_topic
-            .subscriber_builder()
-            .buffer_size(SUBSCRIBER_BUFFER)
-            .create()
-            .map_err(|e| format!("feedback subscriber: {e:?}"))?;
-        let listener = event
-            .listener_builder()
-            .create()
-            .map_err(|e| format!("listener: {e:?}"))?;
-        Ok((node, cmd_sub, fb_sub, listener))
-    };
-    let (_node, cmd_sub, fb_sub, listener) = match setup() {
-        Ok(x) => x,
-        Err(e) => {
-            let _ = ready.send(Err(e.clone()));
-            rec.error = Some(e);
-            return rec;
-        }
-    };
-    // SAFETY: only the number is kept; the listener owns the descriptor and
-    // outlives every use below.
-    let fd = unsafe {
-        iceoryx2_bb_posix::file_descriptor::FileDescriptorBased::file_descriptor(&listener)
-            .native_handle()
-    };
-    let _ = ready.send(Ok(()));
-    while !shared.stop.load(Ordering::Relaxed) {
-        let _ = ppoll_until(fd, monotonic_ns() + 2_000_000);
-        let _ = listener.try_wait(|_| {});
-        loop {
-            match cmd_sub.receive() {
-                Ok(Some(s)) => {
-                    let f = s.payload();
-                    let a = f.axes[0];
-                    let c = Cmd {
-                        seq: f.header.sequence,
-                        ts: f.header.timestamp_ns,
-                        velocity: a.target_velocity,
-                        control_word: a.control_word,
-                    };
-                    let sig = shared.signal_ns.load(Ordering::Acquire);
-                    if sig == 0 {
-                        if cruising(&c, cruise) {
-                            let _ = shared.cruise_since.compare_exchange(
-                                0,
-                                c.ts,
-                                Ordering::AcqRel,
-                                Ordering::Acquire,
-                            );
-                        } else {
-                            shared.cruise_since.store(0, Ordering::Release);
-                        }
-                    } else if c.ts > sig && stopping(&c, cruise) {
-                        let _ = shared.stop_seen.compare_exchange(
-                            0,
-                            c.ts,
-                            Ordering::AcqRel,
-                            Ordering::Acquire,
-                        );
-                    }
-                    if rec.cmds.len() < rec.cmds.capacity() {
-                        rec.cmds.push(c);
-                    }
-                }
-                Ok(None) => break,
-                Err(e) => {
-                    rec.error = Some(format!("receive command: {e:?}"));
-                    return rec;
-                }
-            }
-        }
-        while let Ok(Some(s)) = fb_sub.receive() {
-            let f = s.payload();
-            if rec.fbs.len() < rec.fbs.capacity() {
-                rec.fbs.push((f.header.timestamp_ns, f.answers_sequence));
-            }
-        }
-    }
-    rec
 }
 
 /// One trial's result.
@@ -605,25 +441,38 @@ fn trial(
         }
     };
 
-    // the spy
+    // the spy, which also watches for the cruise and the stop
     let shared = Arc::new(Shared::default());
-    let (tx, rx) = mpsc::channel();
-    let spy_thread = {
-        let (prefix, shared) = (prefix.clone(), shared.clone());
-        let prio = o.spy_priority;
-        std::thread::Builder::new()
-            .name("mb-spy".into())
-            .spawn(move || spy(prefix, spy_cpu, prio, cruise, shared, tx))
-            .map_err(|e| format!("spy thread: {e}"))?
+    let on_cmd = {
+        let shared = shared.clone();
+        move |c: &Cmd| {
+            let sig = shared.signal_ns.load(Ordering::Acquire);
+            if sig == 0 {
+                if cruising(c, cruise) {
+                    let _ = shared.cruise_since.compare_exchange(
+                        0,
+                        c.ts,
+                        Ordering::AcqRel,
+                        Ordering::Acquire,
+                    );
+                } else {
+                    shared.cruise_since.store(0, Ordering::Release);
+                }
+            } else if c.ts > sig && stopping(c, cruise) {
+                let _ =
+                    shared
+                        .stop_seen
+                        .compare_exchange(0, c.ts, Ordering::AcqRel, Ordering::Acquire);
+            }
+        }
     };
-    let spy_ok = rx
-        .recv_timeout(Duration::from_secs(10))
-        .map_err(|_| "the spy did not start".to_string())
-        .and_then(|r| r);
+    let spy = Spy::start(&prefix, "io", spy_cpu, o.spy_priority, 200_000, on_cmd);
     let mut home: Option<Running> = None;
     let mut signalled = false;
     let result = (|| -> Result<(), String> {
-        spy_ok?;
+        if let Err(e) = &spy {
+            return Err(e.clone());
+        }
         let mut cmd = Command::new(&b.motionctl);
         cmd.args([
             "--service-prefix",
@@ -672,10 +521,7 @@ fn trial(
         std::thread::sleep(Duration::from_millis(30));
         Ok(())
     })();
-    shared.stop.store(true, Ordering::Release);
-    let rec = spy_thread
-        .join()
-        .map_err(|_| "the spy thread panicked".to_string())?;
+    let rec = spy.map_or_else(|_| Recording::default(), |mut s| s.finish());
     if let Some(e) = &rec.error {
         t.problems.push(format!("spy: {e}"));
     }
@@ -794,13 +640,13 @@ fn analyse(t: &mut Trial, rec: &Recording, t_sig: u64, cruise: f64) {
         .windows(2)
         .map(|w| w[1].seq.saturating_sub(w[0].seq + 1))
         .sum();
-    if let Some(&(fb_ts, _)) = rec
+    if let Some(fb) = rec
         .fbs
         .iter()
-        .filter(|(ts, _)| *ts <= stop.ts)
-        .max_by_key(|x| x.0)
+        .filter(|f| f.ts <= stop.ts)
+        .max_by_key(|f| f.ts)
     {
-        t.from_last_feedback_ms = Some((stop.ts as f64 - fb_ts as f64) / 1e6);
+        t.from_last_feedback_ms = Some((stop.ts as f64 - fb.ts as f64) / 1e6);
     }
 }
 

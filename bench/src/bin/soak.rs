@@ -8,6 +8,7 @@ use clap::{Parser, ValueEnum};
 use motion_bench::drive::{self, Binaries, HomeRun, Tally};
 use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc;
+use motion_bench::spy::Spy;
 use motion_bench::sys;
 use motion_report::AxisResult;
 use motion_report::GapCounts;
@@ -96,6 +97,12 @@ struct Opts {
     /// OUT/soak-evidence/.
     #[arg(long)]
     trace: bool,
+    /// With --via daemon: a spy subscriber (on the other CPU, SCHED_FIFO 70)
+    /// records every command and feedback frame of each block with their
+    /// send times; blocks with a failed homing get them in
+    /// OUT/soak-evidence/PREFIX.frames.csv.
+    #[arg(long)]
+    spy: bool,
     /// Print the config of a machine (with this run's settings) and exit.
     #[arg(long, value_enum)]
     print_config: Option<Which>,
@@ -655,6 +662,17 @@ fn one_axis_daemon_block(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Re
             drive::tail(&ended.stderr, 5)
         ));
     }
+    let mut spy = if o.spy {
+        match Spy::start(&prefix, "io", ctx.other_cpu, 70, 400_000, |_| {}) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                part.tally.note(format!("{prefix}: {e}"));
+                None
+            }
+        }
+    } else {
+        None
+    };
     let mut interrupted = false;
     let mut failed_in_block = false;
     let t_block = Instant::now();
@@ -706,9 +724,17 @@ fn one_axis_daemon_block(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Re
         }
         let _ = std::fs::remove_file(&csv);
     }
+    let frames = spy.as_mut().map(Spy::finish);
+    drop(spy);
     let ended = drive::stop_run(daemon, Duration::from_secs(30));
     if failed_in_block {
         let dir = o.out.join("soak-evidence");
+        if let Some(r) = &frames {
+            let _ = std::fs::create_dir_all(&dir);
+            if let Err(e) = r.write_csv(&dir.join(format!("{prefix}.frames.csv"))) {
+                eprintln!("soak: cannot write the spy's frames: {e}");
+            }
+        }
         let _ = std::fs::write(dir.join(format!("{prefix}.stderr")), &ended.stderr);
         let _ = std::fs::write(dir.join(format!("{prefix}.run.json")), &ended.stdout);
     }
