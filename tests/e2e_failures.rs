@@ -74,6 +74,17 @@ fn io_killed_mid_homing_aborts_the_axis_and_exits_cleanly() {
         (12.0, 40.0),
         "feedback lost: {s}"
     );
+    // The error says how long the feedback was missing (on a dead peer
+    // about feedback_timeout_ms, 20 here; less if earlier gaps had left the
+    // leaky bucket part full, so only its presence is checked).
+    let e = s["error"].as_str().unwrap_or_default();
+    let ms: f64 = e
+        .split("no valid feedback for ")
+        .nth(1)
+        .and_then(|t| t.split(" ms").next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no gap in the error: {s}"));
+    assert!(ms > 0.0 && ms < 5000.0, "{s}");
     assert_eq!(s["homed"], false);
     assert!(run.stderr.contains("motion-io"), "{}", run.stderr);
     assert_clean(&cfg.prefix);

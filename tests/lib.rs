@@ -46,15 +46,19 @@ pub fn unique_prefix(tag: &str) -> String {
     )
 }
 
-/// A config file removed on drop.
+/// A config file (and its state directory) removed on drop.
 pub struct TempConfig {
     pub path: PathBuf,
     pub prefix: String,
+    /// The config's `state_dir` (homing record, stored references): one
+    /// per test unless the test sets its own.
+    pub state_dir: PathBuf,
 }
 
 impl Drop for TempConfig {
     fn drop(&mut self) {
         let _ = std::fs::remove_file(&self.path);
+        let _ = std::fs::remove_dir_all(&self.state_dir);
     }
 }
 
@@ -84,10 +88,18 @@ pub fn config(tag: &str, supervisor_extra: &str, axes: &str) -> TempConfig {
             sup += &format!("{k} = {v}\n");
         }
     }
+    let state_dir = std::env::temp_dir().join(format!("{prefix}.state"));
+    if !given("state_dir") {
+        sup += &format!("state_dir = \"{}\"\n", state_dir.display());
+    }
     let text =
         format!("[supervisor]\n{sup}service_prefix = \"{prefix}\"\n{supervisor_extra}\n{axes}");
     std::fs::write(&path, text).expect("write config");
-    TempConfig { path, prefix }
+    TempConfig {
+        path,
+        prefix,
+        state_dir,
+    }
 }
 
 /// Files of every iceoryx2 domain of this prefix in /dev/shm.

@@ -12,7 +12,7 @@ homes an axis through the control service and follows it until it is done.
 The supervisor is found through its session file ({runtime_dir}/{prefix}.session,
 readable only by the supervisor's user): it names the iceoryx2 domain and the
 session key every request must carry. The message layouts mirror
-crates/control/src/message.rs (layout 1); iceoryx2 checks type name, size and
+crates/control/src/message.rs (layout 2); iceoryx2 checks type name, size and
 alignment when the services are opened, so a wrong mirror fails loudly.
 
 Exit codes: 0 done (with --home: the axis homed with PC set), 1 refused or
@@ -58,7 +58,7 @@ class ControlRequest(ctypes.Structure):
 
     @staticmethod
     def type_name() -> str:
-        return "motion_control::ControlRequest@1"
+        return "motion_control::ControlRequest@2"
 
 
 class AxisAnswer(ctypes.Structure):
@@ -91,7 +91,7 @@ class ControlResponse(ctypes.Structure):
 
     @staticmethod
     def type_name() -> str:
-        return "motion_control::ControlResponse@1"
+        return "motion_control::ControlResponse@2"
 
 
 class AxisStatusEntry(ctypes.Structure):
@@ -99,7 +99,7 @@ class AxisStatusEntry(ctypes.Structure):
         ("name", ctypes.c_uint8 * NAME_LEN),
         ("phase", ctypes.c_uint8 * PHASE_LEN),
         ("io", ctypes.c_uint8),
-        ("reserved0", ctypes.c_uint8),
+        ("warnings", ctypes.c_uint8),
         ("bits", ctypes.c_uint16),
         ("err", ctypes.c_uint16),
         ("exerr", ctypes.c_uint16),
@@ -121,6 +121,9 @@ class AxisStatusEntry(ctypes.Structure):
         ("search_limit", ctypes.c_double),
         ("lost_after_s", ctypes.c_double),
         ("skew", ctypes.c_double),
+        ("feedback_gap_s", ctypes.c_double),
+        ("drift", ctypes.c_double),
+        ("switch_to_marker", ctypes.c_double),
     ]
 
 
@@ -156,7 +159,7 @@ class StatusFrame(ctypes.Structure):
 
     @staticmethod
     def type_name() -> str:
-        return "motion_control::StatusFrame@1"
+        return "motion_control::StatusFrame@2"
 
 
 def text(arr) -> str:
@@ -232,7 +235,7 @@ class Supervisor:
     def request(self, kind: int, axes, timeout: float = 3.0) -> ControlResponse:
         """One control request with the session key; its response."""
         req = ControlRequest()
-        req.layout_version = 1
+        req.layout_version = 2
         req.kind = kind
         req.key[0], req.key[1] = self.key
         req.request_id = self.next_id

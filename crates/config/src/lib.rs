@@ -31,6 +31,9 @@ use std::path::{Path, PathBuf};
 
 /// The built-in default machine (`deploy/demo.toml`).
 pub const DEMO_TOML: &str = include_str!("../../../deploy/demo.toml");
+/// The shipped gantry example (`deploy/gantry.toml`): home order, a racked
+/// gantry, an absolute axis.
+pub const GANTRY_TOML: &str = include_str!("../../../deploy/gantry.toml");
 
 /// Most axes one supervisor drives (the frame layout's fixed capacity).
 pub const MAX_AXES: usize = 64;
@@ -184,8 +187,8 @@ pub struct SupervisorConfig {
     /// SCHED_FIFO priority of a spawned `motion-io` (0: normal scheduling).
     /// Default: 10 below the cycle, still above the kernel's IRQ threads (50).
     pub io_priority: i32,
-    /// CPU a spawned `motion-io` is pinned to; `None`: another CPU than the
-    /// cycle's, if the machine has one.
+    /// CPU a spawned `motion-io` is pinned to; `None`: the cycle's CPU (it
+    /// answers while the cycle sleeps; see `motion_supervisor::session`).
     pub io_cpu: Option<usize>,
     /// Hold `/dev/cpu_dma_latency` at this many µs while running (default 0,
     /// as cyclictest does); negative: leave the idle states alone.

@@ -65,7 +65,7 @@ pub const TABLE: &[Range] = &[
     ("[supervisor] feedback_loss_drain", 0.0, 1.0, ""),
     ("[supervisor] io_watchdog_cycles × cycle", 1.0, 1000.0, "ms"),
     (
-        "positions (home_position, home_offset, travel_limits, max_position, sim.*)",
+        "positions (home_position, home_offset, travel_limits, max_position, drift_limit, marker_min_distance, max_skew, sim.*)",
         -POSITION,
         POSITION,
         "units",

@@ -99,7 +99,7 @@ pub(crate) fn parse(
         c => {
             r.problem(
                 "io_cpu",
-                format!("{c}: a CPU number, or -1 for \"another CPU\""),
+                format!("{c}: a CPU number, or -1 for the cycle's CPU"),
             );
             None
         }
@@ -145,9 +145,21 @@ pub(crate) fn parse(
     }
 }
 
-/// `/var/lib/motion` for root (systemd's `StateDirectory=motion`), else
-/// `$HOME/.local/state/motion`.
+/// systemd's `$STATE_DIRECTORY` (the unit's `StateDirectory=motion`), else
+/// `/var/lib/motion` for root, else `$HOME/.local/state/motion`.
 pub fn default_state_dir() -> std::path::PathBuf {
+    if let Some(d) = std::env::var_os("STATE_DIRECTORY") {
+        // Several directories are separated by ':'; ours is the first.
+        let first = d
+            .to_string_lossy()
+            .split(':')
+            .next()
+            .unwrap_or("")
+            .to_string();
+        if first.starts_with('/') {
+            return first.into();
+        }
+    }
     if nix::unistd::geteuid().is_root() {
         return "/var/lib/motion".into();
     }

@@ -521,3 +521,31 @@ ethercat_position = 0
         "io: EtherCAT I/O process bus0 drives 33 axes, at most 32",
     );
 }
+
+#[test]
+fn the_gantry_example_has_orders_a_gantry_and_an_absolute_axis() {
+    let m = parse(GANTRY_TOML).unwrap_or_else(|p| panic!("{p:#?}"));
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["Z", "Y1", "Y2", "X", "W"]);
+    let orders: Vec<Option<u32>> = m.axes.iter().map(|a| a.home_order).collect();
+    assert_eq!(orders, [Some(0), Some(1), Some(1), Some(1), None]);
+    assert_eq!(m.gantries.len(), 1);
+    assert_eq!(m.gantries[0].axes, [1, 2]);
+    assert_eq!(m.gantry_of(2), Some(0));
+    let w = &m.axes[4].engine;
+    assert!(w.absolute);
+    assert_eq!(w.home_mode, motion_homing::HomeMode::Absolute);
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+}
+
+/// The README's ranges table is the one the code enforces.
+#[test]
+fn the_readme_prints_every_range() {
+    let readme = include_str!("../../../README.md");
+    for (key, ..) in crate::limits::TABLE {
+        assert!(
+            readme.contains(&format!("| `{key}` |")),
+            "README.md lacks the range of {key}"
+        );
+    }
+}

@@ -12,7 +12,7 @@
 use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
 
 /// Layout version of every type in this file. Bump it on ANY change.
-pub const CONTROL_LAYOUT: u32 = 1;
+pub const CONTROL_LAYOUT: u32 = 2;
 
 /// Bytes of a name (axis, I/O process).
 pub const NAME_LEN: usize = 32;
@@ -103,7 +103,7 @@ pub fn reason_text(reason: u8) -> &'static str {
 /// and `offset`; the client sets `layout_version`, `key` and `request_id`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::ControlRequest@1")]
+#[type_name("motion_control::ControlRequest@2")]
 pub struct ControlRequest {
     pub layout_version: u32,
     /// `REQ_*`.
@@ -142,7 +142,7 @@ pub struct AxisAnswer {
 /// The answer to a [`ControlRequest`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::ControlResponse@1")]
+#[type_name("motion_control::ControlResponse@2")]
 pub struct ControlResponse {
     pub layout_version: u32,
     /// The request's kind.
@@ -209,6 +209,23 @@ pub const SX_IN_SEQUENCE: u8 = 1 << 2;
 pub const SX_LOST_FEEDBACK: u8 = 1 << 3;
 /// With `SX_LOST_HOMED`: lost because its I/O process reconnected.
 pub const SX_LOST_RECONNECT: u8 = 1 << 4;
+/// HomedStatus comes from the stored reference of an absolute axis,
+/// applied without motion (not from a homing run since start-up).
+pub const SX_RESTORED: u8 = 1 << 5;
+
+/// `AxisStatusEntry::warnings`: the last homing's marker lay closer to the
+/// switch edge than `marker_min_distance` (which marker is taken is a
+/// matter of chance).
+pub const W_AMBIGUOUS_MARKER: u8 = 1 << 0;
+/// The last homing's event lay further than `drift_limit` from the recent
+/// events of the axis (`drift`).
+pub const W_DRIFT: u8 = 1 << 1;
+/// The last homing's switch-to-marker distance lay further than
+/// `drift_limit` from the recent ones (`drift`).
+pub const W_SWITCH_DRIFT: u8 = 1 << 2;
+/// The stored reference of this absolute axis was invalidated (the reason
+/// is in the log and the homing record).
+pub const W_REFERENCE_INVALIDATED: u8 = 1 << 3;
 
 /// One axis of the status frame.
 #[repr(C)]
@@ -219,7 +236,8 @@ pub struct AxisStatusEntry {
     pub phase: [u8; PHASE_LEN],
     /// Index of its I/O process in `StatusFrame::ios`.
     pub io: u8,
-    pub reserved0: u8,
+    /// `W_*`: warnings of the last homing (it did not fail because of them).
+    pub warnings: u8,
     /// `ST_*`.
     pub bits: u16,
     pub err: u16,
@@ -258,6 +276,15 @@ pub struct AxisStatusEntry {
     /// A gantry side: the largest skew of its gantry's last homing (how far
     /// apart the sides found their events), units; NaN otherwise.
     pub skew: f64,
+    /// How long the feedback had been missing when the feedback-loss rule
+    /// tripped (ERR 12 / EXERR 40, or HomedStatus lost), s; 0 otherwise.
+    pub feedback_gap_s: f64,
+    /// With `W_DRIFT` / `W_SWITCH_DRIFT`: how far from the median of the
+    /// recent events, units; NaN otherwise.
+    pub drift: f64,
+    /// Switch then marker: the distance from the switch edge to the marker
+    /// of the last homing, units; NaN otherwise.
+    pub switch_to_marker: f64,
 }
 
 /// One I/O process of the status frame.
@@ -284,7 +311,7 @@ pub struct IoStatusEntry {
 /// The status service's frame, published at 100 Hz.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::StatusFrame@1")]
+#[type_name("motion_control::StatusFrame@2")]
 pub struct StatusFrame {
     pub layout_version: u32,
     /// The supervisor's session id.
@@ -392,7 +419,7 @@ impl StatusFrame {
 const _: () = {
     use core::mem::{align_of, offset_of, size_of};
     assert!(
-        CONTROL_LAYOUT == 1,
+        CONTROL_LAYOUT == 2,
         "update the layout asserts together with CONTROL_LAYOUT"
     );
     assert!(size_of::<ControlRequest>() == 56 + MAX_AXES * NAME_LEN);
@@ -414,7 +441,7 @@ const _: () = {
     assert!(offset_of!(ControlResponse, data) == 56 + MESSAGE_LEN + 40 * MAX_AXES);
     assert!(size_of::<ControlResponse>() == 56 + MESSAGE_LEN + 40 * MAX_AXES + DATA_LEN);
 
-    assert!(size_of::<AxisStatusEntry>() == 152);
+    assert!(size_of::<AxisStatusEntry>() == 176);
     assert!(offset_of!(AxisStatusEntry, io) == 48);
     assert!(offset_of!(AxisStatusEntry, bits) == 50);
     assert!(offset_of!(AxisStatusEntry, drive_error_code) == 56);
@@ -429,8 +456,8 @@ const _: () = {
     assert!(offset_of!(IoStatusEntry, gap_cycles) == 112);
 
     assert!(offset_of!(StatusFrame, axes) == 48);
-    assert!(offset_of!(StatusFrame, ios) == 48 + 152 * MAX_AXES);
-    assert!(size_of::<StatusFrame>() == 48 + 152 * MAX_AXES + 120 * MAX_IOS);
+    assert!(offset_of!(StatusFrame, ios) == 48 + 176 * MAX_AXES);
+    assert!(size_of::<StatusFrame>() == 48 + 176 * MAX_AXES + 120 * MAX_IOS);
 };
 
 #[cfg(test)]

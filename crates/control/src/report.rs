@@ -69,11 +69,23 @@ impl AxisStatusEntry {
             });
         }
         if self.has(ST_ER) {
-            return Some(motion_report::codes::explain(self.err, self.exerr).to_string());
+            return Some(motion_report::codes::describe(
+                self.err,
+                self.exerr,
+                Some(self.feedback_gap_s),
+            ));
         }
         if self.extra & SX_LOST_HOMED != 0 && !self.has(ST_HOMED) {
+            let lost = if self.feedback_gap_s > 0.0 {
+                format!(
+                    "feedback lost (no valid feedback for {:.1} ms)",
+                    self.feedback_gap_s * 1e3
+                )
+            } else {
+                "feedback lost".to_string()
+            };
             let why = if self.extra & SX_LOST_FEEDBACK != 0 {
-                "feedback lost"
+                lost.as_str()
             } else if self.extra & SX_LOST_RECONNECT != 0 {
                 "its I/O process reconnected"
             } else {
@@ -85,6 +97,41 @@ impl AxisStatusEntry {
             ));
         }
         None
+    }
+
+    /// The warnings of the last homing, in words.
+    pub fn warning_texts(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if self.warnings & W_AMBIGUOUS_MARKER != 0 {
+            w.push(format!(
+                "ambiguous marker: the marker lay {} from the switch edge, closer than \
+                 marker_min_distance: another homing may take the marker one revolution away",
+                finite(self.switch_to_marker)
+                    .map_or("?".to_string(), |d| motion_report::round(d, 6).to_string())
+            ));
+        }
+        let drift = finite(self.drift).map_or("?".to_string(), |d| format!("{d:+}"));
+        if self.warnings & W_DRIFT != 0 {
+            w.push(format!(
+                "drift: the home event lay {drift} from the median of the recent homings, \
+                 beyond drift_limit (switch wear, coupling slip?): see the homing record"
+            ));
+        }
+        if self.warnings & W_SWITCH_DRIFT != 0 {
+            w.push(format!(
+                "drift: the switch-to-marker distance ({}) differs by more than drift_limit \
+                 from the recent homings: the home switch has moved or wears",
+                finite(self.switch_to_marker)
+                    .map_or("?".to_string(), |d| motion_report::round(d, 6).to_string())
+            ));
+        }
+        if self.warnings & W_REFERENCE_INVALIDATED != 0 {
+            w.push(
+                "stored reference invalidated: the reason is in the log and the homing record"
+                    .into(),
+            );
+        }
+        w
     }
 
     /// A row of `home --json`.
@@ -113,7 +160,7 @@ impl AxisStatusEntry {
             duration_s: done.then(|| motion_report::round(self.elapsed_s, 3)),
             error: self.error_text(names),
             skew: finite(self.skew).map(|x| motion_report::round(x, 6)),
-            warnings: Vec::new(),
+            warnings: self.warning_texts(),
         }
     }
 }
@@ -164,12 +211,15 @@ impl StatusFrame {
                         elapsed_s: motion_report::round(a.elapsed_s, 3),
                         timeout_s: a.timeout_s,
                         search_travel: motion_report::round(a.search_travel, 6),
-                        search_limit: (a.search_limit > 0.0).then_some(a.search_limit),
+                        search_limit: (a.search_limit > 0.0)
+                            .then(|| motion_report::round(a.search_limit, 6)),
                         enabled: a.has(ST_ENABLED),
                         fault: a.has(ST_FAULT),
                         drive_error_code: a.drive_error_code,
                         skew: finite(a.skew).map(|x| motion_report::round(x, 6)),
+                        restored: a.extra & SX_RESTORED != 0,
                         error: a.error_text(&names),
+                        warnings: a.warning_texts(),
                     }
                 })
                 .collect(),

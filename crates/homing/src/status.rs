@@ -93,6 +93,10 @@ pub struct Status {
     pub phase: Phase,
     /// Raw position of the home event, once found.
     pub event_raw: Option<f64>,
+    /// The raw → axis offset in force when this homing started, if the axis
+    /// was homed then: the event in that earlier reference is
+    /// `event_raw + prior_offset`, which is what a drift check compares.
+    pub prior_offset: Option<f64>,
     /// Command position (raw) in the cycle the event was detected: where the
     /// axis latched in the common command frame of a coordinated machine.
     pub event_command: Option<f64>,

@@ -186,6 +186,24 @@ impl Plant {
         self.trip();
     }
 
+    /// Tests: the home switch is moved by `shift` along the axis (a worn
+    /// switch, a loose bracket) while everything else stays as it is; a
+    /// non-finite shift changes nothing.
+    pub fn move_switch(&mut self, shift: f64) {
+        if !shift.is_finite() {
+            return;
+        }
+        if let Some((lo, hi)) = self.cfg.switch {
+            let moved = (lo + shift, hi + shift);
+            self.cfg.switch = Some(moved);
+            self.switch = Some(Switch::new(
+                moved.0,
+                moved.1,
+                self.cfg.switch_normally_closed,
+            ));
+        }
+    }
+
     /// The (sanitized) configuration in use.
     pub fn config(&self) -> &PlantConfig {
         &self.cfg

@@ -36,3 +36,15 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         _ => "error",
     }
 }
+
+/// [`explain`], and for a loss of feedback how long it had been missing
+/// when the rule tripped (`gap_s`, seconds; 0 or `None` = not known).
+pub fn describe(err: u16, exerr: u16, gap_s: Option<f64>) -> String {
+    let text = explain(err, exerr);
+    match gap_s {
+        Some(g) if (err, exerr) == (ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST) && g > 0.0 => {
+            format!("{text}: no valid feedback for {:.1} ms", g * 1e3)
+        }
+        _ => text.to_string(),
+    }
+}

@@ -45,8 +45,16 @@ pub struct AxisStatus {
     /// A gantry side: the skew of the gantry's last homing, units.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub skew: Option<f64>,
+    /// HomedStatus comes from the stored reference of an absolute axis,
+    /// applied at start-up without motion.
+    #[serde(default)]
+    pub restored: bool,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// Warnings of the last homing (ambiguous marker, drift, invalidated
+    /// stored reference).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -53,6 +53,11 @@ pub fn axis_results(rows: &[AxisResult]) -> String {
         if let Some(e) = &r.error {
             s += &format!("  └ {e}\n");
         }
+        if let Some(k) = r.skew {
+            s += &format!(
+                "  └ gantry side: skew {k:.4} (how far apart the sides latched their events)\n"
+            );
+        }
         for wrn in &r.warnings {
             s += &format!("  └ warning: {wrn}\n");
         }
@@ -72,7 +77,7 @@ pub fn status(r: &crate::StatusReport) -> String {
         + 2;
     let b = |x: bool, c: &'static str| if x { c } else { "." };
     let mut s = format!(
-        "{:<w$}{:<8}{:<13}{:<12}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17}{:>20}\n",
+        "{:<w$}{:<8}{:<13}{:<12}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17} {:>19}\n",
         "axis",
         "io",
         "phase",
@@ -92,7 +97,7 @@ pub fn status(r: &crate::StatusReport) -> String {
             x.map_or(format!("{:>width$}", "-"), |v| format!("{v:>width$.p$}"))
         };
         s += &format!(
-            "{:<w$}{:<8}{:<13}{} {} {} {} {} {:>7}{:>10}{}{}{}{} {}{}{:>17}{:>20}\n",
+            "{:<w$}{:<8}{:<13}{} {} {} {} {} {:>7}{:>10}{}{}{}{} {}{}{:>17} {:>19}\n",
             a.name,
             a.io,
             a.phase,
@@ -101,7 +106,11 @@ pub fn status(r: &crate::StatusReport) -> String {
             b(a.er, "ER"),
             b(a.ip, "IP"),
             b(a.pc, "PC"),
-            if a.homed { "yes" } else { "no" },
+            match (a.homed, a.restored) {
+                (true, true) => "stored",
+                (true, false) => "yes",
+                _ => "no",
+            },
             format!("{}/{}", a.err, a.exerr),
             f(a.position, 4, 12),
             f(a.raw, 4, 12),
@@ -121,11 +130,15 @@ pub fn status(r: &crate::StatusReport) -> String {
             format!(
                 "{:.3}/{}",
                 a.search_travel,
-                a.search_limit.map_or("-".to_string(), |l| format!("{l}"))
+                a.search_limit
+                    .map_or("-".to_string(), |l| format!("{l:.3}"))
             ),
         );
         if let Some(e) = &a.error {
             s += &format!("  └ {e}\n");
+        }
+        for wrn in &a.warnings {
+            s += &format!("  └ warning: {wrn}\n");
         }
     }
     for io in &r.io {

@@ -63,6 +63,10 @@ pub struct RunArgs {
     /// Extra argument for every spawned motion-io (repeatable).
     #[arg(long = "io-arg", value_name = "ARG", allow_hyphen_values = true)]
     pub io_args: Vec<String>,
+    /// Benchmarks only: run without the control and status services, to
+    /// measure what they cost the cycle (bench/README.md).
+    #[arg(long, hide = true)]
+    pub no_control_plane: bool,
 }
 
 #[derive(Debug, Args)]

@@ -12,6 +12,7 @@
 
 use crate::hlog::HlogFile;
 use crate::hub::{SharedHub, TRACE_MAX};
+use crate::keeper::Keeper;
 use crate::shared::{Ack, Control, Phase, Shared};
 use crate::{status_fill, trace_csv};
 use motion_config::MachineConfig;
@@ -34,6 +35,10 @@ pub struct ControlSettings {
     pub domain: Domain,
     /// `run --hlog FILE`.
     pub hlog_file: Option<PathBuf>,
+    /// Serve the control and status services (false only for the
+    /// benchmark that measures what they cost: then the thread just collects
+    /// what the cycle hands over).
+    pub serve: bool,
 }
 
 /// Readiness of the control thread, for start-up.
@@ -53,7 +58,17 @@ pub fn spawn(
     std::thread::Builder::new()
         .name("motion-control".into())
         .spawn(move || {
+            let serve = s.serve;
             let mut t = ControlThread::new(s, shared, hub);
+            if !serve {
+                ready.ready.store(true, Ordering::Release);
+                while !stop.load(Ordering::Acquire) {
+                    t.pump();
+                    std::thread::sleep(Duration::from_millis(2));
+                }
+                t.pump();
+                return;
+            }
             match Server::create(&t.s.domain) {
                 Ok(server) => {
                     ready.ready.store(true, Ordering::Release);
@@ -85,6 +100,7 @@ struct ControlThread {
     attached: Vec<bool>,
     attachments: Vec<u64>,
     all_mask: u64,
+    keeper: Keeper,
 }
 
 impl ControlThread {
@@ -102,7 +118,9 @@ impl ControlThread {
             });
         let orders: Vec<Option<u32>> = s.machine.axes.iter().map(|a| a.home_order).collect();
         let all_mask = crate::core::sequence::Sequencer::new(&orders).all_mask();
+        let keeper = Keeper::open(&s.machine);
         Self {
+            keeper,
             attached: vec![false; s.machine.ios.len()],
             attachments: vec![0; s.machine.ios.len()],
             s,
@@ -147,8 +165,9 @@ impl ControlThread {
             return;
         };
         let uptime = hub.started.elapsed().as_nanos() as u64;
+        let notes = self.keeper.notes();
         if let Err(e) =
-            server.publish_status(|f| status_fill::fill(&self.s.machine, snap, uptime, f))
+            server.publish_status(|f| status_fill::fill(&self.s.machine, snap, notes, uptime, f))
         {
             log::warn!("status service: {e}");
         }
@@ -159,6 +178,9 @@ impl ControlThread {
         while let Some(a) = self.shared.acks.pop() {
             self.acks.push(a);
         }
+        // The keeper's restore requests are answered here.
+        let (keeper, machine) = (&mut self.keeper, &self.s.machine);
+        self.acks.retain(|a| !keeper.ack(machine, a));
         // Acks nobody waits for any more.
         if self.acks.len() > 64 {
             self.acks.drain(..self.acks.len() - 64);
@@ -184,6 +206,14 @@ impl ControlThread {
             }
         }
         if let Some(snap) = hub.snapshot.as_deref() {
+            let (shared, next_id) = (&self.shared, &mut self.next_id);
+            self.keeper.observe(&self.s.machine, snap, |axis, offset| {
+                let id = *next_id;
+                *next_id = next_id.wrapping_add(1).max(1);
+                shared
+                    .send(Control::Restore { id, axis, offset })
+                    .then_some(id)
+            });
             for (k, io) in self.s.machine.ios.iter().enumerate() {
                 let now = snap.ios[k].attached;
                 // Attachments counted, not just the state seen: a detach and
@@ -211,6 +241,8 @@ impl ControlThread {
                         } else {
                             log::info!("I/O process {} attached ({})", io.name, names.join(", "));
                         }
+                    } else if snap.exiting {
+                        log::info!("I/O process {} stopped answering (shutting down)", io.name);
                     } else {
                         log::warn!(
                             "I/O process {} detached: no fresh feedback for {} cycles; its \
@@ -283,7 +315,8 @@ impl ControlThread {
                     let hub = self.hub.lock();
                     if let Some(s) = hub.snapshot.as_deref() {
                         let uptime = hub.started.elapsed().as_nanos() as u64;
-                        status_fill::fill(&self.s.machine, s, uptime, &mut frame);
+                        let notes = self.keeper.notes();
+                        status_fill::fill(&self.s.machine, s, notes, uptime, &mut frame);
                     }
                 }
                 let json = serde_json::to_vec(&frame.to_report()).unwrap_or_default();
@@ -467,6 +500,14 @@ impl ControlThread {
         }
         r.axis_count = k as u32;
         r.cycle = ack.cycle;
+        if req.kind == REQ_UNHOME {
+            for i in 0..self.s.machine.axes.len() {
+                if mask & (1 << i) != 0 && ack.axes[i].accepted {
+                    self.keeper
+                        .unhomed(&self.s.machine, i, "operator unhome (motionctl unhome)");
+                }
+            }
+        }
         r.result = if all { RESULT_ACCEPTED } else { RESULT_REFUSED };
         if !all {
             if why.is_empty() {

@@ -6,6 +6,8 @@
 //!   home sequences, frames).
 //! * [`shared`] — the lock-free hand-off between real-time and normal threads.
 //! * [`control_thread`] — the control and status services, off the cycle.
+//! * [`keeper`] — what outlives a run: stored references of absolute axes,
+//!   the homing record with its drift checks (files in `state_dir`).
 //! * [`hub`] — what the normal threads share (statistics, snapshot, trace).
 //! * [`stats`], [`hlog`] — latency histograms and their logs.
 //! * [`session`] — start-up and clean shut-down (domain, threads, I/O processes).
@@ -19,6 +21,7 @@ pub mod cpu;
 pub mod hlog;
 pub mod hub;
 pub mod io_child;
+pub mod keeper;
 pub mod rt_thread;
 pub mod session;
 pub mod shared;

@@ -32,6 +32,9 @@ pub struct SessionOptions {
     pub io_args: Vec<String>,
     /// `run --hlog FILE`.
     pub hlog_file: Option<PathBuf>,
+    /// `run --no-control-plane` (benchmarks only): no control or status
+    /// service, to measure what they cost the cycle.
+    pub no_control_plane: bool,
 }
 
 /// A spawned I/O process and when it may be restarted.
@@ -164,6 +167,7 @@ impl Session {
                     machine: machine.clone(),
                     domain: domain.clone(),
                     hlog_file: opts.hlog_file.clone(),
+                    serve: !opts.no_control_plane,
                 },
                 shared,
                 hub,

@@ -22,7 +22,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 pub const MAX_IOS: usize = 16;
 
 /// Requests to the real-time thread. `mask` bit `i` = axis `i`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Control {
     /// Home the axes of `mask`: in home order (config order one at a time
     /// when no axis has one), or all at once with `parallel`. `timeout_ns`
@@ -39,22 +39,27 @@ pub enum Control {
     Unhome { id: u32, mask: u64 },
     /// Record every cycle of the next homing of axis `axis`.
     Trace { id: u32, axis: usize },
+    /// Apply the stored raw → axis `offset` of absolute axis `axis` without
+    /// motion ([`motion_homing::Axis::restore_reference`]).
+    Restore { id: u32, axis: usize, offset: f64 },
     /// Stop every axis, disable the drives once at rest, then leave the loop.
     Exit,
 }
 
 /// The answer for one axis.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AxisAck {
     pub accepted: bool,
     /// `motion_control::REASON_*`.
     pub reason: u8,
     pub err: u16,
     pub exerr: u16,
+    /// Why a `Restore` was refused.
+    pub restore: Option<motion_homing::RestoreRefusal>,
 }
 
 /// The real-time thread's answer to a request with an id.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ack {
     pub id: u32,
     /// The cycle that applied the request.
@@ -140,6 +145,11 @@ pub struct AxisSnap {
     /// why (`motion_control::SX_LOST_*`, 0 = not known).
     pub lost_homed_ns: Option<u64>,
     pub lost_cause: u8,
+    /// The raw → axis offset while homed.
+    pub offset: Option<f64>,
+    /// HomedStatus comes from a stored reference (absolute axis, restored
+    /// without motion), not from a homing run since start-up.
+    pub restored: bool,
 }
 
 impl AxisSnap {
@@ -179,6 +189,8 @@ pub struct Snapshot {
     pub ios: [IoSnap; MAX_IOS],
     /// Every axis is at rest with nothing in process.
     pub all_at_rest: bool,
+    /// The supervisor is leaving (axes stopped, drives disabled).
+    pub exiting: bool,
 }
 
 impl Default for Snapshot {
@@ -191,6 +203,7 @@ impl Default for Snapshot {
             io_count: 0,
             ios: [IoSnap::default(); MAX_IOS],
             all_at_rest: true,
+            exiting: false,
         }
     }
 }

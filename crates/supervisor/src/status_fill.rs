@@ -1,13 +1,21 @@
 //! A snapshot of the cycle as a status frame (what the status service
 //! publishes, and what `status --json` reports).
 
+use crate::keeper::AxisNote;
 use crate::shared::Snapshot;
 use motion_config::MachineConfig;
 use motion_control::*;
 use motion_homing::{effective_search_limit, HomeMode};
 
-/// Fills `f` (zeroed) from `snap`; `uptime_ns` since the supervisor started.
-pub fn fill(m: &MachineConfig, snap: &Snapshot, uptime_ns: u64, f: &mut StatusFrame) {
+/// Fills `f` (zeroed) from `snap` and the keeper's `notes` (per axis);
+/// `uptime_ns` since the supervisor started.
+pub fn fill(
+    m: &MachineConfig,
+    snap: &Snapshot,
+    notes: &[AxisNote],
+    uptime_ns: u64,
+    f: &mut StatusFrame,
+) {
     f.cycle = snap.cycle;
     f.uptime_ns = uptime_ns;
     f.cycle_us = m.supervisor.cycle_us;
@@ -60,7 +68,21 @@ pub fn fill(m: &MachineConfig, snap: &Snapshot, uptime_ns: u64, f: &mut StatusFr
                 0
             })
             | (if a.in_sequence { SX_IN_SEQUENCE } else { 0 })
+            | (if a.restored { SX_RESTORED } else { 0 })
             | a.lost_cause;
+        let note = notes.get(i).copied().unwrap_or_default();
+        e.warnings = note.warnings
+            | if s.ambiguous_marker {
+                W_AMBIGUOUS_MARKER
+            } else {
+                0
+            };
+        e.drift = note.drift;
+        e.feedback_gap_s = s.lost_after_ns.map_or(0.0, |g| g as f64 * 1e-9);
+        e.switch_to_marker = match (s.switch_edge_raw, s.event_raw) {
+            (Some(sw), Some(ev)) => (ev - sw).abs(),
+            _ => f64::NAN,
+        };
         e.position = a.axis.unwrap_or(0.0);
         e.raw = a.raw.unwrap_or(0.0);
         e.velocity = a.velocity;

@@ -282,6 +282,7 @@ impl Axis {
         self.status = Status {
             en: true,
             homed: self.status.homed,
+            prior_offset: self.status.homed.then_some(self.offset),
             feedback_ok: self.status.feedback_ok,
             feedback_gap_ns: self.status.feedback_gap_ns,
             feedback_loss_ns: self.status.feedback_loss_ns,

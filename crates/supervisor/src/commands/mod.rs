@@ -109,6 +109,7 @@ fn options(common: &Common, m: &MachineConfig) -> SessionOptions {
         runtime_dir: common.runtime_dir.clone(),
         io_args: Vec::new(),
         hlog_file: None,
+        no_control_plane: false,
     }
 }
 

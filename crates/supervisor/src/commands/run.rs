@@ -16,6 +16,7 @@ pub fn run(a: &RunArgs) -> i32 {
     let mut opts = options(&a.common, &m);
     opts.io_args = a.io_args.clone();
     opts.hlog_file = a.hlog.clone();
+    opts.no_control_plane = a.no_control_plane;
     let mut session = match Session::start(m, &opts) {
         Ok(s) => s,
         Err(e) => return fail(a.json, vec![ErrorEntry::message(e)], 1),

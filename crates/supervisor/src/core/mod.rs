@@ -44,6 +44,8 @@ struct Rung {
     was_homed: bool,
     lost_homed_ns: Option<u64>,
     lost_cause: u8,
+    /// HomedStatus comes from a stored reference.
+    restored: bool,
     /// This cycle's link events for the axis.
     reconnected: bool,
     fresh_missing: bool,
@@ -158,6 +160,7 @@ impl Core {
                 reason,
                 err,
                 exerr,
+                restore: None,
             })
         };
         if self.exiting {
@@ -224,10 +227,8 @@ impl Core {
                         for i in 0..n {
                             if accepted & (1 << i) != 0 {
                                 ack.axes[i] = AxisAck {
-                                    accepted: false,
                                     reason: REASON_BUSY,
-                                    err: 0,
-                                    exerr: 0,
+                                    ..AxisAck::default()
                                 };
                             }
                         }
@@ -256,6 +257,7 @@ impl Core {
                     if mask & (1 << i) != 0 {
                         ack.axes[i] = if self.rungs[i].pending == 0 && self.axes[i].clear_homed() {
                             self.rungs[i].was_homed = false;
+                            self.rungs[i].restored = false;
                             AxisAck {
                                 accepted: true,
                                 ..AxisAck::default()
@@ -276,6 +278,40 @@ impl Core {
                 if axis < n {
                     self.tracer.arm(axis);
                     ack.axes[axis].accepted = true;
+                }
+                Some(ack)
+            }
+            Control::Restore { id, axis, offset } => {
+                let mut ack = Ack::new(id);
+                if axis < n {
+                    let r = if self.exiting {
+                        Err(REASON_EXITING)
+                    } else if self.rungs[axis].pending > 0 || self.seq.busy() & (1 << axis) != 0 {
+                        Err(REASON_BUSY)
+                    } else {
+                        Ok(())
+                    };
+                    ack.axes[axis] =
+                        match r.map(|()| self.axes[axis].restore_reference(now_ns, offset)) {
+                            Ok(Ok(())) => {
+                                let rung = &mut self.rungs[axis];
+                                rung.was_homed = true;
+                                rung.lost_homed_ns = None;
+                                rung.restored = true;
+                                AxisAck {
+                                    accepted: true,
+                                    ..AxisAck::default()
+                                }
+                            }
+                            Ok(Err(why)) => AxisAck {
+                                restore: Some(why),
+                                ..AxisAck::default()
+                            },
+                            Err(reason) => AxisAck {
+                                reason,
+                                ..AxisAck::default()
+                            },
+                        };
                 }
                 Some(ack)
             }
@@ -426,10 +462,12 @@ impl Core {
             if started {
                 rung.was_homed = false;
                 rung.lost_homed_ns = None;
+                rung.restored = false;
             } else if !s.ip && s.dn && s.homed && !rung.was_homed {
                 rung.was_homed = true;
             } else if rung.was_homed && !s.homed && rung.lost_homed_ns.is_none() {
                 rung.lost_homed_ns = Some(now_ns);
+                rung.restored = false;
                 rung.lost_cause = if rung.reconnected {
                     motion_control::SX_LOST_RECONNECT
                 } else if rung.fresh_missing || !s.feedback_ok {
@@ -526,6 +564,8 @@ impl Core {
                 traced: self.tracer.armed() == Some(i),
                 lost_homed_ns: r.lost_homed_ns,
                 lost_cause: r.lost_cause,
+                offset: a.reference_offset(),
+                restored: r.restored && a.status().homed,
             };
         }
         s.io_count = self.links.len();
@@ -533,8 +573,11 @@ impl Core {
             s.ios[k] = l.snap();
         }
         s.all_at_rest = self.all_at_rest();
+        s.exiting = self.exiting;
     }
 }
 
+#[cfg(test)]
+pub(crate) mod testbench;
 #[cfg(test)]
 mod tests;

@@ -1,0 +1,104 @@
+//! A Core with simulated I/O processes in place: plants per axis and one
+//! frame pair per I/O process, stepped cycle by cycle without threads or
+//! IPC (for the core's and the keeper's tests).
+
+use super::*;
+use motion_frames::feedback_to_axis;
+use motion_plant::Plant;
+
+pub const MS: u64 = 1_000_000;
+
+/// A Core, plants per axis and one frame pair per I/O process.
+pub struct Bench {
+    pub m: MachineConfig,
+    pub core: Core,
+    pub plants: Vec<Plant>,
+    pub cmd: Vec<CommandFrame>,
+    pub fb: Vec<FeedbackFrame>,
+    pub seq: Vec<u64>,
+    pub origin: Vec<u64>,
+    /// I/O processes that answer.
+    pub alive: Vec<bool>,
+    pub k: u64,
+    pub acks: Vec<Ack>,
+}
+
+impl Bench {
+    pub fn new(toml: &str) -> Self {
+        let m = motion_config::parse(toml).unwrap_or_else(|p| panic!("{p:#?}"));
+        let ios = m.ios.len();
+        Self {
+            core: Core::new(&m),
+            plants: m.axes.iter().map(|a| Plant::new(a.sim)).collect(),
+            cmd: vec![CommandFrame::ZERO; ios],
+            fb: vec![FeedbackFrame::ZERO; ios],
+            seq: vec![0; ios],
+            origin: (1..=ios as u64).collect(),
+            alive: vec![true; ios],
+            k: 0,
+            acks: Vec::new(),
+            m,
+        }
+    }
+
+    pub fn control(&mut self, c: Control) {
+        if let Some(a) = self.core.control(c, self.k * MS) {
+            self.acks.push(a);
+        }
+    }
+
+    /// One cycle: the core steps on last cycle's answers, publishes, and
+    /// every live I/O process answers (its plants advance one cycle).
+    pub fn cycle(&mut self) {
+        let now = self.k * MS;
+        let frames: Vec<Option<&FeedbackFrame>> = (0..self.fb.len())
+            .map(|k| (self.alive[k] && self.seq[k] > 0).then_some(&self.fb[k]))
+            .collect();
+        self.core.step(now, &frames);
+        let dt = self.m.supervisor.cycle_us as f64 * 1e-6;
+        for k in 0..self.cmd.len() {
+            self.core.fill(k, &mut self.cmd[k]);
+            self.seq[k] += 1;
+            self.core.sent(k, self.seq[k], now);
+            if !self.alive[k] {
+                continue;
+            }
+            let axes = self.m.axes_of(k);
+            let f = &mut self.fb[k];
+            f.header.axis_count = axes.len() as u32;
+            f.header.origin = self.origin[k];
+            f.header.timestamp_ns = now + 20_000;
+            f.answers_sequence = self.seq[k];
+            for (j, &i) in axes.iter().enumerate() {
+                let a = &self.m.axes[i];
+                let c =
+                    motion_frames::axis_to_command(&self.cmd[k].axes[j], a.engine.counts_per_unit);
+                let fb = self.plants[i].step(&c, dt);
+                f.axes[j] = feedback_to_axis(&fb, a.engine.counts_per_unit);
+            }
+        }
+        self.k += 1;
+    }
+
+    pub fn run(&mut self, cycles: u64) {
+        for _ in 0..cycles {
+            self.cycle();
+        }
+    }
+
+    pub fn snap(&self) -> Snapshot {
+        let mut s = Snapshot::default();
+        self.core.snapshot(self.k * MS, &mut s);
+        s
+    }
+
+    pub fn home(&mut self, mask: u64, parallel: bool) -> Ack {
+        self.control(Control::Home {
+            id: 7,
+            mask,
+            parallel,
+            timeout_ns: 0,
+        });
+        self.acks.pop().unwrap()
+    }
+}
