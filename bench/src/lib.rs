@@ -14,9 +14,11 @@
 
 pub mod args;
 pub mod cyclictest;
+pub mod drive;
 pub mod ecat;
 pub mod hist;
 pub mod machine;
 pub mod proc;
+pub mod spy;
 pub mod svg;
 pub mod sys;

@@ -143,6 +143,11 @@ impl Running {
         }
     }
 
+    /// Sends `sig` to the child (or its group) without waiting.
+    pub fn send_signal(&self, sig: i32) {
+        self.signal(sig);
+    }
+
     /// Still running?
     pub fn running(&mut self) -> bool {
         self.child

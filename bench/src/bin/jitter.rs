@@ -7,9 +7,10 @@
 use hdrhistogram::Histogram;
 use motion_bench::args::Args;
 use motion_bench::cyclictest::{self, CtHistogram};
+use motion_bench::drive::{self, Tally};
 use motion_bench::ecat::{self, BusRun, EcatRig};
 use motion_bench::hist::{self, new_hist, thousands, us, Pct, COLUMNS};
-use motion_bench::machine::{self, Supervisor};
+use motion_bench::machine::{self, Machine, Supervisor};
 use motion_bench::proc::{self, Running};
 use motion_bench::svg::{self, Series};
 use motion_bench::sys;
@@ -23,12 +24,14 @@ use std::time::{Duration, Instant, SystemTime};
 const USAGE: &str = "\
 usage: jitter [--duration S] [--period-us N] [--slice S] [--priority P] [--cpu N]
               [--stress] [--out DIR] [--supervisor PATH] [--cyclictest PATH]
-              [--no-cyclictest] [--hist-max-us N] [--ethercat]
+              [--no-cyclictest] [--hist-max-us N] [--ethercat] [--no-axes64]
 
 Runs `motion-supervisor run` and `cyclictest` in alternating slices until each
 has run --duration seconds, at the same period, SCHED_FIFO priority and CPU,
 then prints their wake-up latencies side by side and writes
-DIR/jitter-<period>us.{hlog,svg,json}.
+DIR/jitter-<period>us.{hlog,svg,json}. The supervisor runs twice per slice:
+the demo machine (4 axes, idle) and a 64-axis machine that `motionctl home
+--parallel` homes again and again while it is measured.
 
   --duration S       seconds per tool (default 60)
   --period-us N      cycle period, µs (default 1000)
@@ -47,6 +50,7 @@ DIR/jitter-<period>us.{hlog,svg,json}.
                      in every slice: the demo machine's axes over a veth pair
                      to ecat-emu's emulated drives (root: ip netns, raw
                      sockets); reported next to the sim backend
+  --no-axes64        skip the 64-axis machine (demo machine only)
 
 Exit status: 0, or 1 if a tool failed to run or crashed, or the supervisor
 missed more than 1 % of its deadlines; 2 on a command-line mistake; 130 if
@@ -71,6 +75,7 @@ struct Opts {
     no_cyclictest: bool,
     hist_max_us: u64,
     ethercat: bool,
+    axes64: bool,
 }
 
 fn parse_opts() -> Result<Option<Opts>, String> {
@@ -93,6 +98,7 @@ fn parse_opts() -> Result<Option<Opts>, String> {
         no_cyclictest: a.flag("--no-cyclictest"),
         hist_max_us: a.num("--hist-max-us", 20_000)?,
         ethercat: a.flag("--ethercat"),
+        axes64: !a.flag("--no-axes64"),
     };
     a.finish()?;
     if !(o.duration > 0.0 && o.duration.is_finite()) {
@@ -342,7 +348,7 @@ fn run(o: &Opts) -> Result<i32, String> {
     let mut stress = match &stress_ng {
         None => None,
         Some(bin) => {
-            let bound = (2.0 * o.duration + 15.0 * slices as f64 + 60.0).ceil() as u64;
+            let bound = (3.0 * o.duration + 20.0 * slices as f64 + 60.0).ceil() as u64;
             let mut c = Command::new(bin);
             c.args([
                 "--cpu",
@@ -365,6 +371,16 @@ fn run(o: &Opts) -> Result<i32, String> {
 
     let mut ours: Vec<OurSlice> = Vec::new();
     let mut ours_ecat: Vec<OurSlice> = Vec::new();
+    let mut ours64: Vec<OurSlice> = Vec::new();
+    let mut homing64 = Homing64::default();
+    let motionctl = supervisor.with_file_name("motionctl");
+    if o.axes64 && !sys::is_executable(&motionctl) {
+        return Err(format!(
+            "motionctl not found at {} (the 64-axis machine is homed with it; build it with \
+             `cargo build --release --workspace --bins`, or pass --no-axes64)",
+            motionctl.display()
+        ));
+    }
     let mut bus_runs: Vec<BusRun> = Vec::new();
     let mut ct: Vec<CtSlice> = Vec::new();
     let mut interrupted = false;
@@ -420,6 +436,63 @@ fn run(o: &Opts) -> Result<i32, String> {
             }
         }
         leftover_shm(&prefix, &mut warnings);
+
+        // --- the supervisor with 64 axes, homing in parallel again and again
+        if o.axes64 {
+            if proc::stop_requested() {
+                interrupted = true;
+                break;
+            }
+            let prefix = format!("mbj{pid}a{i}");
+            let (toml, _) = Machine::Axes64.with(&Supervisor {
+                cycle_us: o.period_us,
+                cpu: o.cpu,
+                priority: o.priority,
+                service_prefix: prefix.clone(),
+            })?;
+            let hlog_path = tmp.join(format!("axes64_{i}.hlog"));
+            let start = t0.elapsed();
+            let (ended, h) = supervisor_run_homing(
+                &supervisor,
+                &motionctl,
+                &tmp,
+                &format!("axes64_{i}"),
+                &toml,
+                &prefix,
+                len,
+                &hlog_path,
+            )?;
+            if ended.interrupted {
+                interrupted = true;
+                break;
+            }
+            match our_slice(&ended, &hlog_path, start, len) {
+                Ok((s, w)) => {
+                    eprintln!(
+                        "jitter: slice {}/{} 64 axes:    {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies); {} homing(s) of 64 axes: {} ok, {} failed, {} cut off by the slice's end",
+                        i + 1,
+                        slices,
+                        s.cycles,
+                        us(s.json_wakeup.p99),
+                        us(s.json_wakeup.max),
+                        s.misses,
+                        s.late,
+                        h.started,
+                        h.ok,
+                        h.failed,
+                        h.cut_off
+                    );
+                    warnings.extend(w.into_iter().map(|w| format!("64 axes: {w}")));
+                    ours64.push(s);
+                    homing64.merge(h);
+                }
+                Err(e) => {
+                    failures.push(format!("slice {}: motion-supervisor (64 axes): {e}", i + 1));
+                    break 'slices;
+                }
+            }
+            leftover_shm(&prefix, &mut warnings);
+        }
 
         // --- the supervisor with the EtherCAT backend
         if let Some(rig) = &rig {
@@ -612,6 +685,25 @@ fn run(o: &Opts) -> Result<i32, String> {
     let e_secs: f64 = ours_ecat.iter().map(|s| s.len.as_secs_f64()).sum();
     let bus = bus_summary(&bus_runs);
 
+    // the same for the 64-axis machine's slices
+    let mut a_wake = new_hist();
+    let mut a_compute = new_hist();
+    let mut a_rt = new_hist();
+    for s in &ours64 {
+        hist::merge(&mut a_wake, &s.wakeup);
+        hist::merge(&mut a_compute, &s.compute);
+        hist::merge(&mut a_rt, &s.roundtrip);
+    }
+    let have_64 = !ours64.is_empty();
+    let w_64 = exact(&ours64, pct_of(&a_wake), |s| s.json_wakeup);
+    let c_64 = exact(&ours64, pct_of(&a_compute), |s| s.json_compute);
+    let r_64 = exact(&ours64, pct_of(&a_rt), |s| s.json_roundtrip);
+    let a_cycles: u64 = ours64.iter().map(|s| s.cycles).sum();
+    let a_misses: u64 = ours64.iter().map(|s| s.misses).sum();
+    let a_late: u64 = ours64.iter().map(|s| s.late).sum();
+    let a_miss_ratio = a_misses as f64 / a_cycles.max(1) as f64;
+    let a_secs: f64 = ours64.iter().map(|s| s.len.as_secs_f64()).sum();
+
     let mut ct_hdr = new_hist();
     let mut ct_total = CtHistogram::default();
     for s in &ct {
@@ -644,6 +736,18 @@ fn run(o: &Opts) -> Result<i32, String> {
             e_miss_ratio * 100.0,
             MAX_MISS_RATIO * 100.0
         ));
+    }
+    if have_64 && a_miss_ratio > MAX_MISS_RATIO {
+        failures.push(format!(
+            "the supervisor (64 axes homing) missed {} of {} deadlines ({:.2} % > {:.0} %)",
+            a_misses,
+            a_cycles,
+            a_miss_ratio * 100.0,
+            MAX_MISS_RATIO * 100.0
+        ));
+    }
+    if o.axes64 && !have_64 && failures.is_empty() && !interrupted {
+        failures.push("the 64-axis machine produced no slice".into());
     }
     if o.ethercat && !have_ecat && failures.is_empty() && !interrupted {
         failures.push("the EtherCAT backend produced no slice".into());
@@ -713,8 +817,11 @@ fn run(o: &Opts) -> Result<i32, String> {
     line(&mut t, header("wake-up latency (µs)"));
     line(
         &mut t,
-        row("ours (supervisor)", &w_ours, Some(w_ours.count)),
+        row("ours, demo (idle)", &w_ours, Some(w_ours.count)),
     );
+    if have_64 {
+        line(&mut t, row("ours, 64 axes homing", &w_64, Some(w_64.count)));
+    }
     if have_ecat {
         line(
             &mut t,
@@ -723,11 +830,18 @@ fn run(o: &Opts) -> Result<i32, String> {
     }
     if have_ct {
         line(&mut t, row("cyclictest", &w_ct, Some(w_ct.count)));
-        let mut s = format!("{:<22}", "ratio ours/cyclictest");
+        let mut s = format!("{:<22}", "ratio demo/cyclictest");
         for r in w_ours.ratio(&w_ct) {
             s += &format!("{:>9}", hist::ratio(r));
         }
         line(&mut t, s);
+        if have_64 {
+            let mut s = format!("{:<22}", "ratio 64 axes/cyclic.");
+            for r in w_64.ratio(&w_ct) {
+                s += &format!("{:>9}", hist::ratio(r));
+            }
+            line(&mut t, s);
+        }
         if have_ecat {
             let mut s = format!("{:<22}", "ratio EtherCAT/cyclic.");
             for r in w_ecat.ratio(&w_ct) {
@@ -742,7 +856,7 @@ fn run(o: &Opts) -> Result<i32, String> {
     line(
         &mut t,
         format!(
-            "deadline misses   ours: {} of {} cycles ({:.3} %, summed over {} slices; limit {:.0} %)",
+            "deadline misses   ours, demo: {} of {} cycles ({:.3} %, summed over {} slices; limit {:.0} %)",
             misses,
             thousands(cycles),
             miss_ratio * 100.0,
@@ -750,6 +864,17 @@ fn run(o: &Opts) -> Result<i32, String> {
             MAX_MISS_RATIO * 100.0
         ),
     );
+    if have_64 {
+        line(
+            &mut t,
+            format!(
+                "                  ours, 64 axes homing: {} of {} cycles ({:.3} %)",
+                a_misses,
+                thousands(a_cycles),
+                a_miss_ratio * 100.0
+            ),
+        );
+    }
     if have_ecat {
         line(
             &mut t,
@@ -772,8 +897,12 @@ fn run(o: &Opts) -> Result<i32, String> {
     }
     line(&mut t, String::new());
     line(&mut t, header("ours, other (µs)"));
-    line(&mut t, row("compute", &c_ours, None));
-    line(&mut t, row("I/O round trip", &r_ours, None));
+    line(&mut t, row("compute, demo", &c_ours, None));
+    line(&mut t, row("I/O round trip, demo", &r_ours, None));
+    if have_64 {
+        line(&mut t, row("compute, 64 axes", &c_64, None));
+        line(&mut t, row("round trip, 64 axes", &r_64, None));
+    }
     if have_ecat {
         line(&mut t, row("compute, EtherCAT", &c_ecat, None));
         line(&mut t, row("round trip, EtherCAT", &r_ecat, None));
@@ -805,8 +934,13 @@ fn run(o: &Opts) -> Result<i32, String> {
     line(
         &mut t,
         format!(
-            "late I/O replies (no answer within half a period): {late} of {}{}",
+            "late I/O replies (no answer within half a period): demo {late} of {}{}{}",
             thousands(cycles),
+            if have_64 {
+                format!("; 64 axes: {a_late} of {}", thousands(a_cycles))
+            } else {
+                String::new()
+            },
             if have_ecat {
                 format!("; EtherCAT backend: {e_late} of {}", thousands(e_cycles))
             } else {
@@ -814,6 +948,12 @@ fn run(o: &Opts) -> Result<i32, String> {
             }
         ),
     );
+    if have_64 {
+        line(&mut t, homing64.line(a_secs));
+        for d in homing64.tally.details.iter().take(10) {
+            line(&mut t, format!("  {d}"));
+        }
+    }
     line(
         &mut t,
         format!(
@@ -854,6 +994,9 @@ fn run(o: &Opts) -> Result<i32, String> {
     for s in &ours_ecat {
         intervals.push(("ours_ethercat", s.start, s.len, &s.wakeup));
     }
+    for s in &ours64 {
+        intervals.push(("ours_axes64", s.start, s.len, &s.wakeup));
+    }
     for (i, s) in ours.iter().enumerate() {
         intervals.push(("ours", s.start, s.len, &s.wakeup));
         if let Some(c) = ct.get(i) {
@@ -866,7 +1009,7 @@ fn run(o: &Opts) -> Result<i32, String> {
             "motion-bench jitter: wake-up latency, ns; period {} us, SCHED_FIFO {} on CPU {}",
             o.period_us, o.priority, o.cpu
         ),
-        "tags: ours = motion-supervisor run (wake-up), ours_ethercat = the same with motion-io --backend ethercat (--ethercat), cyclictest = cyclictest (1 us bins, recorded at the bin's lower edge)".into(),
+        "tags: ours = motion-supervisor run (wake-up), demo machine idle; ours_axes64 = the same with 64 axes homing in parallel again and again; ours_ethercat = the same with motion-io --backend ethercat (--ethercat), cyclictest = cyclictest (1 us bins, recorded at the bin's lower edge)".into(),
         format!("kernel {} ({})", env.kernel, env.preemption),
     ];
     if let Err(e) = hist::write_interval_log(&hlog_path, &comments, t0_wall, &intervals) {
@@ -896,10 +1039,17 @@ fn run(o: &Opts) -> Result<i32, String> {
         }
     );
     let mut series = vec![Series {
-        name: "ours (motion-supervisor)",
+        name: "ours, demo machine (idle)",
         colour: "#1f6fd1",
         hist: &ours_wake,
     }];
+    if have_64 {
+        series.push(Series {
+            name: "ours, 64 axes homing",
+            colour: "#9467bd",
+            hist: &a_wake,
+        });
+    }
     if have_ecat {
         series.push(Series {
             name: "ours, EtherCAT backend",
@@ -953,6 +1103,7 @@ fn run(o: &Opts) -> Result<i32, String> {
             "other_rt_threads": other_rt.iter().cloned().collect::<Vec<_>>(),
         },
         "ours": {
+            "machine": "demo (deploy/demo.toml, 4 axes, idle)",
             "seconds": ours_secs,
             "slices": ours.len(),
             "cycles": cycles,
@@ -965,6 +1116,20 @@ fn run(o: &Opts) -> Result<i32, String> {
             "io_roundtrip_us": serde_json::to_value(r_ours).unwrap_or_default(),
             "warnings": warnings.iter().cloned().collect::<Vec<_>>(),
         },
+        "ours_axes64": if have_64 { json!({
+            "machine": "64 axes (motion_bench::machine::axes64_with), motionctl home --parallel again and again",
+            "seconds": a_secs,
+            "slices": ours64.len(),
+            "cycles": a_cycles,
+            "deadline_misses": a_misses,
+            "deadline_miss_ratio": a_miss_ratio,
+            "late_replies": a_late,
+            "hlog_samples": a_wake.len(),
+            "wakeup_us": serde_json::to_value(w_64).unwrap_or_default(),
+            "compute_us": serde_json::to_value(c_64).unwrap_or_default(),
+            "io_roundtrip_us": serde_json::to_value(r_64).unwrap_or_default(),
+            "homing": homing64.json(),
+        }) } else { json!({"skipped": true}) },
         "ours_ethercat": if have_ecat { json!({
             "seconds": e_secs,
             "slices": ours_ecat.len(),
@@ -991,6 +1156,7 @@ fn run(o: &Opts) -> Result<i32, String> {
             "histogram_overflows": ct_total.overflows,
         }) } else { json!({"skipped": true}) },
         "ratio_ours_over_cyclictest": if have_ct { ratio_json(&w_ours, &w_ct) } else { Value::Null },
+        "ratio_axes64_over_cyclictest": if have_ct && have_64 { ratio_json(&w_64, &w_ct) } else { Value::Null },
         "files": { "hlog": hlog_path, "svg": svg_path },
         "status": {
             "ok": failures.is_empty() && !interrupted,
@@ -1125,13 +1291,19 @@ fn last_lines(s: &str, n: usize) -> String {
     lines[lines.len().saturating_sub(n)..].join(" | ")
 }
 
-/// Shared memory the supervisor (or its motion-io) left behind.
+/// Shared memory the supervisor (or its motion-io, or a motionctl) left
+/// behind: reported, then removed if no process of the prefix lives.
 fn leftover_shm(prefix: &str, warnings: &mut BTreeSet<String>) {
-    let left = motion_frames::Domain::shm_files_of_prefix(prefix);
-    if !left.is_empty() {
+    let (found, remaining) = drive::clean_leftovers(prefix);
+    if !found.is_empty() {
         warnings.insert(format!(
-            "shared memory left in /dev/shm after a run: {}",
-            left.join(", ")
+            "left in /dev/shm after a run (then cleaned by the bench{}): {}",
+            if remaining.is_empty() {
+                ""
+            } else {
+                ", NOT all"
+            },
+            found.join(", ")
         ));
     }
 }
@@ -1206,4 +1378,125 @@ fn bus_summary(runs: &[BusRun]) -> Option<BusRun> {
             lost: a.lost + b.lost,
         },
     ))
+}
+
+/// The homings of the 64-axis machine during its slices.
+#[derive(Default)]
+struct Homing64 {
+    /// `motionctl home --parallel` commands started.
+    started: u64,
+    /// ... in which every axis homed (PC, homed, no error).
+    ok: u64,
+    /// ... in which some axis did not, while the supervisor ran on.
+    failed: u64,
+    /// ... ended by the end of the slice (the supervisor stops every axis).
+    cut_off: u64,
+    /// Per axis, the homings that were not cut off.
+    tally: Tally,
+    /// Seconds from a homing's start to its end (complete ones).
+    durations: Vec<f64>,
+}
+
+impl Homing64 {
+    fn merge(&mut self, h: Homing64) {
+        self.started += h.started;
+        self.ok += h.ok;
+        self.failed += h.failed;
+        self.cut_off += h.cut_off;
+        self.tally.merge(&h.tally);
+        self.durations.extend(h.durations);
+    }
+
+    fn line(&self, secs: f64) -> String {
+        let mean = if self.durations.is_empty() {
+            0.0
+        } else {
+            self.durations.iter().sum::<f64>() / self.durations.len() as f64
+        };
+        format!(
+            "64 axes: {} parallel homing(s) in {:.0} s ({:.1} s each): {} all homed, {} with a failed axis, {} cut off by a slice's end; \
+             axis homings {}: {} ok, {} ERR 12/40 (feedback lost), {} other error(s), {} not homed",
+            self.started,
+            secs,
+            mean,
+            self.ok,
+            self.failed,
+            self.cut_off,
+            self.tally.axis_homings,
+            self.tally.ok,
+            self.tally.feedback_lost,
+            self.tally.other_errors,
+            self.tally.not_homed
+        )
+    }
+
+    fn json(&self) -> Value {
+        json!({
+            "started": self.started,
+            "all_homed": self.ok,
+            "with_failed_axis": self.failed,
+            "cut_off_by_slice_end": self.cut_off,
+            "axes": self.tally,
+            "mean_duration_s": if self.durations.is_empty() { 0.0 }
+                else { self.durations.iter().sum::<f64>() / self.durations.len() as f64 },
+        })
+    }
+}
+
+/// Runs `motion-supervisor run` on the 64-axis `toml` for `len` s (as
+/// [`supervisor_run`]) and, while it runs, homes every axis in parallel
+/// with `motionctl home --parallel`, one homing after the other.
+#[allow(clippy::too_many_arguments)]
+fn supervisor_run_homing(
+    supervisor: &Path,
+    motionctl: &Path,
+    tmp: &Path,
+    tag: &str,
+    toml: &str,
+    prefix: &str,
+    len: f64,
+    hlog: &Path,
+) -> Result<(proc::Ended, Homing64), String> {
+    let cfg_path = tmp.join(format!("{tag}.toml"));
+    std::fs::write(&cfg_path, toml).map_err(|e| format!("{}: {e}", cfg_path.display()))?;
+    let mut cmd = Command::new(supervisor);
+    cmd.arg("run")
+        .arg("--config")
+        .arg(&cfg_path)
+        .arg("--duration")
+        .arg(format!("{len}"))
+        .arg("--json")
+        .arg("--hlog")
+        .arg(hlog)
+        .arg("--service-prefix")
+        .arg(prefix);
+    let t0 = Instant::now();
+    let mut r = Running::spawn(&mut cmd, "motion-supervisor", true, false)?;
+    let mut h = Homing64::default();
+    if drive::wait_until_ready(motionctl, prefix, &mut r, Duration::from_secs_f64(len)).is_ok() {
+        while r.running() && !proc::stop_requested() && t0.elapsed().as_secs_f64() < len {
+            let started = Instant::now();
+            h.started += 1;
+            let run = drive::ctl_home(motionctl, prefix, &[], true, len + 10.0)?;
+            let all_ok = !run.rows.is_empty() && run.rows.iter().all(|x| x.succeeded());
+            if all_ok {
+                h.ok += 1;
+                h.tally.add(&format!("{prefix} homing {}", h.started), &run);
+                h.durations.push(started.elapsed().as_secs_f64());
+            } else if (!r.running() || t0.elapsed().as_secs_f64() >= len - 0.5)
+                && run.rows.iter().all(|x| {
+                    x.succeeded() || (x.er && x.err == 12 && x.exerr == 1) || (!x.er && !x.homed)
+                })
+            {
+                // the supervisor's --duration ended it: every axis stopped
+                // (ERR 12/1), the homed ones unhomed; any other code counts
+                h.cut_off += 1;
+            } else {
+                h.failed += 1;
+                h.tally.add(&format!("{prefix} homing {}", h.started), &run);
+            }
+        }
+    }
+    let left = Duration::from_secs_f64(len + 60.0).saturating_sub(t0.elapsed());
+    Ok((r.wait(left, Duration::from_secs(10)), h))
 }
