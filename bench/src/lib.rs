@@ -12,7 +12,7 @@
 //! IPC bench's measuring thread; the rest is orchestration, parsing and
 //! reporting.
 
-pub mod args;
+pub mod cli;
 pub mod cyclictest;
 pub mod drive;
 pub mod ecat;

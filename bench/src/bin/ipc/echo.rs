@@ -1,0 +1,198 @@
+//! The bare echo peer, `ipc --role echo`: this binary re-run by the bench
+//! for the `bare-*` modes. It answers every ping with a pong through plain
+//! iceoryx2 ports, so that the bench can tell what motion-io adds to the
+//! round trip from what iceoryx2 itself costs.
+//!
+//! Its command line is its own parser, not a subcommand of the bench's:
+//! the bench spawns it as `ipc --role echo --prefix P --cpu N` plus
+//! `--spin` or `--priority P` (see `run_mode`), and its flags mean other
+//! things than the bench's flags of the same name.
+
+use crate::bare::{BareSide, PING, PONG};
+use clap::{Parser, ValueEnum};
+use motion_bench::proc;
+use motion_bench::sys::{self, now_ns};
+use motion_frames::{cleanup_domain, Domain};
+use std::time::Duration;
+
+/// The peer's role (`echo`, the only one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Role {
+    /// Answer every ping with a pong carrying its sequence number.
+    Echo,
+}
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "ipc --role echo",
+    about = "The bare iceoryx2 echo peer of `ipc` (started by it): answers every ping under \
+             PREFIX with a pong, until SIGTERM/SIGINT or the bench's end."
+)]
+pub struct EchoOpts {
+    /// What this process is.
+    #[arg(long, value_enum)]
+    pub role: Role,
+    /// Service prefix of the bench's mode (the domain it joins).
+    #[arg(long, value_name = "PREFIX")]
+    pub prefix: String,
+    /// CPU to pin to.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub cpu: usize,
+    /// SCHED_FIFO priority (default: normal scheduling).
+    #[arg(long, value_name = "P", allow_negative_numbers = true)]
+    pub priority: Option<i32>,
+    /// Busy-poll the subscriber instead of waiting on the event.
+    #[arg(long)]
+    pub spin: bool,
+}
+
+/// The echo's arguments as the bench spawns it: under `prefix` on `cpu`,
+/// SCHED_FIFO at `priority`, or spinning if None.
+pub fn args(prefix: &str, cpu: usize, priority: Option<i32>) -> Vec<String> {
+    let mut a: Vec<String> = ["--role", "echo", "--prefix", prefix, "--cpu"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    a.push(cpu.to_string());
+    match priority {
+        None => a.push("--spin".into()),
+        Some(p) => a.extend(["--priority".into(), p.to_string()]),
+    }
+    a
+}
+
+/// The command line is the echo's: `--role` comes first.
+pub fn wanted(args: &[String]) -> bool {
+    args.get(1)
+        .is_some_and(|a| a == "--role" || a.starts_with("--role="))
+}
+
+/// The echo peer's `main`: its exit code.
+pub fn main() -> i32 {
+    let o = EchoOpts::parse();
+    let (prefix, cpu, prio, spin) = (o.prefix, o.cpu, o.priority, o.spin);
+    // SAFETY: prctl with integer arguments only.
+    unsafe {
+        libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
+    }
+    proc::install_stop_handler();
+    for w in sys::enter_rt(Some(cpu), prio) {
+        eprintln!("ipc echo: warning: {w}");
+    }
+    let code = match echo(&prefix, spin) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("ipc echo: {e}");
+            1
+        }
+    };
+    code
+}
+
+/// Answers every ping with a pong carrying its sequence number, until
+/// SIGTERM/SIGINT. Event mode sleeps in `ppoll` on the listener's
+/// descriptor; spin mode polls the subscriber.
+fn echo(prefix: &str, spin: bool) -> Result<(), String> {
+    let until = std::time::Instant::now() + Duration::from_secs(10);
+    let domain = loop {
+        match Domain::join(prefix, None) {
+            Ok(d) => break d,
+            Err(e) if std::time::Instant::now() > until => return Err(e.to_string()),
+            Err(_) => std::thread::sleep(Duration::from_millis(20)),
+        }
+    };
+    let node = domain
+        .create_node("bench-echo")
+        .map_err(|e| e.to_string())?;
+    let mut x = BareSide::<PONG, PING>::create(&node, prefix, "pong", "ping")?;
+    let r = echo_loop(&mut x, spin);
+    drop(x);
+    drop(node);
+    let _ = cleanup_domain(&domain);
+    r
+}
+
+/// Echoes until stopped: the newest ping only (older ones are dropped, as
+/// motion-io answers only the newest command).
+fn echo_loop(x: &mut BareSide<PONG, PING>, spin: bool) -> Result<(), String> {
+    while !proc::stop_requested() {
+        if !spin {
+            // bounded, so that the stop flag is seen even without pings
+            x.wait_fd_until(now_ns() + 100_000_000);
+        }
+        match x.receive_latest() {
+            Some(seq) => {
+                x.pending = None;
+                x.publish(seq)?;
+            }
+            None => {
+                if spin {
+                    std::hint::spin_loop();
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    fn argv(args: Vec<String>) -> Vec<String> {
+        std::iter::once("ipc".to_string()).chain(args).collect()
+    }
+
+    #[test]
+    fn the_command_is_well_formed() {
+        EchoOpts::command().debug_assert();
+    }
+
+    #[test]
+    fn the_spawned_command_lines_are_the_echos_and_parse() {
+        let event = argv(args("mbi7m1", 0, Some(70)));
+        assert_eq!(
+            event[1..],
+            [
+                "--role",
+                "echo",
+                "--prefix",
+                "mbi7m1",
+                "--cpu",
+                "0",
+                "--priority",
+                "70"
+            ]
+        );
+        assert!(wanted(&event));
+        let o = EchoOpts::try_parse_from(&event).unwrap();
+        assert_eq!((o.role, o.prefix.as_str()), (Role::Echo, "mbi7m1"));
+        assert_eq!((o.cpu, o.priority, o.spin), (0, Some(70), false));
+
+        let spin = argv(args("mbi7m3", 1, None));
+        assert_eq!(
+            spin[1..],
+            ["--role", "echo", "--prefix", "mbi7m3", "--cpu", "1", "--spin"]
+        );
+        let o = EchoOpts::try_parse_from(&spin).unwrap();
+        assert_eq!((o.cpu, o.priority, o.spin), (1, None, true));
+    }
+
+    #[test]
+    fn only_a_leading_role_makes_an_echo() {
+        let v = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        assert!(wanted(&v(&["ipc", "--role=echo", "--prefix", "p"])));
+        assert!(!wanted(&v(&["ipc"])));
+        assert!(!wanted(&v(&["ipc", "--count", "5", "--role", "echo"])));
+    }
+
+    #[test]
+    fn the_prefix_is_required_and_the_role_checked() {
+        let parse = |a: &[&str]| EchoOpts::try_parse_from(a.iter().copied());
+        assert!(parse(&["ipc", "--role", "echo"]).is_err());
+        assert!(parse(&["ipc", "--role", "ping", "--prefix", "p"]).is_err());
+        let o = parse(&["ipc", "--role", "echo", "--prefix", "p"]).unwrap();
+        assert_eq!((o.cpu, o.priority, o.spin), (0, None, false));
+    }
+}

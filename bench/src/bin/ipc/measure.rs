@@ -1,0 +1,95 @@
+//! The measurement: one message per period, timed as the supervisor's cycle
+//! times its exchange with motion-io, after a warm-up that proves the peer
+//! is there. Answers later than half a period past the deadline are
+//! counted apart, not put in the percentiles.
+
+use crate::exchange::Exchange;
+use hdrhistogram::Histogram;
+use motion_bench::hist::new_hist;
+use motion_bench::proc;
+use motion_bench::sys::{self, now_ns};
+use std::time::{Duration, Instant};
+
+/// Result of one mode.
+pub struct Measured {
+    pub hist: Histogram<u64>,
+    pub sent: u64,
+    /// Messages without an answer within half a period.
+    pub late: u64,
+}
+
+/// One cycle as `rt_thread` does it: clear stale wake-ups, timestamp,
+/// publish + notify, wait (at most half a period after the deadline, at most
+/// 4 wake-ups) for the answer to *this* message. Returns the round trip, ns.
+fn cycle<X: Exchange>(x: &mut X, deadline: u64, period_ns: u64) -> Result<Option<u64>, String> {
+    x.clear();
+    let t_send = now_ns();
+    let seq = x.send()?;
+    let budget_end = deadline + period_ns / 2;
+    for _ in 0..4 {
+        if !x.wait_until(budget_end) {
+            break;
+        }
+        if x.answer() == Some(seq) {
+            return Ok(Some(now_ns() - t_send));
+        }
+    }
+    Ok(None)
+}
+
+/// `count` messages, one per period of `period_ns`, after `warmup` answers
+/// in a row.
+pub fn measure<X: Exchange>(
+    x: &mut X,
+    count: u64,
+    period_ns: u64,
+    warmup: u64,
+) -> Result<Measured, String> {
+    let mut deadline = now_ns() + period_ns;
+    let next = |deadline: &mut u64| {
+        *deadline += period_ns;
+        // keep the phase; skip whole periods that already passed
+        let now = now_ns();
+        if now > *deadline {
+            *deadline += (now - *deadline) / period_ns * period_ns + period_ns;
+        }
+    };
+    // warm-up: until `warmup` answers in a row (peer started, connected)
+    let started = Instant::now();
+    let mut in_row = 0;
+    while in_row < warmup {
+        if started.elapsed() > Duration::from_secs(15) {
+            return Err(format!(
+                "the peer did not answer {warmup} messages in a row within 15 s"
+            ));
+        }
+        if proc::stop_requested() {
+            return Err("interrupted".into());
+        }
+        sys::sleep_until(deadline);
+        in_row = if cycle(x, deadline, period_ns)?.is_some() {
+            in_row + 1
+        } else {
+            0
+        };
+        next(&mut deadline);
+    }
+    let mut m = Measured {
+        hist: new_hist(),
+        sent: 0,
+        late: 0,
+    };
+    while m.sent < count {
+        if m.sent % 1000 == 0 && proc::stop_requested() {
+            return Err("interrupted".into());
+        }
+        sys::sleep_until(deadline);
+        m.sent += 1;
+        match cycle(x, deadline, period_ns)? {
+            Some(rt) => m.hist.saturating_record(rt.max(1)),
+            None => m.late += 1,
+        }
+        next(&mut deadline);
+    }
+    Ok(m)
+}
