@@ -203,8 +203,103 @@ fn cleanup_domain_keeps_a_live_domain_and_removes_an_empty_one() {
     assert!(!r.removed_global_mgmt && r.domain_gone(), "{r:?}");
 }
 
-/// Issue 8, attack 4: the node counter is 0666 in iceoryx2; ours is made
-/// 0600, and a truncated one is refused instead of hanging node creation.
+/// Watches /dev/shm (inotify) while `f` runs and records the mode of every
+/// file starting with `prefix` each time it is created, written or has its
+/// permissions changed, as seen right after the event: a window in which
+/// a file is group- or world-accessible shows up as such a mode.
+fn modes_seen_while(prefix: &str, f: impl FnOnce()) -> Vec<(String, u32)> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    // SAFETY: plain syscalls on a descriptor this function owns.
+    let fd = unsafe { libc::inotify_init1(libc::IN_NONBLOCK | libc::IN_CLOEXEC) };
+    assert!(fd >= 0);
+    let mask = libc::IN_CREATE | libc::IN_ATTRIB | libc::IN_MODIFY | libc::IN_CLOSE_WRITE;
+    let wd = unsafe { libc::inotify_add_watch(fd, c"/dev/shm".as_ptr(), mask) };
+    assert!(wd >= 0);
+    let stop = Arc::new(AtomicBool::new(false));
+    let watcher = {
+        let stop = stop.clone();
+        let prefix = prefix.to_string();
+        std::thread::spawn(move || {
+            let mut seen = Vec::new();
+            let mut buf = [0u64; 1024];
+            loop {
+                let done = stop.load(Ordering::Acquire);
+                let mut pfd = libc::pollfd {
+                    fd,
+                    events: libc::POLLIN,
+                    revents: 0,
+                };
+                unsafe { libc::poll(&mut pfd, 1, 20) };
+                let n = unsafe { libc::read(fd, buf.as_mut_ptr().cast(), 8 * buf.len()) };
+                let bytes: &[u8] =
+                    unsafe { std::slice::from_raw_parts(buf.as_ptr().cast(), n.max(0) as usize) };
+                let mut at = 0;
+                while at + 16 <= bytes.len() {
+                    let len = u32::from_ne_bytes(bytes[at + 12..at + 16].try_into().unwrap());
+                    let raw = &bytes[at + 16..at + 16 + len as usize];
+                    let name = String::from_utf8_lossy(raw.split(|&b| b == 0).next().unwrap());
+                    if name.starts_with(&prefix) {
+                        let path = std::path::Path::new("/dev/shm").join(name.as_ref());
+                        if let Ok(m) = std::fs::symlink_metadata(&path) {
+                            seen.push((name.into_owned(), m.mode() & 0o7777));
+                        }
+                    }
+                    at += 16 + len as usize;
+                }
+                if done && n <= 0 {
+                    return seen;
+                }
+            }
+        })
+    };
+    f();
+    std::thread::sleep(Duration::from_millis(50));
+    stop.store(true, Ordering::Release);
+    let seen = watcher.join().unwrap();
+    unsafe { libc::close(fd) };
+    seen
+}
+
+/// Issue 8: creating a node in a fresh domain never leaves a file that
+/// group or others could open, not even for a moment (iceoryx2 makes its
+/// node counter 0666 with fchmod; a chmod afterwards left a window).
+#[test]
+fn no_file_of_a_new_node_is_ever_accessible_to_others() {
+    for round in 0..5 {
+        let env = TestEnv::new("um");
+        let mut node = None;
+        let seen = modes_seen_while(&env.domain.file_prefix(), || {
+            node = Some(env.domain.create_node("motion-supervisor").unwrap());
+        });
+        assert!(
+            seen.iter().any(|(n, _)| n.ends_with(".global_mgmt")),
+            "round {round}: the node counter's creation was not observed: {seen:?}"
+        );
+        let open: Vec<_> = seen
+            .iter()
+            .filter(|(_, m)| m & 0o077 != 0)
+            .map(|(n, m)| format!("{n}: {m:o}"))
+            .collect();
+        assert!(
+            open.is_empty(),
+            "round {round}: accessible to others: {open:?}"
+        );
+        for f in env.shm_files() {
+            let m = std::fs::metadata(std::path::Path::new("/dev/shm").join(&f)).unwrap();
+            assert_eq!(m.mode() & 0o777, 0o600, "{f}");
+        }
+        for f in env.root_files() {
+            let m = std::fs::symlink_metadata(&f).unwrap();
+            assert_eq!(m.mode() & 0o077, 0, "{}: {:o}", f.display(), m.mode());
+        }
+        drop(node);
+    }
+}
+
+/// Issue 8, attack 4: the node counter is 0666 in iceoryx2; ours is 0600
+/// from its creation on, and a truncated one is refused instead of hanging
+/// node creation.
 #[test]
 fn the_node_counter_is_private_and_a_truncated_one_is_refused() {
     let env = TestEnv::new("gm");
@@ -218,7 +313,7 @@ fn the_node_counter_is_private_and_a_truncated_one_is_refused() {
     let path = std::path::Path::new("/dev/shm").join(&mgmt[0]);
     assert_eq!(std::fs::metadata(&path).unwrap().mode() & 0o777, 0o600);
     drop(node);
-    // Someone truncates it (possible before our chmod, or as our user).
+    // Someone of our user truncates it.
     std::fs::OpenOptions::new()
         .write(true)
         .open(&path)
