@@ -191,7 +191,7 @@ fn homing_core(m: &MachineConfig) -> (Core, FeedbackFrame, CommandFrame, u64) {
                 k * dt_ns,
             );
         }
-        core.step(k * dt_ns, &[(k > 0).then_some(&fb)]);
+        core.step(k * dt_ns, false, &[(k > 0).then_some(&fb)]);
         core.fill(0, &mut cmd);
         core.sent(0, k + 1, k * dt_ns);
         fb.answers_sequence = k + 1;
@@ -236,7 +236,7 @@ fn cycle(c: &mut Criterion) {
         // real work; the frame conversion runs for every axis.
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
-                core.step(black_box(now), &[Some(black_box(&fb))]);
+                core.step(black_box(now), false, &[Some(black_box(&fb))]);
                 core.fill(0, black_box(&mut cmd));
             })
         });

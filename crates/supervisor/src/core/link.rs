@@ -114,12 +114,7 @@ impl IoLink {
 
     /// One cycle: `frame` is the newest frame received this cycle, if any;
     /// `stalled`: the supervisor woke late for it.
-    pub fn step(
-        &mut self,
-        now_ns: u64,
-        frame: Option<&FeedbackFrame>,
-        stalled: bool,
-    ) -> LinkCycle {
+    pub fn step(&mut self, now_ns: u64, frame: Option<&FeedbackFrame>, stalled: bool) -> LinkCycle {
         let mut out = LinkCycle::default();
         // A step later than the cycle is one missed answer: the supervisor's
         // own stall is not the peer's silence (the engines count the same way).
