@@ -10,12 +10,14 @@
 //! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`.
 //! * [`codes`] — ERR/EXERR in plain words.
 //! * [`table`] — the fixed-width text tables of the same reports.
+//! * [`panic`] — a panic with `--json`: one error object, like every failure.
 
 pub mod codes;
 pub mod errors;
 pub mod home;
 pub mod io;
 pub mod latency;
+pub mod panic;
 pub mod status;
 pub mod table;
 
@@ -35,8 +37,10 @@ pub fn round(x: f64, digits: i32) -> f64 {
     (x * k).round() / k
 }
 
-/// Prints `v` as one line of JSON on stdout.
+/// Prints `v` as one line of JSON on stdout (and notes that a JSON object
+/// is out: a panic after it prints no second one, see [`panic`]).
 pub fn print_json<T: serde::Serialize>(v: &T) {
+    panic::note_json_printed();
     match serde_json::to_string(v) {
         Ok(s) => println!("{s}"),
         // Our report types always serialize; say so rather than print nothing.
