@@ -160,6 +160,13 @@ impl Axis {
         self.last.map(|s| s.fb.position)
     }
 
+    /// When the newest valid feedback was taken: the `now_ns` of its step.
+    /// A step whose feedback was refused (not finite, out of range,
+    /// implausible) leaves it as it was.
+    pub fn sampled_ns(&self) -> Option<u64> {
+        self.last_sample_ns
+    }
+
     /// Axis actual position from the newest valid feedback.
     pub fn axis_position(&self) -> Option<f64> {
         self.raw_position().map(|r| self.to_axis(r))

@@ -462,7 +462,9 @@ impl Core {
             };
             let fb = self.feedback[i];
             self.commands[i] = self.axes[i].step(now_ns, fb.as_ref(), &req);
-            if fb.is_some() {
+            // The status shows only what the engine took: a refused sample
+            // (not finite, out of range, implausible) is not a reading.
+            if fb.is_some() && self.axes[i].sampled_ns() == Some(now_ns) {
                 self.last_fb[i] = fb;
             }
             // Stop is a one-cycle pulse (the engine takes its rising edge).
@@ -588,6 +590,8 @@ impl Core {
     }
 }
 
+#[cfg(test)]
+mod fuzz;
 #[cfg(test)]
 pub(crate) mod testbench;
 #[cfg(test)]
