@@ -412,4 +412,85 @@ start = 1.0
         assert!(b.watchdog_stop(f64::NAN, &mut fb));
         assert_eq!(fb.axes[0].status_word, SW_FAULT);
     }
+
+    /// Issue 8, fuzzed: command frames of any content (as a forger holding
+    /// the key could send; the ports checked key and layout), in any order
+    /// with watchdog and emergency stops: no panic, and the feedback the
+    /// drives give back stays a reading (finite, never the no-number
+    /// sentinel).
+    #[test]
+    fn any_command_frame_never_breaks_the_drives() {
+        use motion_frames::{INVALID_COUNTS, MAX_AXES};
+        use proptest::prelude::*;
+        use proptest::test_runner::{Config, TestRunner};
+
+        #[derive(Clone, Debug)]
+        enum Step {
+            /// Any bytes in the two axes' commands (a right axis count
+            /// unless `count` is given).
+            Exchange {
+                bytes: Vec<u8>,
+                count: Option<u32>,
+            },
+            Watchdog(f64),
+            Emergency,
+        }
+        let axis = std::mem::size_of::<AxisCommand>();
+        let step = prop_oneof![
+            6 => (
+                prop::collection::vec(any::<u8>(), 0..=2 * axis),
+                prop::option::weighted(0.1, any::<u32>()),
+            )
+                .prop_map(|(bytes, count)| Step::Exchange { bytes, count }),
+            1 => prop_oneof![Just(0.001), Just(f64::NAN), Just(-1.0), Just(1e300), any::<f64>()]
+                .prop_map(Step::Watchdog),
+            1 => Just(Step::Emergency),
+        ];
+        let mut runner = TestRunner::new(Config {
+            cases: 128,
+            failure_persistence: None,
+            ..Config::default()
+        });
+        runner
+            .run(&prop::collection::vec(step, 1..40), |steps| {
+                let mut b = backend();
+                let mut fb = FeedbackFrame::ZERO;
+                // Moving first: garbage arrives mid-motion.
+                for k in 0..20 {
+                    let f = frame(&[on(k as f64 * 0.03, 30.0), on(1.0, 0.0)], &[1000.0, 100.0]);
+                    b.exchange(&f, &mut fb).unwrap();
+                }
+                for st in &steps {
+                    match st {
+                        Step::Exchange { bytes, count } => {
+                            let mut f = CommandFrame::ZERO;
+                            f.header.axis_count = count.unwrap_or(2);
+                            let n = bytes.len().min(MAX_AXES * axis);
+                            // SAFETY: AxisCommand is a repr(C) struct of
+                            // integers and floats (as on the wire): every bit
+                            // pattern is a value; the write stays in `axes`.
+                            unsafe {
+                                std::ptr::copy_nonoverlapping(
+                                    bytes.as_ptr(),
+                                    f.axes.as_mut_ptr().cast::<u8>(),
+                                    n,
+                                );
+                            }
+                            let _ = b.exchange(&f, &mut fb);
+                        }
+                        Step::Watchdog(dt) => {
+                            b.watchdog_stop(*dt, &mut fb);
+                        }
+                        Step::Emergency => b.emergency_stop(&mut fb),
+                    }
+                    for (i, a) in fb.axes[..2].iter().enumerate() {
+                        prop_assert_ne!(a.position, INVALID_COUNTS, "axis {}: {:?}", i, a);
+                        prop_assert!(a.velocity.is_finite() && a.torque.is_finite(), "{a:?}");
+                        prop_assert!(b.position(i).is_finite());
+                    }
+                }
+                Ok(())
+            })
+            .unwrap();
+    }
 }
