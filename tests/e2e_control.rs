@@ -4,6 +4,7 @@
 
 use motion_tests::*;
 use nix::sys::signal::Signal;
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
 /// X: switch then marker 20 units away (about 3 s), on bus0.
@@ -297,6 +298,37 @@ fn losing_one_of_two_io_processes_aborts_only_its_axes() {
         signal(w.child.id() as i32, Signal::SIGTERM);
         let _ = w.child.wait();
     }
+    assert_clean(&p);
+}
+
+/// An HMI that outlives the daemon (`status --watch` notices it is gone
+/// and exits) is the domain's last node: nothing of the domain may stay in
+/// /dev/shm behind it (iceoryx2 would leave its node counter).
+#[test]
+fn an_hmi_outliving_the_daemon_leaves_nothing_behind() {
+    let _serial = serial();
+    let cfg = two_buses("hmi", "sim");
+    let d = Daemon::start(&cfg, &["bus0", "bus1"]);
+    let p = cfg.prefix.clone();
+    let hmi = Command::new(bin("motionctl"))
+        .args(["--service-prefix", &p, "status", "--watch"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("motionctl status --watch");
+    let mut hmi = Watched::new(hmi);
+    std::thread::sleep(Duration::from_millis(500));
+    let run = d.stop();
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    // The watcher finds the status service gone within its 2 s wait.
+    assert!(
+        wait_for(Duration::from_secs(15), || {
+            hmi.child.try_wait().map_or(true, |s| s.is_some())
+        }),
+        "motionctl status --watch did not notice the supervisor was gone"
+    );
+    let ended = hmi.finish();
+    assert_ne!(ended.code, Some(0), "it must say the supervisor is gone");
     assert_clean(&p);
 }
 

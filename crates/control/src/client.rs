@@ -58,6 +58,21 @@ pub struct Client {
     domain: Domain,
     session: u32,
     next_id: u64,
+    // Last: runs after the node is gone.
+    _tidy: Tidy,
+}
+
+/// Tidies the domain when the client goes: a client that outlives the
+/// supervisor (an HMI's `status --watch`) is the domain's last node, and
+/// iceoryx2 leaves the domain's node counter in `/dev/shm` behind it.
+/// [`motion_frames::cleanup_domain`] removes it only when no live node
+/// remains, so with the supervisor running it changes nothing.
+struct Tidy(Domain);
+
+impl Drop for Tidy {
+    fn drop(&mut self) {
+        let _ = motion_frames::cleanup_domain(&self.0);
+    }
 }
 
 impl Client {
@@ -104,6 +119,7 @@ impl Client {
             control,
             status,
             _node: node,
+            _tidy: Tidy(domain.clone()),
             domain,
             session,
             next_id: 1,

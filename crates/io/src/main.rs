@@ -288,6 +288,10 @@ fn serve(
     let outcome = run::run(&mut ports, backend, s, &domain.id);
     drop(ports);
     drop(node);
+    // Outliving the supervisor, this was the domain's last node: iceoryx2
+    // would leave the node counter behind (removed only when no live node
+    // remains, so with the supervisor running this changes nothing).
+    let _ = motion_frames::cleanup_domain(domain);
     Ok(outcome)
 }
 
