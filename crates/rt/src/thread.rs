@@ -326,6 +326,36 @@ fn num_cpus_configured() -> usize {
     }
 }
 
+/// Moves the calling thread off `cpu`: its affinity becomes the CPUs it may
+/// use now, minus `cpu`. Returns the CPUs it keeps.
+///
+/// Why: the kernels this runs on are often not fully preemptible
+/// (`PREEMPT_DYNAMIC` in mode none or voluntary, and every non-RT kernel):
+/// a normal-priority thread inside a system call on the cycle's CPU delays
+/// the real-time thread's wake-up until it reaches a scheduling point,
+/// whatever the priorities say. Threads spawned afterwards inherit the
+/// mask. Refused (mask unchanged) when `cpu` is the only CPU left.
+pub fn keep_off_cpu(cpu: usize) -> Result<Vec<usize>, String> {
+    let keep: Vec<usize> = current_affinity()
+        .into_iter()
+        .filter(|&c| c != cpu)
+        .collect();
+    if keep.is_empty() {
+        return Err(format!(
+            "cpu {cpu} is the only CPU this process may use: the non-real-time threads \
+             share it with the cycle"
+        ));
+    }
+    let mut set = CpuSet::new();
+    for &c in &keep {
+        set.set(c)
+            .map_err(|e| format!("cpu affinity: cpu {c}: {e}"))?;
+    }
+    sched_setaffinity(Pid::from_raw(0), &set)
+        .map_err(|e| format!("cpu affinity: keeping off cpu {cpu} failed: {e}"))?;
+    Ok(keep)
+}
+
 /// The calling thread's affinity mask.
 pub(crate) fn current_affinity() -> Vec<usize> {
     match sched_getaffinity(Pid::from_raw(0)) {
@@ -445,6 +475,31 @@ fn touch_stack(remaining: usize, page: usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn keep_off_cpu_leaves_the_cycle_cpu_to_the_cycle() {
+        // On a thread of its own: the mask is per thread.
+        std::thread::spawn(|| {
+            let before = current_affinity();
+            let cpu = before[0];
+            match keep_off_cpu(cpu) {
+                Ok(kept) => {
+                    assert!(before.len() > 1);
+                    assert!(!kept.contains(&cpu));
+                    assert_eq!(current_affinity(), kept);
+                    // Threads spawned afterwards inherit it.
+                    let child = std::thread::spawn(current_affinity).join().unwrap();
+                    assert_eq!(child, kept);
+                }
+                Err(e) => {
+                    assert_eq!(before.len(), 1, "{e}");
+                    assert_eq!(current_affinity(), before);
+                }
+            }
+        })
+        .join()
+        .unwrap();
+    }
 
     #[test]
     fn bad_cpu_is_a_warning() {

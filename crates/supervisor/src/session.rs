@@ -160,6 +160,20 @@ impl Session {
                 Phase::Starting => std::thread::sleep(Duration::from_millis(5)),
             }
         }
+        // This thread and the ones it spawns from here on (control, status,
+        // reporting) leave the cycle's CPU to the cycle (and the I/O process
+        // placed there, which pins itself): see `motion_rt::keep_off_cpu`.
+        match motion_rt::keep_off_cpu(machine.supervisor.cpu) {
+            Ok(cpus) => log::info!(
+                "non-real-time threads kept off cpu {} (on cpu {})",
+                machine.supervisor.cpu,
+                cpus.iter()
+                    .map(|c| c.to_string())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
+            Err(w) => s.warnings.push(w),
+        }
         let ready = Arc::new(Ready::default());
         s.control = Some(
             control_thread::spawn(

@@ -33,6 +33,17 @@ pub struct Group {
 }
 
 impl Group {
+    /// Wake-ups at least `period_us` late: what cyclictest's "samples ≥
+    /// period" counts, for a like-for-like comparison (our deadline misses
+    /// also count a cycle whose compute ends past the next deadline).
+    pub fn wakeups_ge(&self, period_us: u32) -> u64 {
+        let ns = u64::from(period_us) * 1000;
+        if self.wake.is_empty() || self.wake.max() < ns {
+            return 0;
+        }
+        self.wake.count_between(ns, self.wake.max())
+    }
+
     pub fn of(slices: &[OurSlice]) -> Self {
         let mut wake = new_hist();
         let mut compute = new_hist();

@@ -122,22 +122,24 @@ pub fn text(
     line(
         &mut t,
         format!(
-            "deadline misses   ours, demo: {} of {} cycles ({:.3} %, summed over {} slices; limit {:.0} %)",
+            "deadline misses   ours, demo: {} of {} cycles ({:.3} %, summed over {} slices; limit {:.0} %); wake-ups ≥ period: {}",
             m.ours.misses,
             thousands(m.ours.cycles),
             m.ours.miss_ratio * 100.0,
             m.ours.slices,
-            MAX_MISS_RATIO * 100.0
+            MAX_MISS_RATIO * 100.0,
+            m.ours.wakeups_ge(o.period_us)
         ),
     );
     if m.axes64.ran() {
         line(
             &mut t,
             format!(
-                "                  ours, 64 axes homing: {} of {} cycles ({:.3} %)",
+                "                  ours, 64 axes homing: {} of {} cycles ({:.3} %); wake-ups ≥ period: {}",
                 m.axes64.misses,
                 thousands(m.axes64.cycles),
-                m.axes64.miss_ratio * 100.0
+                m.axes64.miss_ratio * 100.0,
+                m.axes64.wakeups_ge(o.period_us)
             ),
         );
     }
@@ -145,10 +147,11 @@ pub fn text(
         line(
             &mut t,
             format!(
-                "                  EtherCAT backend: {} of {} cycles ({:.3} %)",
+                "                  EtherCAT backend: {} of {} cycles ({:.3} %); wake-ups ≥ period: {}",
                 m.ecat.misses,
                 thousands(m.ecat.cycles),
-                m.ecat.miss_ratio * 100.0
+                m.ecat.miss_ratio * 100.0,
+                m.ecat.wakeups_ge(o.period_us)
             ),
         );
     }
