@@ -12,6 +12,8 @@
 
 pub mod args;
 mod axis;
+#[cfg(feature = "cli-fuzz")]
+pub mod cli_fuzz;
 pub mod file;
 mod gantry;
 mod io;
