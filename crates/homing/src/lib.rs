@@ -28,6 +28,7 @@ pub mod profile;
 pub mod status;
 pub mod validate;
 
+pub use axis::loss::FeedbackLoss;
 pub use axis::{Axis, RestoreRefusal};
 pub use config::*;
 pub use io::*;

@@ -29,10 +29,13 @@
 //!
 //! Once tripped the loss has been reported; the first fresh sample after it
 //! starts a new connection with an empty bucket.
+//!
+//! The supervisor's I/O links judge their processes' answers with this same
+//! bucket (attached / detached), so the rule has one implementation.
 
 /// Bucket state. Times in ns.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct FeedbackLoss {
+pub struct FeedbackLoss {
     /// Missing time not yet drained.
     bucket: u64,
     /// Time of the previous step, once there was one.
@@ -86,6 +89,15 @@ impl FeedbackLoss {
             return true;
         }
         false
+    }
+
+    /// A new connection at `now` (a peer attached or restarted): empty
+    /// bucket, no gap, nothing tripped.
+    pub fn connected(&mut self, now: u64) {
+        self.bucket = 0;
+        self.excused = 0;
+        self.tripped = false;
+        self.gap_since = Some(now);
     }
 
     /// Length of the current gap at `now` (0 right after a fresh sample).

@@ -39,7 +39,7 @@ mod detect;
 mod intake;
 mod latches;
 mod legs;
-mod loss;
+pub mod loss;
 mod plausible;
 mod reference;
 mod state;

@@ -13,8 +13,9 @@
 //!
 //! # Attached
 //!
-//! The process is attached while its answers satisfy the same leaky-bucket
-//! rule the engines apply to their feedback: missing time fills the bucket,
+//! The process is attached while its answers satisfy the leaky-bucket rule
+//! the engines apply to their feedback — the same type,
+//! `motion_homing::FeedbackLoss`: missing time fills the bucket,
 //! fresh answers drain it, and past the time bound the process is detached
 //! (the engines abort homing on its axes by the same rule, independently),
 //! including its excuse for steps the supervisor woke late for.
@@ -23,6 +24,7 @@
 //! reconnected: HomedStatus cleared, as the CIP rules ask.
 
 use motion_frames::FeedbackFrame;
+use motion_homing::FeedbackLoss;
 use motion_report::GapCounts;
 
 use crate::shared::IoSnap;
@@ -45,13 +47,11 @@ pub struct IoLink {
     window: u64,
     /// Nominal cycle: a late step counts one cycle toward the bucket.
     cycle_ns: u64,
-    /// Leaky bucket, ns.
-    bucket_ns: u64,
-    /// Missing time excused in the current gap (late steps), ns.
-    excused_ns: u64,
+    /// The engines' feedback-loss bucket (`motion_homing::FeedbackLoss`),
+    /// judging this process's answers.
+    loss: FeedbackLoss,
     limit_ns: u64,
     drain: f64,
-    last_step_ns: Option<u64>,
     gap: u64,
     snap: IoSnap,
 }
@@ -83,15 +83,13 @@ impl IoLink {
             sent_ns: [0; SENT_RING],
             window,
             cycle_ns: cycle_ns.max(1),
-            bucket_ns: limit_ns,
-            excused_ns: 0,
+            loss: FeedbackLoss::default(),
             limit_ns,
             drain: if drain.is_finite() {
                 drain.clamp(0.0, 1.0)
             } else {
                 0.25
             },
-            last_step_ns: None,
             gap: 0,
             snap: IoSnap::default(),
         }
@@ -116,13 +114,9 @@ impl IoLink {
     /// `stalled`: the supervisor woke late for it.
     pub fn step(&mut self, now_ns: u64, frame: Option<&FeedbackFrame>, stalled: bool) -> LinkCycle {
         let mut out = LinkCycle::default();
-        // A step later than the cycle is one missed answer: the supervisor's
-        // own stall is not the peer's silence (the engines count the same way).
-        let elapsed = self
-            .last_step_ns
-            .map_or(0, |t| now_ns.saturating_sub(t))
-            .min(self.cycle_ns);
-        self.last_step_ns = Some(now_ns);
+        // At most one cycle per step: the supervisor's own stall is not the
+        // peer's silence (the engines count the same way, same code).
+        let elapsed = self.loss.tick(now_ns, self.cycle_ns);
 
         let mut usable = None;
         if let Some(f) = frame {
@@ -153,11 +147,8 @@ impl IoLink {
                     self.snap.gaps.add(self.gap);
                     self.gap = 0;
                 }
-                self.excused_ns = 0;
                 self.snap.frames_received += 1;
-                self.bucket_ns = self
-                    .bucket_ns
-                    .saturating_sub((elapsed as f64 * self.drain) as u64);
+                self.loss.fresh(now_ns, elapsed, self.drain);
                 let new_origin = f.header.origin != self.origin;
                 if !self.attached || new_origin {
                     if self.ever_attached && new_origin {
@@ -166,7 +157,7 @@ impl IoLink {
                     self.attached = true;
                     self.ever_attached = true;
                     self.origin = f.header.origin;
-                    self.bucket_ns = 0;
+                    self.loss.connected(now_ns);
                     self.snap.attachments += 1;
                     out.reconnected = true;
                 }
@@ -177,14 +168,9 @@ impl IoLink {
                 if self.ever_attached {
                     self.gap += 1;
                 }
-                // The machine stalled, not the peer: excused, within a bound
-                // (the engines' rule, `motion_homing` axis::loss).
-                if stalled && self.excused_ns.saturating_add(elapsed) <= self.limit_ns {
-                    self.excused_ns += elapsed;
-                } else {
-                    self.bucket_ns = self.bucket_ns.saturating_add(elapsed);
-                }
-                if self.attached && self.bucket_ns > self.limit_ns {
+                // Trips once per loss; a stalled step is excused within a
+                // bound (see `motion_homing::axis::loss`).
+                if self.loss.missing(elapsed, self.limit_ns, stalled) && self.attached {
                     self.attached = false;
                 }
             }
