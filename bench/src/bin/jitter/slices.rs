@@ -120,48 +120,61 @@ fn sup(o: &Opts, prefix: &str) -> Supervisor {
     }
 }
 
-/// The supervisor on the demo machine, idle.
-fn ours_demo(p: &Plan, i: usize, len: f64, c: &mut Collected) -> Result<Flow, String> {
+/// One series of supervisor slices: the letter of its service prefixes,
+/// its name in the progress lines and failures.
+struct Series {
+    letter: char,
+    label: &'static str,
+}
+
+/// One supervisor slice of a series: `launch` runs it under `prefix` with
+/// its interval log at `hlog` and returns how it ended with whatever else
+/// it measured; `keep` files the slice (and that) and returns what to add
+/// to the progress line. The stop request, the report, the progress line,
+/// the failure and the clean-up are the same for every series.
+fn our_slice_of<X>(
+    p: &Plan,
+    i: usize,
+    len: f64,
+    c: &mut Collected,
+    series: Series,
+    launch: impl FnOnce(&str, &Path) -> Result<(proc::Ended, X), String>,
+    keep: impl FnOnce(&mut Collected, OurSlice, Vec<String>, X, &proc::Ended) -> String,
+) -> Result<Flow, String> {
     if proc::stop_requested() {
         c.interrupted = true;
         return Ok(Flow::Stop);
     }
-    let (o, pid) = (p.o, p.pid);
-    let prefix = format!("mbj{pid}s{i}");
-    let (toml, _) = machine::demo_with(&sup(o, &prefix))?;
-    let hlog_path = p.tmp.join(format!("ours{i}.hlog"));
+    let prefix = format!("mbj{}{}{i}", p.pid, series.letter);
+    let hlog_path = p.tmp.join(format!("{}{i}.hlog", series.letter));
     let start = p.t0.elapsed();
-    let ended = supervisor::run(
-        p.supervisor,
-        p.tmp,
-        &format!("slice{i}"),
-        &toml,
-        &prefix,
-        len,
-        &hlog_path,
-    )?;
+    let (ended, extra) = launch(&prefix, &hlog_path)?;
     if ended.interrupted {
         c.interrupted = true;
         return Ok(Flow::Stop);
     }
     match our_slice(&ended, &hlog_path, start, len) {
         Ok((s, w)) => {
-            eprintln!(
-                "jitter: slice {}/{} ours:       {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies)",
+            let line = format!(
+                "jitter: slice {}/{} {:<11} {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies)",
                 i + 1,
                 p.slices,
+                format!("{}:", series.label),
                 s.cycles,
                 us(s.json_wakeup.p99),
                 us(s.json_wakeup.max),
                 s.misses,
                 s.late
             );
-            c.warnings.extend(w);
-            c.ours.push(s);
+            let more = keep(c, s, w, extra, &ended);
+            eprintln!("{line}{more}");
         }
         Err(e) => {
-            c.failures
-                .push(format!("slice {}: motion-supervisor: {e}", i + 1));
+            c.failures.push(format!(
+                "slice {}: motion-supervisor ({}): {e}",
+                i + 1,
+                series.label
+            ));
             return Ok(Flow::Stop);
         }
     }
@@ -169,60 +182,76 @@ fn ours_demo(p: &Plan, i: usize, len: f64, c: &mut Collected) -> Result<Flow, St
     Ok(Flow::Go)
 }
 
+/// The supervisor on the demo machine, idle.
+fn ours_demo(p: &Plan, i: usize, len: f64, c: &mut Collected) -> Result<Flow, String> {
+    let series = Series {
+        letter: 's',
+        label: "ours",
+    };
+    our_slice_of(
+        p,
+        i,
+        len,
+        c,
+        series,
+        |prefix, hlog| {
+            let (toml, _) = machine::demo_with(&sup(p.o, prefix))?;
+            let ended = supervisor::run(
+                p.supervisor,
+                p.tmp,
+                &format!("slice{i}"),
+                &toml,
+                prefix,
+                len,
+                hlog,
+            )?;
+            Ok((ended, ()))
+        },
+        |c, s, w, (), _| {
+            c.warnings.extend(w);
+            c.ours.push(s);
+            String::new()
+        },
+    )
+}
+
 /// The supervisor with 64 axes, homing in parallel again and again.
 fn ours_axes64(p: &Plan, i: usize, len: f64, c: &mut Collected) -> Result<Flow, String> {
-    if proc::stop_requested() {
-        c.interrupted = true;
-        return Ok(Flow::Stop);
-    }
-    let (o, pid) = (p.o, p.pid);
-    let prefix = format!("mbj{pid}a{i}");
-    let (toml, _) = Machine::Axes64.with(&sup(o, &prefix))?;
-    let hlog_path = p.tmp.join(format!("axes64_{i}.hlog"));
-    let start = p.t0.elapsed();
-    let (ended, h) = homing64::run(
-        p.supervisor,
-        p.motionctl,
-        p.tmp,
-        &format!("axes64_{i}"),
-        &toml,
-        &prefix,
+    let series = Series {
+        letter: 'a',
+        label: "64 axes",
+    };
+    our_slice_of(
+        p,
+        i,
         len,
-        &hlog_path,
-    )?;
-    if ended.interrupted {
-        c.interrupted = true;
-        return Ok(Flow::Stop);
-    }
-    match our_slice(&ended, &hlog_path, start, len) {
-        Ok((s, w)) => {
-            eprintln!(
-                "jitter: slice {}/{} 64 axes:    {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies); {} homing(s) of 64 axes: {} ok, {} failed, {} cut off by the slice's end",
-                i + 1,
-                p.slices,
-                s.cycles,
-                us(s.json_wakeup.p99),
-                us(s.json_wakeup.max),
-                s.misses,
-                s.late,
-                h.started,
-                h.ok,
-                h.failed,
-                h.cut_off
+        c,
+        series,
+        |prefix, hlog| {
+            let (toml, _) = Machine::Axes64.with(&sup(p.o, prefix))?;
+            homing64::run(
+                p.supervisor,
+                p.motionctl,
+                p.tmp,
+                &format!("axes64_{i}"),
+                &toml,
+                prefix,
+                len,
+                hlog,
+            )
+        },
+        |c, s, w, h: Homing64, _| {
+            let more = format!(
+                "; {} homing(s) of 64 axes: {} ok, {} failed, {} cut off by the slice's end",
+                h.started, h.ok, h.failed, h.cut_off
             );
             c.warnings
                 .extend(w.into_iter().map(|w| format!("64 axes: {w}")));
             c.ours64.push(s);
             c.homing64.merge(h);
-        }
-        Err(e) => {
-            c.failures
-                .push(format!("slice {}: motion-supervisor (64 axes): {e}", i + 1));
-            return Ok(Flow::Stop);
-        }
-    }
-    leftover_shm(&prefix, &mut c.warnings);
-    Ok(Flow::Go)
+            more
+        },
+    )
 }
 
 /// The supervisor on the demo machine with the EtherCAT backend.
@@ -233,41 +262,34 @@ fn ours_ethercat(
     len: f64,
     c: &mut Collected,
 ) -> Result<Flow, String> {
-    if proc::stop_requested() {
-        c.interrupted = true;
-        return Ok(Flow::Stop);
-    }
-    let (o, pid) = (p.o, p.pid);
-    let prefix = format!("mbj{pid}e{i}");
-    let (toml, _) = machine::demo_with(&sup(o, &prefix))?;
-    let (toml, _) = ecat::on_ethercat(&toml, rig.interface())?;
-    let hlog_path = p.tmp.join(format!("ecat{i}.hlog"));
-    let start = p.t0.elapsed();
-    let ended = supervisor::run(
-        p.supervisor,
-        p.tmp,
-        &format!("ecat{i}"),
-        &toml,
-        &prefix,
+    let series = Series {
+        letter: 'e',
+        label: "EtherCAT",
+    };
+    our_slice_of(
+        p,
+        i,
         len,
-        &hlog_path,
-    )?;
-    if ended.interrupted {
-        c.interrupted = true;
-        return Ok(Flow::Stop);
-    }
-    let bus = ecat::bus_run(&ended.stderr);
-    match our_slice(&ended, &hlog_path, start, len) {
-        Ok((s, w)) => {
-            eprintln!(
-                "jitter: slice {}/{} EtherCAT:   {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies); bus round trip {}",
-                i + 1,
-                p.slices,
-                s.cycles,
-                us(s.json_wakeup.p99),
-                us(s.json_wakeup.max),
-                s.misses,
-                s.late,
+        c,
+        series,
+        |prefix, hlog| {
+            let (toml, _) = machine::demo_with(&sup(p.o, prefix))?;
+            let (toml, _) = ecat::on_ethercat(&toml, rig.interface())?;
+            let ended = supervisor::run(
+                p.supervisor,
+                p.tmp,
+                &format!("ecat{i}"),
+                &toml,
+                prefix,
+                len,
+                hlog,
+            )?;
+            Ok((ended, ()))
+        },
+        |c, s, w, (), ended| {
+            let bus = ecat::bus_run(&ended.stderr);
+            let more = format!(
+                "; bus round trip {}",
                 bus.map_or("not reported".to_string(), |b| format!(
                     "p50 {} / p99 {} / max {} µs, {} lost frame(s)",
                     us(b.p50),
@@ -279,23 +301,16 @@ fn ours_ethercat(
             c.warnings
                 .extend(w.into_iter().map(|w| format!("EtherCAT: {w}")));
             c.ours_ecat.push(s);
-            if let Some(b) = bus {
-                c.bus_runs.push(b);
-            } else {
-                c.warnings
-                    .insert("EtherCAT: motion-io reported no bus summary in a slice".into());
+            match bus {
+                Some(b) => c.bus_runs.push(b),
+                None => {
+                    c.warnings
+                        .insert("EtherCAT: motion-io reported no bus summary in a slice".into());
+                }
             }
-        }
-        Err(e) => {
-            c.failures.push(format!(
-                "slice {}: motion-supervisor (EtherCAT): {e}",
-                i + 1
-            ));
-            return Ok(Flow::Stop);
-        }
-    }
-    leftover_shm(&prefix, &mut c.warnings);
-    Ok(Flow::Go)
+            more
+        },
+    )
 }
 
 /// cyclictest, as many periods as fit in the slice.
