@@ -3,9 +3,9 @@
 //! parsing of the text).
 
 use crate::cli::Opts;
-use crate::host::{Env, OtherRt};
 use crate::summary::{ratio_of, Group};
 use motion_bench::hist::Pct;
+use motion_bench::host::{Env, OtherRt};
 use serde_json::{json, Value};
 use std::path::Path;
 

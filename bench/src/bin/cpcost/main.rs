@@ -17,7 +17,6 @@
 
 mod cli;
 mod clients;
-mod host;
 mod json;
 mod slice;
 mod summary;
@@ -26,9 +25,9 @@ mod variant;
 
 use clap::Parser;
 use cli::Opts;
-use host::{Env, OtherRt};
 use motion_bench::drive::Binaries;
 use motion_bench::hist::us;
+use motion_bench::host::{Env, OtherRt};
 use motion_bench::proc;
 use slice::{Outcome, Slice};
 use std::collections::BTreeSet;
@@ -93,7 +92,7 @@ fn run(o: &Opts) -> Result<i32, String> {
             env.preemption
         );
     }
-    let mut other_rt = OtherRt::default();
+    let mut other_rt = OtherRt::new("cpcost");
     other_rt.note("before the bench");
 
     let t0 = Instant::now();

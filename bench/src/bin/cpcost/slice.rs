@@ -10,11 +10,11 @@ use crate::clients::{self, Clients};
 use crate::variant::Variant;
 use hdrhistogram::Histogram;
 use motion_bench::drive::{self, Binaries};
-use motion_bench::hist::{self, Pct};
+use motion_bench::hist::Pct;
 use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc::{self, Running};
+use motion_bench::run_report;
 use std::path::Path;
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// What one slice measured.
@@ -79,17 +79,7 @@ pub fn run(
     let cfg = p.tmp.join(format!("{tag}.toml"));
     std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
     let hlog = p.tmp.join(format!("{tag}.hlog"));
-    let mut cmd = Command::new(&p.b.supervisor);
-    cmd.arg("run")
-        .arg("--config")
-        .arg(&cfg)
-        .arg("--duration")
-        .arg(format!("{len}"))
-        .arg("--json")
-        .arg("--hlog")
-        .arg(&hlog)
-        .arg("--service-prefix")
-        .arg(&prefix);
+    let mut cmd = run_report::run_command(&p.b.supervisor, &cfg, len, &hlog, &prefix);
     if !v.serves() {
         cmd.arg("--no-control-plane");
     }
@@ -153,44 +143,18 @@ pub fn run(
     }
 }
 
-/// Reads one run: its JSON report (`motion_report::RunReport`) and its
-/// interval log. Returns the slice and the run's warnings.
+/// Reads one run (`motion_bench::run_report`). Returns the slice and the
+/// run's warnings.
 fn parse(ended: &proc::Ended, hlog: &Path, len: f64) -> Result<(Slice, Vec<String>), String> {
-    let tail = || {
-        let e = ended.stderr.trim();
-        if e.is_empty() {
-            String::new()
-        } else {
-            format!("; its stderr: {}", drive::tail(e, 8))
-        }
-    };
-    if !ended.success() {
-        return Err(format!("{}{}", ended.describe(), tail()));
-    }
-    let report: motion_report::RunReport = ended
-        .stdout
-        .lines()
-        .rev()
-        .find_map(|l| serde_json::from_str(l.trim()).ok())
-        .ok_or_else(|| format!("no run report on its stdout{}", tail()))?;
-    let mut warnings = report.warnings.clone();
-    if let Some(rt) = &report.rt {
-        warnings.extend(rt.warnings.iter().cloned());
-    }
-    if report.rt.as_ref().map(|r| r.policy.as_str()) != Some("SCHED_FIFO") {
-        warnings.push(format!(
-            "the cycle did not run SCHED_FIFO (rt: {:?})",
-            report.rt
-        ));
-    }
-    let intervals = hist::read_interval_log_file(hlog)?;
+    let m = run_report::read(ended, hlog)?;
+    let report = m.report;
     let lat = report.latency;
     let io_cpu: Vec<f64> = report.cpu.io.iter().filter_map(|(_, c)| *c).collect();
     let s = Slice {
         len,
-        wakeup: hist::sum_tag(&intervals, "wakeup"),
-        compute: hist::sum_tag(&intervals, "compute"),
-        roundtrip: hist::sum_tag(&intervals, "roundtrip"),
+        wakeup: m.wakeup,
+        compute: m.compute,
+        roundtrip: m.roundtrip,
         cycles: lat.cycles,
         misses: lat.deadline_misses,
         late: lat.late_replies,
@@ -203,8 +167,5 @@ fn parse(ended: &proc::Ended, hlog: &Path, len: f64) -> Result<(Slice, Vec<Strin
         attach_s: None,
         clients: Clients::default(),
     };
-    if s.cycles == 0 {
-        return Err(format!("it measured no cycles{}", tail()));
-    }
-    Ok((s, warnings))
+    Ok((s, m.warnings))
 }

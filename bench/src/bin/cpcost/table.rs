@@ -6,10 +6,10 @@
 
 use crate::cli::Opts;
 use crate::clients::Count;
-use crate::host::{Env, OtherRt};
 use crate::summary::{ratio_of, ratios, Group, COLUMNS, MAX_MISS_RATIO};
 use crate::variant::Variant;
 use motion_bench::hist::{self, thousands, us, Pct};
+use motion_bench::host::{Env, OtherRt};
 use motion_bench::sys;
 
 /// Everything the report shows besides the groups.
@@ -209,7 +209,7 @@ pub fn text(o: &Opts, groups: &[Group], n: &Notes) -> String {
             n.leftovers.0, n.leftovers.1
         ));
     }
-    if !n.other_rt.0.is_empty() {
+    if !n.other_rt.is_empty() {
         line(format!(
             "WARNING: other real-time threads ran during the bench: {}",
             n.other_rt.list().join("; ")

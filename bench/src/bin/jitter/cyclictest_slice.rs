@@ -4,9 +4,9 @@
 //! histogram written to a file and read back.
 
 use crate::cli::Opts;
-use crate::supervisor::last_lines;
 use hdrhistogram::Histogram;
 use motion_bench::cyclictest::{self, CtHistogram};
+use motion_bench::drive;
 use motion_bench::proc;
 use std::path::Path;
 use std::time::Duration;
@@ -60,7 +60,7 @@ pub fn ct_slice(
         if e.is_empty() {
             String::new()
         } else {
-            format!("; its output: {}", last_lines(e, 8))
+            format!("; its output: {}", drive::tail(e, 8))
         }
     };
     if !ended.success() {

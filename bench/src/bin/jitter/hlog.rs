@@ -4,10 +4,10 @@
 //! tools read it) without running the bench again.
 
 use crate::cli::Opts;
-use crate::host::Env;
 use crate::slices::Collected;
 use hdrhistogram::Histogram;
 use motion_bench::hist;
+use motion_bench::host::Env;
 use std::path::Path;
 use std::time::{Duration, SystemTime};
 

@@ -3,10 +3,10 @@
 //! read a run's results (no parsing of the text).
 
 use crate::cli::Opts;
-use crate::host::{Env, OtherRt};
 use crate::slices::Collected;
 use crate::summary::Summary;
 use motion_bench::hist::Pct;
+use motion_bench::host::{Env, OtherRt};
 use serde_json::{json, Value};
 use std::path::Path;
 use std::time::Duration;

@@ -19,7 +19,6 @@ mod cli;
 mod cyclictest_slice;
 mod hlog;
 mod homing64;
-mod host;
 mod json;
 mod plot;
 mod slices;
@@ -31,8 +30,8 @@ mod tools;
 
 use clap::Parser;
 use cli::Opts;
-use host::{Env, OtherRt};
 use motion_bench::ecat::EcatRig;
+use motion_bench::host::{Env, OtherRt};
 use motion_bench::proc;
 use std::path::PathBuf;
 use std::time::{Instant, SystemTime};
@@ -88,7 +87,7 @@ fn run(o: &Opts) -> Result<i32, String> {
             env.preemption
         );
     }
-    let mut other_rt = OtherRt::default();
+    let mut other_rt = OtherRt::new("jitter");
     other_rt.note("before the bench");
 
     let rig = if o.ethercat {

@@ -3,8 +3,8 @@
 //! marked, so that the distributions are compared on the same axes.
 
 use crate::cli::Opts;
-use crate::host::Env;
 use crate::summary::Summary;
+use motion_bench::host::Env;
 use motion_bench::svg::{self, Series};
 use std::path::Path;
 

@@ -10,10 +10,10 @@
 use crate::cli::Opts;
 use crate::cyclictest_slice::{self, CtSlice};
 use crate::homing64::{self, Homing64};
-use crate::host::OtherRt;
 use crate::supervisor::{self, leftover_shm, our_slice, OurSlice};
 use motion_bench::ecat::{self, BusRun, EcatRig};
 use motion_bench::hist::us;
+use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine, Supervisor};
 use motion_bench::proc::{self, Running};
 use std::collections::BTreeSet;

@@ -5,8 +5,9 @@
 
 use hdrhistogram::Histogram;
 use motion_bench::drive;
-use motion_bench::hist::{self, Pct};
+use motion_bench::hist::Pct;
 use motion_bench::proc::{self, Running};
+use motion_bench::run_report;
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;
@@ -42,18 +43,9 @@ pub fn run_command(
 ) -> Result<Command, String> {
     let cfg_path = tmp.join(format!("{tag}.toml"));
     std::fs::write(&cfg_path, toml).map_err(|e| format!("{}: {e}", cfg_path.display()))?;
-    let mut cmd = Command::new(supervisor);
-    cmd.arg("run")
-        .arg("--config")
-        .arg(&cfg_path)
-        .arg("--duration")
-        .arg(format!("{len}"))
-        .arg("--json")
-        .arg("--hlog")
-        .arg(hlog)
-        .arg("--service-prefix")
-        .arg(prefix);
-    Ok(cmd)
+    Ok(run_report::run_command(
+        supervisor, &cfg_path, len, hlog, prefix,
+    ))
 }
 
 /// Runs `motion-supervisor run` on `toml` for `len` s with an interval log
@@ -72,51 +64,22 @@ pub fn run(
         .wait(Duration::from_secs_f64(len + 60.0), Duration::from_secs(10)))
 }
 
-/// Parses one supervisor run: its JSON and its hlog. Returns the slice and
-/// the run's warnings.
+/// Parses one supervisor run (`motion_bench::run_report`). Returns the
+/// slice and the run's warnings.
 pub fn our_slice(
     ended: &proc::Ended,
     hlog: &Path,
     start: Duration,
     len: f64,
 ) -> Result<(OurSlice, Vec<String>), String> {
-    let tail = || {
-        let e = ended.stderr.trim();
-        if e.is_empty() {
-            String::new()
-        } else {
-            format!("; its stderr: {}", last_lines(e, 8))
-        }
-    };
-    if !ended.success() {
-        return Err(format!("{}{}", ended.describe(), tail()));
-    }
-    // The supervisor's own typed report (motion_report::RunReport).
-    let report: motion_report::RunReport = ended
-        .stdout
-        .lines()
-        .rev()
-        .find_map(|l| serde_json::from_str(l.trim()).ok())
-        .ok_or_else(|| format!("no run report on its stdout{}", tail()))?;
-    let lat = report.latency;
-    let mut warnings: Vec<String> = report.warnings.clone();
-    if let Some(rt) = &report.rt {
-        warnings.extend(rt.warnings.iter().cloned());
-    }
-    let policy = report.rt.as_ref().map(|r| r.policy.as_str());
-    if policy != Some("SCHED_FIFO") {
-        warnings.push(format!(
-            "the cycle did not run SCHED_FIFO (rt: {:?})",
-            report.rt
-        ));
-    }
-    let intervals = hist::read_interval_log_file(hlog)?;
+    let m = run_report::read(ended, hlog)?;
+    let lat = m.report.latency;
     let s = OurSlice {
         start,
         len: Duration::from_secs_f64(len),
-        wakeup: hist::sum_tag(&intervals, "wakeup"),
-        compute: hist::sum_tag(&intervals, "compute"),
-        roundtrip: hist::sum_tag(&intervals, "roundtrip"),
+        wakeup: m.wakeup,
+        compute: m.compute,
+        roundtrip: m.roundtrip,
         cycles: lat.cycles,
         misses: lat.deadline_misses,
         late: lat.late_replies,
@@ -124,16 +87,7 @@ pub fn our_slice(
         json_compute: lat.compute_us,
         json_roundtrip: lat.io_roundtrip_us,
     };
-    if s.cycles == 0 {
-        return Err(format!("it measured no cycles{}", tail()));
-    }
-    Ok((s, warnings))
-}
-
-/// The last `n` lines of a tool's output, on one line, for an error message.
-pub fn last_lines(s: &str, n: usize) -> String {
-    let lines: Vec<&str> = s.lines().collect();
-    lines[lines.len().saturating_sub(n)..].join(" | ")
+    Ok((s, m.warnings))
 }
 
 /// Shared memory the supervisor (or its motion-io, or a motionctl) left

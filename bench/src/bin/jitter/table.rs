@@ -5,10 +5,10 @@
 //! Same numbers as the JSON, laid out to be read in a CI log.
 
 use crate::cli::Opts;
-use crate::host::{Env, OtherRt};
 use crate::slices::Collected;
 use crate::summary::{Summary, MAX_MISS_RATIO};
 use motion_bench::hist::{self, thousands, us, Pct, COLUMNS};
+use motion_bench::host::{Env, OtherRt};
 use motion_bench::sys;
 
 /// The report's text; `other_cpu` is where stress-ng ran (`--stress`).
