@@ -38,3 +38,57 @@ impl ErrorReport {
         Self::one(ErrorEntry::message(message))
     }
 }
+
+/// As a log line: `axis A: key: message (ERR n EXERR m)`, each part only
+/// where it applies.
+impl std::fmt::Display for ErrorEntry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if let Some(a) = &self.axis {
+            write!(f, "axis {a}: ")?;
+        }
+        if let Some(k) = &self.key {
+            write!(f, "{k}: ")?;
+        }
+        f.write_str(&self.message)?;
+        if let (Some(err), Some(exerr)) = (self.err, self.exerr) {
+            write!(f, " (ERR {err} EXERR {exerr})")?;
+        }
+        Ok(())
+    }
+}
+
+/// Reports `errors` — one JSON object with `json`, else one log line each
+/// (stderr) — and returns `code`: how every binary fails.
+pub fn fail(json: bool, errors: Vec<ErrorEntry>, code: i32) -> i32 {
+    if json {
+        crate::print_json(&ErrorReport { errors });
+    } else {
+        for e in &errors {
+            log::error!("{e}");
+        }
+    }
+    code
+}
+
+#[cfg(test)]
+mod display_tests {
+    use super::*;
+
+    #[test]
+    fn a_line_names_what_applies() {
+        let e = ErrorEntry {
+            axis: Some("X".into()),
+            key: Some("home_speed".into()),
+            err: Some(12),
+            exerr: Some(40),
+            message: "bad".into(),
+        };
+        assert_eq!(e.to_string(), "axis X: home_speed: bad (ERR 12 EXERR 40)");
+        let e = ErrorEntry {
+            axis: Some("X".into()),
+            ..ErrorEntry::message("gone")
+        };
+        assert_eq!(e.to_string(), "axis X: gone");
+        assert_eq!(ErrorEntry::message("m").to_string(), "m");
+    }
+}

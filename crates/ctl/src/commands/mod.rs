@@ -68,26 +68,7 @@ fn target(t: &Target) -> Result<(String, Option<PathBuf>), Vec<ErrorEntry>> {
     Ok((prefix, runtime_dir))
 }
 
-/// Reports `errors` (one JSON object with `json`, else on stderr), returns `code`.
-pub fn fail(json: bool, errors: Vec<ErrorEntry>, code: i32) -> i32 {
-    if json {
-        print_json(&ErrorReport { errors });
-    } else {
-        for e in &errors {
-            let code = match (e.err, e.exerr) {
-                (Some(a), Some(b)) => format!(" (ERR {a} EXERR {b})"),
-                _ => String::new(),
-            };
-            match (&e.axis, &e.key) {
-                (Some(a), Some(k)) => log::error!("axis {a}: {k}: {}{code}", e.message),
-                (Some(a), None) => log::error!("axis {a}: {}{code}", e.message),
-                (None, Some(k)) => log::error!("{k}: {}{code}", e.message),
-                _ => log::error!("{}{code}", e.message),
-            }
-        }
-    }
-    code
-}
+pub use motion_report::errors::fail;
 
 /// A client error, with the exit code it means.
 pub fn client_error(json: bool, e: &ClientError) -> i32 {

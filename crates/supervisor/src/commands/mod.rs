@@ -60,26 +60,7 @@ pub fn entries(problems: &[Problem]) -> Vec<ErrorEntry> {
         .collect()
 }
 
-/// Reports `errors` (one JSON object with `json`, else lines on stderr) and
-/// returns `code`.
-pub fn fail(json: bool, errors: Vec<ErrorEntry>, code: i32) -> i32 {
-    if json {
-        print_json(&ErrorReport { errors });
-    } else {
-        for e in &errors {
-            let code = match (e.err, e.exerr) {
-                (Some(err), Some(exerr)) => format!(" (ERR {err} EXERR {exerr})"),
-                _ => String::new(),
-            };
-            match (&e.axis, &e.key) {
-                (Some(a), Some(k)) => log::error!("axis {a}: {k}: {}{code}", e.message),
-                (None, Some(k)) => log::error!("{k}: {}{code}", e.message),
-                _ => log::error!("{}{code}", e.message),
-            }
-        }
-    }
-    code
-}
+pub use motion_report::errors::fail;
 
 /// Loads the machine; on error reports every problem and returns exit code 2.
 fn load(common: &Common, json: bool) -> Result<(MachineConfig, String), i32> {
