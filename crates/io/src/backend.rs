@@ -83,10 +83,29 @@ pub trait Backend {
     fn axis_names(&self) -> Vec<String>;
 
     /// One cycle: apply `cmd` to the drives and fill `fb` with their feedback.
-    /// A command that cannot be applied (e.g. the axis count does not match)
-    /// is not applied at all; `fb` is still filled and the reason returned.
-    fn exchange(&mut self, cmd: &CommandFrame, fb: &mut FeedbackFrame)
-        -> Result<(), ExchangeError>;
+    /// A command that cannot be applied (the axis count does not match: the
+    /// two processes use different configs) is not applied at all; `fb` is
+    /// still filled and the reason returned. The check is made here, once,
+    /// for every backend; [`apply`](Self::apply) does the rest.
+    fn exchange(
+        &mut self,
+        cmd: &CommandFrame,
+        fb: &mut FeedbackFrame,
+    ) -> Result<(), ExchangeError> {
+        let (theirs, ours) = (cmd.header.axis_count as usize, self.axis_count());
+        if theirs != ours {
+            self.status(fb);
+            return Err(ExchangeError::AxisCountMismatch {
+                frame: theirs,
+                ours,
+            });
+        }
+        self.apply(cmd, fb)
+    }
+
+    /// [`exchange`](Self::exchange) once the frame is known to carry this
+    /// backend's axis count.
+    fn apply(&mut self, cmd: &CommandFrame, fb: &mut FeedbackFrame) -> Result<(), ExchangeError>;
 
     /// Commands have stopped: one cycle (`dt_s` seconds) of bringing every
     /// axis to a controlled stop, then disabling it with a communication

@@ -302,20 +302,8 @@ impl Backend for EthercatIo {
         self.names.clone()
     }
 
-    fn exchange(
-        &mut self,
-        cmd: &CommandFrame,
-        fb: &mut FeedbackFrame,
-    ) -> Result<(), ExchangeError> {
+    fn apply(&mut self, cmd: &CommandFrame, fb: &mut FeedbackFrame) -> Result<(), ExchangeError> {
         let n = self.names.len();
-        let theirs = cmd.header.axis_count as usize;
-        if theirs != n {
-            self.status(fb);
-            return Err(ExchangeError::AxisCountMismatch {
-                frame: theirs,
-                ours: n,
-            });
-        }
         let r = if self.direct {
             self.inner.exchange(cmd, fb)
         } else {

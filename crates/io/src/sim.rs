@@ -169,20 +169,8 @@ impl Backend for SimBackend {
         self.axes.iter().map(|a| a.name.clone()).collect()
     }
 
-    fn exchange(
-        &mut self,
-        cmd: &CommandFrame,
-        fb: &mut FeedbackFrame,
-    ) -> Result<(), ExchangeError> {
+    fn apply(&mut self, cmd: &CommandFrame, fb: &mut FeedbackFrame) -> Result<(), ExchangeError> {
         let n = self.axes.len();
-        let theirs = cmd.header.axis_count as usize;
-        if theirs != n {
-            self.status(fb);
-            return Err(ExchangeError::AxisCountMismatch {
-                frame: theirs,
-                ours: n,
-            });
-        }
         for ((axis, wire), out) in self.axes.iter_mut().zip(&cmd.axes).zip(&mut fb.axes) {
             let c = axis_to_command(wire, axis.counts_per_unit);
             let f = axis.plant.step(&c, self.dt);
