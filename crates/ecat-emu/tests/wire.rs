@@ -604,8 +604,11 @@ fn following_error_window_follows_the_tolerance() {
         r.emu().view(0).unwrap().drive.following_error_window == 500
     });
     r.axis(0).position_error_tolerance = 0.0;
-    r.until("window off", Duration::from_secs(3), |r| {
+    // The drive applies the SDO write before the master has its answer and
+    // counts it: wait for both.
+    r.until("window off, two writes counted", Duration::from_secs(3), |r| {
         r.emu().view(0).unwrap().drive.following_error_window == u32::MAX
+            && r.backend.bus_status().axes[0].following_window_writes >= 2
     });
     assert_eq!(r.backend.bus_status().axes[0].following_window_writes, 2);
 }
