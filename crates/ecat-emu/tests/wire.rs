@@ -517,9 +517,15 @@ fn unplugged_subdevice_is_no_data_then_recovers_after_replug() {
     r.settle(0);
     assert_eq!(r.fb.axes[0].status_word & SW_NO_DATA, 0);
     // the unplugged drive's SM watchdog expires on its own
-    r.until("watchdog expired", Duration::from_secs(2), |r| {
-        r.emu().view(1).unwrap().al_code == 0x001B
-    });
+    // (the master counts what it saw after the drive changed: wait for both)
+    r.until(
+        "watchdog expired, seen by the master",
+        Duration::from_secs(2),
+        |r| {
+            r.emu().view(1).unwrap().al_code == 0x001B
+                && r.backend.bus_status().axes[1].no_data_not_op > 0
+        },
+    );
     let st = r.backend.bus_status();
     assert!(st.axes[1].no_data_not_op > 0, "{:?}", st.axes[1]);
     assert_eq!(
@@ -530,9 +536,11 @@ fn unplugged_subdevice_is_no_data_then_recovers_after_replug() {
     );
     // re-plug: acknowledged, back to OP, data again
     r.emu().replug(1);
-    let n = r.until("axis 1 data again", Duration::from_secs(3), |r| {
-        r.fb.axes[1].status_word & SW_NO_DATA == 0
-    });
+    let n = r.until(
+        "axis 1 data again, recovery counted",
+        Duration::from_secs(3),
+        |r| r.fb.axes[1].status_word & SW_NO_DATA == 0 && r.backend.bus_status().recoveries >= 1,
+    );
     eprintln!("data again after {n} cycles");
     assert_eq!(r.emu().view(1).unwrap().al_status, 0x08);
     assert!(r.backend.bus_status().recoveries >= 1);
@@ -606,10 +614,14 @@ fn following_error_window_follows_the_tolerance() {
     r.axis(0).position_error_tolerance = 0.0;
     // The drive applies the SDO write before the master has its answer and
     // counts it: wait for both.
-    r.until("window off, two writes counted", Duration::from_secs(3), |r| {
-        r.emu().view(0).unwrap().drive.following_error_window == u32::MAX
-            && r.backend.bus_status().axes[0].following_window_writes >= 2
-    });
+    r.until(
+        "window off, two writes counted",
+        Duration::from_secs(3),
+        |r| {
+            r.emu().view(0).unwrap().drive.following_error_window == u32::MAX
+                && r.backend.bus_status().axes[0].following_window_writes >= 2
+        },
+    );
     assert_eq!(r.backend.bus_status().axes[0].following_window_writes, 2);
 }
 
