@@ -136,7 +136,7 @@ fn squatting_the_services_first_changes_nothing() {
     }
     drop(squatters);
     // The squatter's own leftovers (its domains' node counters).
-    motion_frames::cleanup::cleanup_stale_domains(&p, std::path::Path::new(root));
+    motion_ipc::cleanup_stale_domains(&p, std::path::Path::new(root));
     for f in std::fs::read_dir("/dev/shm").unwrap().flatten() {
         if f.file_name()
             .to_string_lossy()
@@ -161,15 +161,15 @@ fn forged_commands_never_move_an_axis() {
     assert!(io.wait_line("waiting for the supervisor", Duration::from_secs(10)));
     // A forger with no session: motion-io has not even created a node.
     std::thread::sleep(Duration::from_millis(500));
-    assert!(motion_frames::Domain::shm_files_of_prefix(&p).is_empty());
+    assert!(motion_ipc::Domain::shm_files_of_prefix(&p).is_empty());
 
     // The real session (played by this test), and a forger who knows the
     // domain but not the key and got to the command topic first.
-    let real = motion_frames::Domain::establish(&p, None).unwrap();
+    let real = motion_ipc::Domain::establish(&p, None).unwrap();
     let mut forged_domain = real.clone();
     forged_domain.key = [0xdead, 0xbeef];
     let node = forged_domain.create_node("forger").unwrap();
-    let mut ports = motion_frames::SupervisorPorts::create(&node, &forged_domain, "io").unwrap();
+    let mut ports = motion_ipc::SupervisorPorts::create(&node, &forged_domain, "io").unwrap();
     assert!(io.wait_line("backend sim", Duration::from_secs(10)));
     for _ in 0..300 {
         let _ = ports.send(|f| {
@@ -193,7 +193,7 @@ fn forged_commands_never_move_an_axis() {
     // The axis never moved: ask with the real key, on the same services
     // (motion-io holds them), with raw iceoryx2 ports.
     use iceoryx2::prelude::*;
-    let names = motion_frames::IoServiceNames::new(&p, "io");
+    let names = motion_ipc::IoServiceNames::new(&p, "io");
     let cmd = node
         .service_builder(&ServiceName::new(&names.command).unwrap())
         .publish_subscribe::<motion_frames::CommandFrame>()
@@ -237,7 +237,7 @@ fn forged_commands_never_move_an_axis() {
     signal(io.child.id() as i32, Signal::SIGTERM);
     let _ = io.child.wait();
     real.withdraw();
-    let _ = motion_frames::cleanup_domain(&real);
+    let _ = motion_ipc::cleanup_domain(&real);
     assert_clean(&p);
 }
 
@@ -317,7 +317,7 @@ fn attacker_part() {
         },
     );
     // Every file of the domain in /dev/shm: open for writing, truncate.
-    let files = motion_frames::Domain::shm_files_of_prefix(&prefix);
+    let files = motion_ipc::Domain::shm_files_of_prefix(&prefix);
     result("shm_files_visible", files.len().to_string());
     let mut opened = 0;
     for f in &files {
@@ -335,7 +335,7 @@ fn attacker_part() {
         .first()
         .and_then(|f| f[prefix.len() + 1..].split('.').next().map(str::to_string))
         .unwrap_or_default();
-    let d = motion_frames::Domain {
+    let d = motion_ipc::Domain {
         prefix: prefix.clone(),
         runtime_dir: runtime.clone(),
         id,

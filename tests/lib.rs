@@ -104,7 +104,7 @@ pub fn config(tag: &str, supervisor_extra: &str, axes: &str) -> TempConfig {
 
 /// Files of every iceoryx2 domain of this prefix in /dev/shm.
 pub fn shm_leftovers(prefix: &str) -> Vec<String> {
-    motion_frames::Domain::shm_files_of_prefix(prefix)
+    motion_ipc::Domain::shm_files_of_prefix(prefix)
 }
 
 /// Asserts that the domain left nothing behind (waits briefly: a process

@@ -67,7 +67,7 @@ pub fn wait_until_ready(
         if proc::stop_requested() {
             return Err("interrupted".into());
         }
-        if motion_frames::Domain::join(prefix, None).is_ok() {
+        if motion_ipc::Domain::join(prefix, None).is_ok() {
             if let Some(v) = status(motionctl, prefix) {
                 let attached = v["io"]
                     .as_array()
@@ -323,9 +323,8 @@ pub fn stress(cpu: usize, bound: Duration) -> Result<Running, String> {
 
 /// What a prefix left behind: its files in `/dev/shm` and its session file.
 pub fn leftovers(prefix: &str) -> Vec<String> {
-    let mut v = motion_frames::Domain::shm_files_of_prefix(prefix);
-    let session =
-        motion_frames::domain::session_path(&motion_frames::domain::default_runtime_dir(), prefix);
+    let mut v = motion_ipc::Domain::shm_files_of_prefix(prefix);
+    let session = motion_ipc::session_path(&motion_ipc::default_runtime_dir(), prefix);
     if session.exists() {
         v.push(session.display().to_string());
     }
@@ -343,10 +342,7 @@ pub fn clean_leftovers(prefix: &str) -> (Vec<String>, Vec<String>) {
     if found.is_empty() {
         return (found, Vec::new());
     }
-    motion_frames::cleanup::cleanup_stale_domains(
-        prefix,
-        &motion_frames::domain::default_runtime_dir(),
-    );
+    motion_ipc::cleanup_stale_domains(prefix, &motion_ipc::default_runtime_dir());
     (found, leftovers(prefix))
 }
 

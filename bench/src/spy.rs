@@ -7,9 +7,10 @@
 
 use crate::sys;
 use iceoryx2::prelude::ServiceName;
-use motion_frames::ports::{MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED};
-use motion_frames::wait::ppoll_until;
-use motion_frames::{monotonic_ns, CommandFrame, Domain, FeedbackFrame, IoServiceNames};
+use motion_frames::{CommandFrame, FeedbackFrame};
+use motion_ipc::ports::{MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED};
+use motion_ipc::wait::ppoll_until;
+use motion_ipc::{monotonic_ns, Domain, IoServiceNames};
 use std::io::Write;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -55,6 +55,9 @@ pub fn cpu(s: &str) -> Result<usize, String> {
     crate::check_cpu(n).map(|()| n as usize)
 }
 
-/// Longest runtime directory (iceoryx2's socket paths below it are limited;
-/// the same bound as `motion_frames::domain::RUNTIME_DIR_MAX`).
+/// Longest runtime directory: iceoryx2 puts its event sockets directly in it,
+/// named `{file prefix}{40 hex}.event`, and a unix socket path has at most 107
+/// bytes. With a 32-character service prefix ([`crate::names::PREFIX_MAX`])
+/// that leaves 19. Defined once, here, where the user's value is checked
+/// first; `motion-ipc` checks it again when it creates the directory.
 pub const RUNTIME_DIR_MAX: usize = 19;

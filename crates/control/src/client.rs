@@ -13,8 +13,8 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::{ipc, ServiceName};
 use iceoryx2::service::builder::publish_subscribe::PublishSubscribeOpenError;
 use iceoryx2::service::builder::request_response::RequestResponseOpenError;
-use motion_frames::names::{control_service, status_service};
-use motion_frames::{Domain, IpcError};
+use motion_ipc::names::{control_service, status_service};
+use motion_ipc::{Domain, IpcError};
 
 use crate::message::*;
 
@@ -65,13 +65,13 @@ pub struct Client {
 /// Tidies the domain when the client goes: a client that outlives the
 /// supervisor (an HMI's `status --watch`) is the domain's last node, and
 /// iceoryx2 leaves the domain's node counter in `/dev/shm` behind it.
-/// [`motion_frames::cleanup_domain`] removes it only when no live node
+/// [`motion_ipc::cleanup_domain`] removes it only when no live node
 /// remains, so with the supervisor running it changes nothing.
 struct Tidy(Domain);
 
 impl Drop for Tidy {
     fn drop(&mut self) {
-        let _ = motion_frames::cleanup_domain(&self.0);
+        let _ = motion_ipc::cleanup_domain(&self.0);
     }
 }
 

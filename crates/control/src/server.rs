@@ -11,8 +11,8 @@ use iceoryx2::node::Node;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::server::Server as IoxServer;
 use iceoryx2::prelude::{ipc, PlacementDefault, ServiceName};
-use motion_frames::names::{control_service, status_service};
-use motion_frames::{Domain, IpcError};
+use motion_ipc::names::{control_service, status_service};
+use motion_ipc::{Domain, IpcError};
 
 use crate::message::*;
 

@@ -20,13 +20,22 @@
 //! that contains [`LAYOUT_VERSION`] ([`COMMAND_FRAME_TYPE_NAME`],
 //! [`FEEDBACK_FRAME_TYPE_NAME`]). iceoryx2 compares type name, size and alignment
 //! when a process opens a service, so two binaries built with different layouts
-//! cannot connect at all (see [`crate::ipc::IpcError::LayoutMismatch`]). The
+//! cannot connect at all (`motion_ipc::IpcError::LayoutMismatch`). The
 //! [`FrameHeader::layout_version`] field is checked again on every received frame
 //! ([`FrameHeader::check`]) as defense in depth.
+//!
+//! The iceoryx2 traits themselves (`ZeroCopySend`, `PlacementDefault`) are
+//! derived here and implemented in `zero_copy.rs`, both only with the
+//! `zero-copy` feature (see the crate documentation).
 
 use core::fmt;
 
-use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
+#[cfg(feature = "zero-copy")]
+use iceoryx2_bb_derive_macros::{PlacementDefault, ZeroCopySend};
+#[cfg(feature = "zero-copy")]
+use iceoryx2_bb_elementary_traits::{
+    placement_default::PlacementDefault, zero_copy_send::ZeroCopySend,
+};
 
 /// Expands to the layout version as a literal, so it can be spliced into the
 /// iceoryx2 type names with `concat!` (the single source of the number).
@@ -90,7 +99,8 @@ pub const EDGE_FALLING: u8 = 1;
 
 /// Header in front of every frame.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend, PlacementDefault)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "zero-copy", derive(ZeroCopySend, PlacementDefault))]
 pub struct FrameHeader {
     /// [`LAYOUT_VERSION`] of the sender. Stamped by the `publish` helpers.
     pub layout_version: u32,
@@ -101,7 +111,7 @@ pub struct FrameHeader {
     pub sequence: u64,
     /// `CLOCK_MONOTONIC` of the sender, in ns, taken right before the frame was
     /// sent. `CLOCK_MONOTONIC` is system-wide on Linux, so the receiver can
-    /// compare it with its own clock (see [`crate::monotonic_ns`]).
+    /// compare it with its own clock (`motion_ipc::monotonic_ns`).
     pub timestamp_ns: u64,
     /// Random per process start of the sender: a new value means the peer
     /// was restarted (its sequence numbers start again at 1, and the
@@ -184,7 +194,8 @@ impl FrameHeader {
 
 /// One cycle's command for one axis, in drive units (counts).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend, PlacementDefault)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "zero-copy", derive(ZeroCopySend, PlacementDefault))]
 pub struct AxisCommand {
     /// Raw position set-point, counts.
     pub target_position: i64,
@@ -213,7 +224,8 @@ pub struct AxisCommand {
 
 /// One cycle's feedback for one axis, in drive units (counts).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend, PlacementDefault)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "zero-copy", derive(ZeroCopySend, PlacementDefault))]
 pub struct AxisFeedback {
     /// Raw actual position, counts.
     pub position: i64,
@@ -284,11 +296,12 @@ impl AxisFeedback {
 /// Supervisor → motion-io, once per cycle.
 ///
 /// The iceoryx2 type name is [`COMMAND_FRAME_TYPE_NAME`] (implemented by hand
-/// below instead of `#[derive(ZeroCopySend)]`, because the derive's
+/// in `zero_copy.rs` instead of `#[derive(ZeroCopySend)]`, because the derive's
 /// `#[type_name("..")]` only takes a plain literal and could drift from
 /// [`LAYOUT_VERSION`]).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, PlacementDefault)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "zero-copy", derive(PlacementDefault))]
 pub struct CommandFrame {
     pub header: FrameHeader,
     /// The first `header.axis_count` entries are valid.
@@ -299,7 +312,8 @@ pub struct CommandFrame {
 ///
 /// The iceoryx2 type name is [`FEEDBACK_FRAME_TYPE_NAME`].
 #[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, PlacementDefault)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "zero-copy", derive(PlacementDefault))]
 pub struct FeedbackFrame {
     pub header: FrameHeader,
     /// `header.sequence` of the [`CommandFrame`] this feedback answers
@@ -351,29 +365,13 @@ impl Default for FeedbackFrame {
     }
 }
 
-// SAFETY: `#[repr(C)]`, fields are `FrameHeader` and an array of `AxisCommand`,
-// both `ZeroCopySend` (checked at compile time below), no pointers or
-// process-local references, no implicit padding (size asserts below). The type
-// name carries the layout version so that processes with another layout are
-// rejected by iceoryx2 when they open the service.
-unsafe impl ZeroCopySend for CommandFrame {
-    unsafe fn type_name() -> &'static str {
-        COMMAND_FRAME_TYPE_NAME
-    }
-}
-
-// SAFETY: as for `CommandFrame`; the extra fields are plain `u64`.
-unsafe impl ZeroCopySend for FeedbackFrame {
-    unsafe fn type_name() -> &'static str {
-        FEEDBACK_FRAME_TYPE_NAME
-    }
-}
-
-/// What both frame types share; lets the port helpers stamp headers generically.
-pub trait Frame: ZeroCopySend + PlacementDefault + fmt::Debug + Copy + Default + 'static {
+/// What both frame types share; lets the port helpers stamp headers
+/// generically (`motion-ipc` adds iceoryx2's traits to the bound).
+pub trait Frame: fmt::Debug + Copy + Default + 'static {
     /// Human-readable name used in error messages.
     const NAME: &'static str;
-    /// The iceoryx2 type name (equal to `ZeroCopySend::type_name()`).
+    /// The iceoryx2 type name (equal to `ZeroCopySend::type_name()` with the
+    /// `zero-copy` feature).
     const TYPE_NAME: &'static str;
     fn header(&self) -> &FrameHeader;
     fn header_mut(&mut self) -> &mut FrameHeader;
@@ -404,16 +402,6 @@ impl Frame for FeedbackFrame {
 // ---------------------------------------------------------------------------
 // Compile-time layout pins. Any accidental change of a frame type fails here.
 // ---------------------------------------------------------------------------
-
-const fn assert_zero_copy_send<T: ZeroCopySend + ?Sized>() {}
-
-const _: () = {
-    // Every field of the hand-implemented frames is ZeroCopySend.
-    assert_zero_copy_send::<FrameHeader>();
-    assert_zero_copy_send::<[AxisCommand; MAX_AXES]>();
-    assert_zero_copy_send::<[AxisFeedback; MAX_AXES]>();
-    assert_zero_copy_send::<u64>();
-};
 
 const _: () = {
     use core::mem::{align_of, offset_of, size_of};
@@ -482,7 +470,6 @@ const _: () = {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use core::mem::MaybeUninit;
 
     fn bytes_of<T: Copy>(v: &T) -> &[u8] {
         // SAFETY: the frame types have no implicit padding (asserted above), so
@@ -495,38 +482,23 @@ mod tests {
         let v = format!("@layout{LAYOUT_VERSION}");
         assert!(COMMAND_FRAME_TYPE_NAME.ends_with(&v));
         assert!(FEEDBACK_FRAME_TYPE_NAME.ends_with(&v));
-        // SAFETY: type_name() is only unsafe to implement, not to call.
-        unsafe {
-            assert_eq!(
-                <CommandFrame as ZeroCopySend>::type_name(),
-                COMMAND_FRAME_TYPE_NAME
-            );
-            assert_eq!(
-                <FeedbackFrame as ZeroCopySend>::type_name(),
-                FEEDBACK_FRAME_TYPE_NAME
-            );
-        }
         assert_ne!(COMMAND_FRAME_TYPE_NAME, FEEDBACK_FRAME_TYPE_NAME);
+        // Other processes and the Python client open the services by these
+        // very strings: the crate's name in them stays what it was.
+        assert_eq!(
+            COMMAND_FRAME_TYPE_NAME,
+            "motion_frames::CommandFrame@layout3"
+        );
+        assert_eq!(
+            FEEDBACK_FRAME_TYPE_NAME,
+            "motion_frames::FeedbackFrame@layout3"
+        );
     }
 
     #[test]
     fn default_is_all_zero_bytes() {
         assert!(bytes_of(&CommandFrame::default()).iter().all(|&b| b == 0));
         assert!(bytes_of(&FeedbackFrame::default()).iter().all(|&b| b == 0));
-    }
-
-    #[test]
-    fn placement_default_equals_default() {
-        let mut c = MaybeUninit::<CommandFrame>::uninit();
-        let mut f = MaybeUninit::<FeedbackFrame>::uninit();
-        // SAFETY: pointers are valid, aligned, uninitialized memory of the type.
-        let (c, f) = unsafe {
-            CommandFrame::placement_default(c.as_mut_ptr());
-            FeedbackFrame::placement_default(f.as_mut_ptr());
-            (c.assume_init(), f.assume_init())
-        };
-        assert_eq!(c, CommandFrame::default());
-        assert_eq!(f, FeedbackFrame::default());
     }
 
     #[test]

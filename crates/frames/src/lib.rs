@@ -1,43 +1,36 @@
-//! `motion-frames`: the per-cycle command and feedback frames exchanged
-//! between `motion-supervisor` and the drive-I/O processes over iceoryx2 0.10
-//! shared memory, their conversion from/to the homing engine's
-//! [`motion_homing::Command`] / [`motion_homing::Feedback`], and the IPC
-//! plumbing every process of the product shares.
+//! `motion-frames`: the wire types of the per-cycle exchange between
+//! `motion-supervisor` and the drive-I/O processes, and their conversion
+//! from/to the homing engine's [`motion_homing::Command`] /
+//! [`motion_homing::Feedback`]. Nothing here opens a file, a socket or shared
+//! memory: moving the frames between processes is `motion-ipc`'s job.
 //!
-//! * [`frame`] — `#[repr(C)]` wire types with pinned layout and versioned
-//!   iceoryx2 type names.
+//! * [`frame`] — `#[repr(C)]` wire types with pinned layout, the layout
+//!   version and the versioned iceoryx2 type names.
 //! * [`convert`] — units ↔ counts, pure and allocation-free.
-//! * [`domain`] — the supervisor's private iceoryx2 domain: runtime
-//!   directory, session file and key, node creation with its guards.
-//! * [`names`] — service names.
-//! * [`ports`] — the frame ports of one I/O process ([`SupervisorPorts`],
-//!   [`IoPorts`]).
-//! * [`wait`] — exact waits on an iceoryx2 listener (`ppoll`).
-//! * [`cleanup`] — leaving nothing behind in `/dev/shm`.
-//! * [`error`] — engineer-readable errors.
+//! * `zero_copy` (feature `zero-copy`) — iceoryx2's `ZeroCopySend` (with the
+//!   type names above) and `PlacementDefault` for the frames.
+//!
+//! # Why the iceoryx2 traits are a feature
+//!
+//! The frames travel through iceoryx2 shared memory, so they must implement
+//! its `ZeroCopySend` and `PlacementDefault`. Those traits and their derives
+//! live in two small iceoryx2 crates without any IPC
+//! (`iceoryx2-bb-elementary-traits`, `iceoryx2-bb-derive-macros`); the derive
+//! crate still brings iceoryx2's logger and synchronisation crates along. A
+//! crate that only fills or reads frames (the EtherCAT backend, the emulator's
+//! tests, the engine bench) needs none of it, so the traits sit behind the
+//! `zero-copy` feature, which `motion-ipc` turns on: every crate that moves
+//! frames through iceoryx2 depends on `motion-ipc` and so gets them, and a
+//! wire-only user compiles no iceoryx2 code at all. The type names and the
+//! layout are the same with and without the feature.
 
-pub mod cleanup;
 pub mod convert;
-pub mod domain;
-pub mod error;
 pub mod frame;
-pub mod names;
-pub mod ports;
-pub mod wait;
+#[cfg(feature = "zero-copy")]
+mod zero_copy;
 
-pub use cleanup::{cleanup_domain, CleanupReport};
 pub use convert::{
     axis_to_command, axis_to_feedback, command_to_axis, counts_to_units, feedback_to_axis,
     units_to_counts, INVALID_COUNTS,
 };
-pub use domain::Domain;
-pub use error::IpcError;
 pub use frame::*;
-pub use names::IoServiceNames;
-pub use ports::{IoPorts, Ports, Sent, SupervisorPorts};
-
-/// `CLOCK_MONOTONIC` now, in ns: the clock of every frame timestamp. It is
-/// system-wide on Linux, so values taken in `motion-supervisor` and
-/// `motion-io` compare directly. (The runtime's clock, under the name the
-/// frame code uses.)
-pub use motion_rt::now_ns as monotonic_ns;

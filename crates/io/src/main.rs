@@ -25,7 +25,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use clap::Parser;
-use motion_frames::{cleanup_domain, Domain, IoPorts, IpcError};
+use motion_ipc::{cleanup_domain, Domain, IoPorts, IpcError};
 use motion_rt::{enter_realtime, RtConfig};
 
 use crate::backend::Backend;
@@ -95,7 +95,7 @@ fn real_main() -> i32 {
         .service_prefix
         .clone()
         .unwrap_or_else(|| cfg.supervisor.service_prefix.clone());
-    let runtime_dir = motion_frames::domain::runtime_dir_or_default(
+    let runtime_dir = motion_ipc::runtime_dir_or_default(
         opts.runtime_dir
             .as_deref()
             .or(cfg.supervisor.runtime_dir.as_deref()),
@@ -291,7 +291,7 @@ fn serve(
     // Outliving the supervisor, this was the domain's last node: iceoryx2
     // would leave the node counter behind (removed only when no live node
     // remains, so with the supervisor running this changes nothing).
-    let _ = motion_frames::cleanup_domain(domain);
+    let _ = motion_ipc::cleanup_domain(domain);
     Ok(outcome)
 }
 

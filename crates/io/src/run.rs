@@ -18,7 +18,8 @@
 
 use std::time::Duration;
 
-use motion_frames::{monotonic_ns, Domain, FeedbackFrame, IoPorts, IpcError};
+use motion_frames::FeedbackFrame;
+use motion_ipc::{monotonic_ns, Domain, IoPorts, IpcError};
 
 use crate::backend::Backend;
 use crate::say::{Once, Say};

@@ -6,7 +6,8 @@ mod common;
 use std::time::{Duration, Instant};
 
 use common::*;
-use motion_frames::{cleanup_domain, AxisCommand, CW_ENABLE, SW_ENABLED};
+use motion_frames::{AxisCommand, CW_ENABLE, SW_ENABLED};
+use motion_ipc::cleanup_domain;
 use nix::sys::signal::Signal;
 
 const STOP_LINE: &str = "motion-io: signal: every axis stopped";

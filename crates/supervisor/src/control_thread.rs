@@ -17,7 +17,7 @@ use crate::shared::{Ack, Control, Phase, Shared};
 use crate::{status_fill, trace_csv};
 use motion_config::MachineConfig;
 use motion_control::*;
-use motion_frames::Domain;
+use motion_ipc::Domain;
 use motion_report::{Allocations, IoReport, StatsReport};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};

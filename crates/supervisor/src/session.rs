@@ -14,7 +14,7 @@ use crate::io_child::IoChild;
 use crate::rt_thread::{self, RtOutcome, RtSettings};
 use crate::shared::{Control, Phase, Shared, Snapshot};
 use motion_config::{IoMode, MachineConfig};
-use motion_frames::Domain;
+use motion_ipc::Domain;
 use motion_report::{IoReport, Latency};
 use motion_rt::termination as signals;
 use std::path::PathBuf;
@@ -433,7 +433,7 @@ impl Session {
             }
             sp.child = None;
         }
-        let report = motion_frames::cleanup_domain(&self.domain);
+        let report = motion_ipc::cleanup_domain(&self.domain);
         if !report.domain_gone() {
             log::debug!("iceoryx2 domain on exit: {report}");
         }

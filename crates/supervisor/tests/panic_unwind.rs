@@ -9,7 +9,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use motion_config::IoMode;
-use motion_frames::domain::session_path;
+use motion_ipc::session_path;
 use motion_supervisor::session::{Session, SessionOptions};
 use motion_supervisor::shared::Phase;
 

@@ -12,13 +12,13 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::{ipc, BackpressureStrategy, ServiceName};
 use iceoryx2::sample::Sample;
-use motion_frames::ports::{
+use motion_frames::{CommandFrame, FeedbackFrame};
+use motion_ipc::ports::{
     MAX_LISTENERS, MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED,
 };
-use motion_frames::wait::{ppoll_until, PollWake};
-use motion_frames::{CommandFrame, FeedbackFrame};
+use motion_ipc::wait::{ppoll_until, PollWake};
 
-// The rest of the frames' QoS (`motion_frames::ports` sets these inline).
+// The rest of the frames' QoS (`motion_ipc::ports` sets these inline).
 const HISTORY: usize = 0;
 const MAX_NOTIFIERS: usize = 1;
 const MAX_PUBLISHERS: usize = 1;
@@ -28,7 +28,7 @@ pub const PING: usize = std::mem::size_of::<CommandFrame>();
 pub const PONG: usize = std::mem::size_of::<FeedbackFrame>();
 
 /// A `[u8; N]` topic with the frames' QoS (the same settings as
-/// `motion_frames::ports`, so the bare peer differs only in payload type).
+/// `motion_ipc::ports`, so the bare peer differs only in payload type).
 fn open_topic<const N: usize>(
     node: &Node<ipc::Service>,
     name: &str,
@@ -160,7 +160,7 @@ impl<const TX: usize, const RX: usize> BareSide<TX, RX> {
         Some(u64::from_le_bytes(b))
     }
 
-    /// As `motion_frames::Ports::wait_until`: `try_wait`, else `ppoll` on
+    /// As `motion_ipc::Ports::wait_until`: `try_wait`, else `ppoll` on
     /// the listener's descriptor until the deadline.
     pub fn wait_fd_until(&mut self, deadline_ns: u64) -> bool {
         loop {

@@ -12,7 +12,7 @@ use crate::bare::{BareSide, PING, PONG};
 use clap::{Parser, ValueEnum};
 use motion_bench::proc;
 use motion_bench::sys::{self, now_ns};
-use motion_frames::{cleanup_domain, Domain};
+use motion_ipc::{cleanup_domain, Domain};
 use std::time::Duration;
 
 /// The peer's role (`echo`, the only one).

@@ -6,7 +6,8 @@
 
 use iceoryx2::prelude::ipc;
 use iceoryx2::sample::Sample;
-use motion_frames::{FeedbackFrame, SupervisorPorts};
+use motion_frames::FeedbackFrame;
+use motion_ipc::SupervisorPorts;
 
 /// The measuring side of one exchange.
 pub trait Exchange {

@@ -29,7 +29,7 @@ use measure::Measured;
 use mode::Mode;
 use motion_bench::proc;
 use motion_bench::sys;
-use motion_frames::Domain;
+use motion_ipc::Domain;
 use run_mode::run_mode;
 use std::path::PathBuf;
 

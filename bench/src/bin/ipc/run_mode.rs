@@ -12,7 +12,7 @@ use crate::mode::Mode;
 use motion_bench::machine::{self, Supervisor};
 use motion_bench::proc::Running;
 use motion_bench::sys;
-use motion_frames::{cleanup_domain, Domain, SupervisorPorts};
+use motion_ipc::{cleanup_domain, Domain, SupervisorPorts};
 use std::process::Command;
 use std::time::Duration;
 

@@ -12,10 +12,9 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
 use iceoryx2::prelude::ipc;
-use motion_frames::cleanup::cleanup_stale_domains;
-use motion_frames::{
-    cleanup_domain, monotonic_ns, AxisCommand, CommandFrame, Domain, FeedbackFrame, Sent,
-    SupervisorPorts,
+use motion_frames::{AxisCommand, CommandFrame, FeedbackFrame};
+use motion_ipc::{
+    cleanup_domain, cleanup_stale_domains, monotonic_ns, Domain, Sent, SupervisorPorts,
 };
 use nix::sys::signal::{kill, Signal};
 use nix::unistd::Pid;
@@ -344,7 +343,7 @@ pub fn finish(sup: Option<Sup>, prefix: &str) {
             }
             None => true,
         };
-        cleanup_stale_domains(prefix, &motion_frames::domain::default_runtime_dir());
+        cleanup_stale_domains(prefix, &motion_ipc::default_runtime_dir());
         if (gone && shm_entries(prefix).is_empty()) || Instant::now() >= deadline {
             break;
         }
@@ -364,7 +363,7 @@ impl Drop for DomainGuard {
         if !std::thread::panicking() {
             return;
         }
-        let dir = motion_frames::domain::default_runtime_dir();
+        let dir = motion_ipc::default_runtime_dir();
         let deadline = Instant::now() + Duration::from_secs(2);
         while !shm_entries(&self.0).is_empty() && Instant::now() < deadline {
             cleanup_stale_domains(&self.0, &dir);

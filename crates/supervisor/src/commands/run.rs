@@ -25,8 +25,7 @@ pub fn run(a: &RunArgs) -> i32 {
         "running {source} at {} µs, service prefix {:?}, session file {}; SIGINT/SIGTERM to stop",
         session.machine.supervisor.cycle_us,
         session.domain.prefix,
-        motion_frames::domain::session_path(&session.domain.runtime_dir, &session.domain.prefix)
-            .display()
+        motion_ipc::session_path(&session.domain.runtime_dir, &session.domain.prefix).display()
     );
     for w in &session.warnings {
         log::warn!("{w}");

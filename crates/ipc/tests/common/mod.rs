@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
 
-use motion_frames::Domain;
+use motion_ipc::{cleanup_domain, Domain};
 
 static COUNTER: AtomicU32 = AtomicU32::new(0);
 
@@ -69,14 +69,14 @@ impl TestEnv {
             "iceoryx2 left files under {}: {files:?}",
             self.root.display()
         );
-        let report = motion_frames::cleanup_domain(&self.domain);
+        let report = cleanup_domain(&self.domain);
         assert!(report.domain_gone(), "{report}");
         let left = self.shm_files();
         assert!(left.is_empty(), "still in /dev/shm: {left:?}");
     }
 
     fn remove_domain(&self) {
-        let _ = motion_frames::cleanup_domain(&self.domain);
+        let _ = cleanup_domain(&self.domain);
         self.domain.withdraw();
         let _ = std::fs::remove_dir_all(&self.root);
     }

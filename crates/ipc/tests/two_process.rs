@@ -1,5 +1,5 @@
 //! Supervisor in this process, motion-io peer in a child process (this test
-//! binary re-executed with `MOTION_FRAMES_CHILD_ROLE=io`, running only
+//! binary re-executed with `MOTION_IPC_CHILD_ROLE=io`, running only
 //! `child_io_peer`). The child starts FIRST and creates the services, the
 //! supervisor attaches afterwards. After round trips the child is killed with
 //! SIGKILL mid-run: the supervisor must neither block nor crash, and cleaning
@@ -14,15 +14,13 @@ use std::time::{Duration, Instant};
 
 use common::TestEnv;
 use iceoryx2::prelude::*;
-use motion_frames::{
-    axis_to_command, axis_to_feedback, command_to_axis, feedback_to_axis, monotonic_ns, IoPorts,
-    SupervisorPorts,
-};
+use motion_frames::{axis_to_command, axis_to_feedback, command_to_axis, feedback_to_axis};
 use motion_homing::Feedback;
+use motion_ipc::{monotonic_ns, IoPorts, SupervisorPorts};
 
-const ROLE_VAR: &str = "MOTION_FRAMES_CHILD_ROLE";
-const PREFIX_VAR: &str = "MOTION_FRAMES_CHILD_PREFIX";
-const ROOT_VAR: &str = "MOTION_FRAMES_CHILD_ROOT";
+const ROLE_VAR: &str = "MOTION_IPC_CHILD_ROLE";
+const PREFIX_VAR: &str = "MOTION_IPC_CHILD_PREFIX";
+const ROOT_VAR: &str = "MOTION_IPC_CHILD_ROOT";
 const CPU: f64 = 1000.0;
 
 /// The io peer. Does nothing unless started by `supervisor_with_io_child...`.

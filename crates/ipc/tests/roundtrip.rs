@@ -11,10 +11,11 @@ use common::TestEnv;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use motion_frames::{
-    axis_to_command, axis_to_feedback, command_to_axis, feedback_to_axis, monotonic_ns,
-    CommandFrame, IoPorts, SupervisorPorts, LAYOUT_VERSION,
+    axis_to_command, axis_to_feedback, command_to_axis, feedback_to_axis, CommandFrame,
+    LAYOUT_VERSION,
 };
 use motion_homing::{Command, Edge, Feedback, LatchArm};
+use motion_ipc::{monotonic_ns, IoPorts, SupervisorPorts};
 
 // ---------------------------------------------------------------------------
 // Counting allocator: counts allocations of the current thread only, so tests
@@ -130,16 +131,24 @@ fn io_answer(cmd: &CommandFrame) -> Feedback {
     }
 }
 
+/// Both sides of I/O process "io" in `env`'s domain, each on its own node
+/// (as in two processes), connected. Bind all three: the ports drop before
+/// the nodes.
+fn connected(env: &TestEnv) -> ([Node<ipc::Service>; 2], SupervisorPorts, IoPorts) {
+    let sup_node = env.domain.create_node("motion-supervisor").unwrap();
+    let io_node = env.domain.create_node("motion-io").unwrap();
+    let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
+    let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
+    sup.update_connections().unwrap();
+    io.update_connections().unwrap();
+    ([sup_node, io_node], sup, io)
+}
+
 #[test]
 fn thousand_round_trips_in_one_process_and_nothing_left_behind() {
     let env = TestEnv::new("rt");
     {
-        let sup_node = env.domain.create_node("motion-supervisor").unwrap();
-        let io_node = env.domain.create_node("motion-io").unwrap();
-        let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
-        let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
-        sup.update_connections().unwrap();
-        io.update_connections().unwrap();
+        let (_nodes, mut sup, mut io) = connected(&env);
 
         let timeout = Duration::from_secs(2);
         let mut last_cmd_ts = 0;
@@ -210,12 +219,7 @@ fn thousand_round_trips_in_one_process_and_nothing_left_behind() {
 fn heap_allocations_per_operation() {
     let env = TestEnv::new("al");
     {
-        let sup_node = env.domain.create_node("motion-supervisor").unwrap();
-        let io_node = env.domain.create_node("motion-io").unwrap();
-        let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
-        let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
-        sup.update_connections().unwrap();
-        io.update_connections().unwrap();
+        let (_nodes, mut sup, mut io) = connected(&env);
 
         let timeout = Duration::from_secs(2);
         let mut t_publish = Tally::new("SupervisorPorts::publish (loan+init+send)");
@@ -312,7 +316,7 @@ fn heap_allocations_per_operation() {
         }
 
         println!(
-            "heap allocations per call, motion-frames API, steady state \
+            "heap allocations per call, motion-ipc API, steady state \
              ({} measured cycles after {WARMUP} warm-up):",
             t_publish.calls
         );
@@ -337,7 +341,7 @@ fn heap_allocations_per_operation() {
     env.assert_clean_and_remove();
 }
 
-/// The raw iceoryx2 calls, one by one, with the same QoS as motion-frames, to
+/// The raw iceoryx2 calls, one by one, with the same QoS as motion-ipc, to
 /// split `publish` into loan / write / send and compare with the notes' table.
 #[test]
 fn heap_allocations_per_raw_iceoryx2_call() {

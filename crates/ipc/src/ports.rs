@@ -33,13 +33,14 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
-use iceoryx2::prelude::{ipc, BackpressureStrategy, ServiceName};
+use iceoryx2::prelude::{ipc, BackpressureStrategy, PlacementDefault, ServiceName, ZeroCopySend};
 use iceoryx2::sample::Sample;
 use iceoryx2::service::builder::publish_subscribe::PublishSubscribeOpenError;
 
+use motion_frames::{CommandFrame, FeedbackFrame, Frame, LAYOUT_VERSION};
+
 use crate::domain::Domain;
 use crate::error::IpcError;
-use crate::frame::{CommandFrame, FeedbackFrame, Frame, LAYOUT_VERSION};
 use crate::monotonic_ns;
 use crate::names::IoServiceNames;
 use crate::wait::{ppoll_until, PollWake};
@@ -53,6 +54,13 @@ pub const SUBSCRIBER_MAX_BORROWED: usize = 4;
 pub const MAX_SUBSCRIBERS: usize = 2;
 /// Listeners per event service (the peer plus one observer).
 pub const MAX_LISTENERS: usize = 2;
+
+/// A frame iceoryx2 can carry: [`Frame`]'s header access plus iceoryx2's
+/// zero-copy traits, which `motion-frames` implements under its `zero-copy`
+/// feature (turned on by this crate).
+pub trait ShmFrame: Frame + ZeroCopySend + PlacementDefault {}
+
+impl<T: Frame + ZeroCopySend + PlacementDefault> ShmFrame for T {}
 
 /// Create (supervisor) or open (peer).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,7 +90,7 @@ type TopicFactory<T> =
     iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>;
 type EventFactory = iceoryx2::service::port_factory::event::PortFactory<ipc::Service>;
 
-fn topic<T: Frame>(
+fn topic<T: ShmFrame>(
     node: &Node<ipc::Service>,
     name: &Named,
     access: Access,
@@ -146,7 +154,7 @@ pub struct Sent {
 ///
 /// Single-threaded (`ipc::Service` ports are `!Send`): create and use the ports
 /// on the thread that runs the cycle.
-pub struct Ports<Tx: Frame, Rx: Frame> {
+pub struct Ports<Tx: ShmFrame, Rx: ShmFrame> {
     publisher: Publisher<ipc::Service, Tx, ()>,
     notifier: Notifier<ipc::Service>,
     subscriber: Subscriber<ipc::Service, Rx, ()>,
@@ -210,7 +218,7 @@ impl Ports<FeedbackFrame, CommandFrame> {
     }
 }
 
-impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
+impl<Tx: ShmFrame, Rx: ShmFrame> Ports<Tx, Rx> {
     /// `[tx topic, tx event, rx topic, rx event]`.
     fn with_names(
         node: &Node<ipc::Service>,
@@ -358,7 +366,7 @@ impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
     /// Drains the subscriber buffer and returns the newest frame (`None` if
     /// nothing arrived). Older frames found in the buffer are dropped and
     /// counted in [`Self::skipped`]. The newest frame's header is checked
-    /// ([`crate::FrameHeader::check`]) and must carry the session key (else
+    /// ([`motion_frames::FrameHeader::check`]) and must carry the session key (else
     /// [`IpcError::Forged`], counted in [`Self::refused`]). If a receive fails after a frame was
     /// already taken, that frame is returned and the failure shows again on the
     /// next call.
@@ -516,7 +524,7 @@ impl<Tx: Frame, Rx: Frame> Ports<Tx, Rx> {
     }
 }
 
-impl<Tx: Frame, Rx: Frame> fmt::Debug for Ports<Tx, Rx> {
+impl<Tx: ShmFrame, Rx: ShmFrame> fmt::Debug for Ports<Tx, Rx> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Ports")
             .field("publishes", &self.tx_service)

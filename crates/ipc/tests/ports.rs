@@ -9,6 +9,7 @@ use std::time::Duration;
 use common::TestEnv;
 use iceoryx2::prelude::*;
 use motion_frames::*;
+use motion_ipc::*;
 
 /// A command frame as a future motion-frames version might define it: same
 /// service name, another layout (and so another type name).
@@ -26,7 +27,7 @@ fn a_32_character_prefix_fits_the_socket_paths() {
     let prefix = format!("{:x<32}", format!("p{}", std::process::id()));
     assert_eq!(prefix.len(), 32);
     let dir = std::path::PathBuf::from(format!("/tmp/mflong{:07}", std::process::id()));
-    assert!(dir.as_os_str().len() <= domain::RUNTIME_DIR_MAX);
+    assert!(dir.as_os_str().len() <= motion_config::args::RUNTIME_DIR_MAX);
     let _ = std::fs::remove_dir_all(&dir);
     let d = Domain::establish(&prefix, Some(&dir)).unwrap();
     {

@@ -20,8 +20,7 @@ use iceoryx2::service::builder::publish_subscribe::{
 };
 use iceoryx2::service::service_name::ServiceNameError;
 
-use crate::frame::{LayoutError, LAYOUT_VERSION};
-use crate::ports::SUBSCRIBER_MAX_BORROWED;
+use motion_frames::{LayoutError, LAYOUT_VERSION};
 
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum IpcError {
@@ -166,8 +165,6 @@ pub enum IpcError {
     #[error("frame on '{service}' refused: it does not carry this session's key (a forged frame, or a peer of another supervisor)")]
     Forged { service: Arc<str> },
 }
-
-const _: usize = SUBSCRIBER_MAX_BORROWED;
 
 fn open_hint(e: &PublishSubscribeOpenError) -> &'static str {
     use PublishSubscribeOpenError as O;

@@ -4,9 +4,9 @@
 //!
 //! | service | pattern | writer → reader |
 //! |---|---|---|
-//! | `P/io/NAME/command` | publish-subscribe of [`crate::CommandFrame`] | supervisor → I/O process `NAME` |
+//! | `P/io/NAME/command` | publish-subscribe of [`motion_frames::CommandFrame`] | supervisor → I/O process `NAME` |
 //! | `P/io/NAME/command_ready` | event | supervisor → I/O process ("a command was sent") |
-//! | `P/io/NAME/feedback` | publish-subscribe of [`crate::FeedbackFrame`] | I/O process → supervisor |
+//! | `P/io/NAME/feedback` | publish-subscribe of [`motion_frames::FeedbackFrame`] | I/O process → supervisor |
 //! | `P/io/NAME/feedback_ready` | event | I/O process → supervisor |
 //! | `P/control` | request-response (`motion-control`) | motionctl, HMIs → supervisor |
 //! | `P/status` | publish-subscribe (`motion-control`), 100 Hz | supervisor → motionctl, HMIs |

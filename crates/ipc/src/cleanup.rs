@@ -121,21 +121,6 @@ pub fn cleanup_domain(domain: &Domain) -> CleanupReport {
     report
 }
 
-/// Nodes of `domain` whose process is alive (or undeterminable).
-pub(crate) fn live_nodes(domain: &Domain) -> usize {
-    let Ok(icfg) = domain.iceoryx2_config() else {
-        return 0;
-    };
-    let mut n = 0;
-    let _ = Node::<ipc::Service>::list(&icfg, |state| {
-        if !matches!(state, NodeState::Dead(_)) {
-            n += 1;
-        }
-        CallbackProgression::Continue
-    });
-    n
-}
-
 /// Removes the node-counter segment of the domain with file prefix `prefix`.
 fn remove_global_mgmt(prefix: &str) -> Result<bool, String> {
     let mut removed = false;
