@@ -89,22 +89,18 @@ pub(crate) fn parse(
         );
     }
     let engine = AxisConfig {
-        configuration: r.choice("configuration", names::CONFIGURATIONS, AC::Servo),
-        control_mode: r.choice("control_mode", names::CONTROL_MODES, CM::Position),
-        travel: r.choice("travel", names::TRAVEL_MODES, TM::Linear),
+        configuration: r.choice("configuration", AC::NAMES, AC::Servo),
+        control_mode: r.choice("control_mode", CM::NAMES, CM::Position),
+        travel: r.choice("travel", TM::NAMES, TM::Linear),
         unwind: r.f64_in("unwind", 0.0, 0.0, POSITION, "units"),
         counts_per_unit,
         marker: r.bool("marker", false),
         marker_latch: r.bool("marker_latch", true),
         registration: r.bool("registration", false),
         travel_limits: r.interval("travel_limits", POSITION),
-        home_mode: r.choice("home_mode", names::HOME_MODES, HM::Active),
-        home_direction: r.choice(
-            "home_direction",
-            names::HOME_DIRECTIONS,
-            HD::BidirectionalForward,
-        ),
-        home_sequence: r.choice("home_sequence", names::HOME_SEQUENCES, HS::Immediate),
+        home_mode: r.choice("home_mode", HM::NAMES, HM::Active),
+        home_direction: r.choice("home_direction", HD::NAMES, HD::BidirectionalForward),
+        home_sequence: r.choice("home_sequence", HS::NAMES, HS::Immediate),
         home_switch_normally_closed: r.bool("home_switch_normally_closed", false),
         home_position: r.f64_in("home_position", 0.0, -POSITION, POSITION, "units"),
         home_offset: r.f64_in("home_offset", 0.0, -POSITION, POSITION, "units"),

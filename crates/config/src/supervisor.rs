@@ -17,20 +17,7 @@ pub(crate) fn parse(
         r.problem("cpu", e);
     }
     let priority = r.u32_in("priority", 80, 1, 99) as i32;
-    let io = match r.string("io", "sim").as_str() {
-        "sim" => IoMode::Sim,
-        "external" => IoMode::External,
-        other => {
-            r.problem(
-                "io",
-                format!(
-                    "{} is not one of \"sim\", \"external\"",
-                    names::shown(other)
-                ),
-            );
-            IoMode::Sim
-        }
-    };
+    let io = r.choice("io", IoMode::NAMES, IoMode::Sim);
     let service_prefix = r.string("service_prefix", "motion");
     if let Err(e) = names::check_service_prefix(&service_prefix) {
         r.problem("service_prefix", e);

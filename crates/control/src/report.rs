@@ -3,41 +3,8 @@
 //! clients, with one function each.
 
 use crate::message::*;
+use motion_homing::{HomeDirection, HomeMode, HomeSequence};
 use motion_report::{AxisResult, AxisStatus, GapCounts, IoStatus, StatusReport};
-
-/// Home Mode by CIP number (interface.md spellings).
-pub fn mode_name(n: u8) -> &'static str {
-    match n {
-        0 => "passive",
-        1 => "active",
-        2 => "absolute",
-        _ => "?",
-    }
-}
-
-/// Home Sequence by CIP number.
-pub fn sequence_name(n: u8) -> &'static str {
-    match n {
-        0 => "immediate",
-        1 => "switch",
-        2 => "marker",
-        3 => "switch_then_marker",
-        4 => "torque",
-        5 => "torque_then_marker",
-        _ => "?",
-    }
-}
-
-/// Home Direction by CIP number.
-pub fn direction_name(n: u8) -> &'static str {
-    match n {
-        0 => "unidirectional_forward",
-        1 => "bidirectional_forward",
-        2 => "unidirectional_reverse",
-        3 => "bidirectional_reverse",
-        _ => "?",
-    }
-}
 
 fn finite(x: f64) -> Option<f64> {
     x.is_finite().then_some(x)
@@ -139,9 +106,15 @@ impl AxisStatusEntry {
         let done = !self.has(ST_IP) && (self.has(ST_DN) || self.has(ST_ER));
         AxisResult {
             name: get_str(&self.name),
-            mode: mode_name(self.home_mode).into(),
-            sequence: sequence_name(self.home_sequence).into(),
-            direction: direction_name(self.home_direction).into(),
+            mode: HomeMode::from_number(self.home_mode)
+                .map_or("?", HomeMode::name)
+                .into(),
+            sequence: HomeSequence::from_number(self.home_sequence)
+                .map_or("?", HomeSequence::name)
+                .into(),
+            direction: HomeDirection::from_number(self.home_direction)
+                .map_or("?", HomeDirection::name)
+                .into(),
             io: ios.get(self.io as usize).cloned().unwrap_or_default(),
             pc: self.has(ST_PC),
             er: self.has(ST_ER),

@@ -10,6 +10,7 @@
 //! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`.
 //! * [`codes`] — ERR/EXERR in plain words.
 //! * [`table`] — the fixed-width text tables of the same reports.
+//! * [`trace`] — the trace CSV, written by the daemon and read by `motionctl`.
 //! * [`panic`] — a panic with `--json`: one error object, like every failure.
 
 pub mod codes;
@@ -20,6 +21,7 @@ pub mod latency;
 pub mod panic;
 pub mod status;
 pub mod table;
+pub mod trace;
 
 pub use errors::{ErrorEntry, ErrorReport};
 pub use home::{
@@ -29,6 +31,7 @@ pub use home::{
 pub use io::{GapCounts, IoReport};
 pub use latency::{LateWakeup, Latency, Percentiles};
 pub use status::{AxisStatus, IoStatus, StatusReport};
+pub use trace::TraceRow;
 
 /// Rounds to `digits` decimals for printing (JSON keeps what a reader can use,
 /// not float noise).

@@ -84,7 +84,7 @@ pub fn trace(client: &mut Client, a: &TraceArgs) -> i32 {
             EXIT_FAILED,
         );
     }
-    let rows = plot::parse_csv(&String::from_utf8_lossy(&csv));
+    let rows = motion_report::trace::parse_csv(&String::from_utf8_lossy(&csv));
     if let Some(p) = &a.plot {
         if let Err(e) = plot::draw(&rows, &a.axis, p) {
             return fail(a.json, vec![ErrorEntry::message(e)], EXIT_FAILED);
@@ -93,7 +93,7 @@ pub fn trace(client: &mut Client, a: &TraceArgs) -> i32 {
     let report = TraceReport {
         axis: a.axis.clone(),
         cycles: rows.len(),
-        duration_s: rows.last().map_or(0.0, |r| r.t),
+        duration_s: rows.last().map_or(0.0, |r| r.t_s),
         event_raw: rows.iter().find_map(|r| r.event_raw),
         csv: a.out.display().to_string(),
         plot: a.plot.as_ref().map(|p| p.display().to_string()),
