@@ -1,10 +1,43 @@
-//! Status frames in the reports' words: `status --json` and the rows of
-//! `home --json` are made from the status frame, by both the daemon and its
-//! clients, with one function each.
+//! Status frames and answers in the reports' words: `status --json` and the
+//! rows of `home --json` are made from the status frame, and a refused
+//! request's errors from its answer, by both the daemon and its clients,
+//! with one function each.
 
 use crate::message::*;
 use motion_homing::{HomeDirection, HomeMode, HomeSequence};
-use motion_report::{AxisResult, AxisStatus, GapCounts, IoStatus, StatusReport};
+use motion_report::{AxisResult, AxisStatus, ErrorEntry, GapCounts, IoStatus, StatusReport};
+
+impl AxisAnswer {
+    /// A refused axis as an error entry: its name, the Home instruction's
+    /// codes where it has them, the reason in words.
+    pub fn error_entry(&self) -> ErrorEntry {
+        ErrorEntry {
+            axis: Some(get_str(&self.name)),
+            key: None,
+            err: (self.err != 0).then_some(self.err),
+            exerr: (self.err != 0).then_some(self.exerr),
+            message: reason_text(self.reason).into(),
+        }
+    }
+}
+
+impl ControlResponse {
+    /// A refused request as errors: `"{what} refused: {message}"`, then the
+    /// error entry of every axis answer `which` selects.
+    pub fn refusal(&self, what: &str, which: impl Fn(&AxisAnswer) -> bool) -> Vec<ErrorEntry> {
+        let mut errors = vec![ErrorEntry::message(format!(
+            "{what} refused: {}",
+            self.message_text()
+        ))];
+        errors.extend(
+            self.answers()
+                .iter()
+                .filter(|x| which(x))
+                .map(AxisAnswer::error_entry),
+        );
+        errors
+    }
+}
 
 fn finite(x: f64) -> Option<f64> {
     x.is_finite().then_some(x)

@@ -7,7 +7,8 @@
 //! * [`home`] — `home --json`: one row per axis (interface.md).
 //! * [`status`] — `status --json`: the live state of every axis and I/O process.
 //! * [`io`] — per I/O process: attached, frames, gaps by length.
-//! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`.
+//! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`
+//!   (also for a refused command line).
 //! * [`codes`] — ERR/EXERR in plain words.
 //! * [`table`] — the fixed-width text tables of the same reports.
 //! * [`trace`] — the trace CSV, written by the daemon and read by `motionctl`.

@@ -15,27 +15,13 @@ pub fn trace(client: &mut Client, a: &TraceArgs) -> i32 {
         Err(e) => return client_error(a.json, &e),
     };
     if resp.result != RESULT_ACCEPTED {
-        return fail(
-            a.json,
-            vec![ErrorEntry::message(format!(
-                "trace refused: {}",
-                resp.message_text()
-            ))],
-            EXIT_FAILED,
-        );
+        return fail(a.json, resp.refusal("trace", |_| false), EXIT_FAILED);
     }
     if a.home {
         match client.simple(REQ_HOME, 0, &axes, t) {
             Err(e) => return client_error(a.json, &e),
             Ok(r) if r.result != RESULT_ACCEPTED => {
-                return fail(
-                    a.json,
-                    vec![ErrorEntry::message(format!(
-                        "home refused: {}",
-                        r.message_text()
-                    ))],
-                    EXIT_FAILED,
-                )
+                return fail(a.json, r.refusal("home", |_| false), EXIT_FAILED)
             }
             Ok(_) => {}
         }
