@@ -129,6 +129,17 @@ pub(crate) fn current_affinity() -> Vec<usize> {
     }
 }
 
+/// The page size (`sysconf(_SC_PAGESIZE)`, 4096 if it cannot be read).
+pub(crate) fn page_size() -> usize {
+    // SAFETY: plain query.
+    let p = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+    if p > 0 {
+        p as usize
+    } else {
+        4096
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

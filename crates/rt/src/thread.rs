@@ -31,8 +31,8 @@ use nix::sys::resource::{getrlimit, Resource};
 use nix::unistd::Pid;
 
 use crate::procfs::{
-    current_affinity, fmt_cpulist, fmt_rlimit, has_capability, online_cpus, read_status_kib,
-    CAP_IPC_LOCK, CAP_SYS_NICE,
+    current_affinity, fmt_cpulist, fmt_rlimit, has_capability, online_cpus, page_size,
+    read_status_kib, CAP_IPC_LOCK, CAP_SYS_NICE,
 };
 
 /// What [`enter_realtime`] should apply to the calling thread.
@@ -366,16 +366,6 @@ pub fn current_sched() -> (SchedPolicy, i32) {
         (SchedPolicy::from_raw(policy), param.sched_priority)
     } else {
         (SchedPolicy::Unknown(-1), 0)
-    }
-}
-
-fn page_size() -> usize {
-    // SAFETY: plain query.
-    let p = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
-    if p > 0 {
-        p as usize
-    } else {
-        4096
     }
 }
 
