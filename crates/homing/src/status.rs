@@ -70,16 +70,17 @@ pub struct Status {
     pub en: bool,
     /// DN: the instruction finished (completed, or aborted / errored).
     pub dn: bool,
-    /// ER: the instruction detected an error; see `err` / `exerr`.
+    /// ER: the instruction detected an error, the codes below say which.
     pub er: bool,
+    /// ERR / EXERR of that error ([`codes`](crate::codes)).
+    pub err: u16,
+    pub exerr: u16,
     /// IP: homing in process.
     pub ip: bool,
     /// PC: process complete — homed *and* at Home Position where the
     /// sequence moves there. A unidirectional sequence that could not reach
     /// Home Position without reversing clears IP without PC.
     pub pc: bool,
-    pub err: u16,
-    pub exerr: u16,
     /// Axis HomingStatus.
     pub homing: bool,
     /// Axis HomedStatus: the machine reference is established.
