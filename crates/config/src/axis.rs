@@ -15,8 +15,37 @@ pub(crate) fn parse(
     ios: &[IoConfig],
     problems: &mut Vec<Problem>,
 ) -> Option<AxisEntry> {
+    let name = axis_name(index, t, problems);
+    let before = problems.len();
+    let mut r = Reader::new(t, Some(&name), "", problems);
+    r.mark_used("name");
+    let io = io_of(&mut r, ios);
+    let home_order = r
+        .has("home_order")
+        .then(|| r.u32_in("home_order", 0, 0, 1000));
+    let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
+    let engine = engine(&mut r, sup);
+    let ethercat = parse_ethercat(&mut r, &engine, ios.get(io));
+    let sim_table = r.table("sim");
+    r.finish();
+    let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
+    engine_problems(&name, &engine, problems, before);
+    (problems.len() == before).then_some(AxisEntry {
+        name,
+        io,
+        home_order,
+        drift_limit,
+        engine,
+        sim,
+        ethercat,
+    })
+}
+
+/// The axis's name; a missing or bad one is a problem, and the axis is
+/// called `#n` (its place in the file) in the problems that follow.
+fn axis_name(index: usize, t: &toml::Table, problems: &mut Vec<Problem>) -> String {
     let fallback = format!("#{}", index + 1);
-    let name = match t.get("name").and_then(|v| v.as_str()) {
+    match t.get("name").and_then(|v| v.as_str()) {
         Some(n) => match names::check_name(n) {
             Ok(()) => n.to_string(),
             Err(e) => {
@@ -28,46 +57,42 @@ pub(crate) fn parse(
             problems.push(Problem::new(Some(&fallback), "name", "missing"));
             fallback
         }
-    };
-    let before = problems.len();
-    let mut r = Reader::new(t, Some(&name), "", problems);
-    r.mark_used("name");
-    let io = if r.has("io") {
-        let io_name = r.string("io", "");
-        match ios.iter().position(|i| i.name == io_name) {
-            Some(k) => k,
-            None => {
-                let known: Vec<&str> = ios.iter().map(|i| i.name.as_str()).collect();
-                r.problem(
-                    "io",
-                    format!(
-                        "no I/O process {} (configured: {})",
-                        names::shown(&io_name),
-                        known.join(", ")
-                    ),
-                );
-                0
-            }
-        }
-    } else {
+    }
+}
+
+/// The index of the axis's I/O process (`io`, which may be left out when
+/// there is only one).
+fn io_of(r: &mut Reader<'_>, ios: &[IoConfig]) -> usize {
+    if !r.has("io") {
         if ios.len() > 1 {
             r.problem(
                 "io",
                 "missing: with several [[io]] sections every axis names its I/O process".into(),
             );
         }
-        0
-    };
-    let home_order = r
-        .has("home_order")
-        .then(|| r.u32_in("home_order", 0, 0, 1000));
-    let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
-    let d = AxisConfig::default();
-    use motion_homing::{
-        AxisConfiguration as AC, ControlMode as CM, HomeDirection as HD, HomeMode as HM,
-        HomeSequence as HS, TravelMode as TM,
-    };
-    let cycle_ms = f64::from(sup.cycle_us) / 1000.0;
+        return 0;
+    }
+    let io_name = r.string("io", "");
+    match ios.iter().position(|i| i.name == io_name) {
+        Some(k) => k,
+        None => {
+            let known: Vec<&str> = ios.iter().map(|i| i.name.as_str()).collect();
+            r.problem(
+                "io",
+                format!(
+                    "no I/O process {} (configured: {})",
+                    names::shown(&io_name),
+                    known.join(", ")
+                ),
+            );
+            0
+        }
+    }
+}
+
+/// `counts_per_unit` and `max_position`: positions travel as exact integer
+/// counts, so the largest one must be one.
+fn scaling(r: &mut Reader<'_>) -> (f64, f64) {
     let counts_per_unit = r.f64_in(
         "counts_per_unit",
         1.0,
@@ -75,7 +100,8 @@ pub(crate) fn parse(
         COUNTS_PER_UNIT.1,
         "counts/unit",
     );
-    let max_position = r.f64_in("max_position", d.max_position, 1e-3, POSITION, "units");
+    let default = AxisConfig::default().max_position;
+    let max_position = r.f64_in("max_position", default, 1e-3, POSITION, "units");
     if max_position * counts_per_unit > MAX_COUNTS {
         r.problem(
             "max_position",
@@ -88,23 +114,31 @@ pub(crate) fn parse(
             ),
         );
     }
-    let engine = AxisConfig {
-        configuration: r.choice("configuration", names::CONFIGURATIONS, AC::Servo),
-        control_mode: r.choice("control_mode", names::CONTROL_MODES, CM::Position),
-        travel: r.choice("travel", names::TRAVEL_MODES, TM::Linear),
+    (counts_per_unit, max_position)
+}
+
+/// The engine's configuration of the axis: its keys, each in its physical
+/// range, and the feedback-loss rule and cycle of `[supervisor]`.
+fn engine(r: &mut Reader<'_>, sup: &SupervisorConfig) -> AxisConfig {
+    use motion_homing::{
+        AxisConfiguration as AC, ControlMode as CM, HomeDirection as HD, HomeMode as HM,
+        HomeSequence as HS, TravelMode as TM,
+    };
+    let d = AxisConfig::default();
+    let (counts_per_unit, max_position) = scaling(r);
+    let mut engine = AxisConfig {
+        configuration: r.choice("configuration", AC::NAMES, AC::Servo),
+        control_mode: r.choice("control_mode", CM::NAMES, CM::Position),
+        travel: r.choice("travel", TM::NAMES, TM::Linear),
         unwind: r.f64_in("unwind", 0.0, 0.0, POSITION, "units"),
         counts_per_unit,
         marker: r.bool("marker", false),
         marker_latch: r.bool("marker_latch", true),
         registration: r.bool("registration", false),
         travel_limits: r.interval("travel_limits", POSITION),
-        home_mode: r.choice("home_mode", names::HOME_MODES, HM::Active),
-        home_direction: r.choice(
-            "home_direction",
-            names::HOME_DIRECTIONS,
-            HD::BidirectionalForward,
-        ),
-        home_sequence: r.choice("home_sequence", names::HOME_SEQUENCES, HS::Immediate),
+        home_mode: r.choice("home_mode", HM::NAMES, HM::Active),
+        home_direction: r.choice("home_direction", HD::NAMES, HD::BidirectionalForward),
+        home_sequence: r.choice("home_sequence", HS::NAMES, HS::Immediate),
         home_switch_normally_closed: r.bool("home_switch_normally_closed", false),
         home_position: r.f64_in("home_position", 0.0, -POSITION, POSITION, "units"),
         home_offset: r.f64_in("home_offset", 0.0, -POSITION, POSITION, "units"),
@@ -131,10 +165,10 @@ pub(crate) fn parse(
         marker_min_distance: 0.0,
         refuse_ambiguous_marker: r.bool("refuse_ambiguous_marker", false),
     };
-    let mut engine = engine;
     // A switch edge sampled once per cycle is known to a cycle of travel at
     // return speed; a marker closer than two such cycles to it is ambiguous.
     // The default check uses exactly that distance.
+    let cycle_ms = f64::from(sup.cycle_us) / 1000.0;
     engine.marker_min_distance = r.f64_in(
         "marker_min_distance",
         2.0 * engine.home_return_speed * cycle_ms / 1000.0,
@@ -142,14 +176,15 @@ pub(crate) fn parse(
         POSITION,
         "units",
     );
-    let ethercat = parse_ethercat(&mut r, &engine, ios.get(io));
-    let sim_table = r.table("sim");
-    r.finish();
-    let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
-    // Numbers the range checks above already reported are not reported again
-    // by the engine's own (coarser) finiteness rule.
-    for e in validate(&engine) {
-        let p = Problem::from_engine(&name, &e);
+    engine
+}
+
+/// The engine's own rules (with their CIP codes) on top of the problems of
+/// this axis found since `before`. Numbers the range checks already
+/// reported are not reported again by the engine's (coarser) finiteness rule.
+fn engine_problems(name: &str, engine: &AxisConfig, problems: &mut Vec<Problem>, before: usize) {
+    for e in validate(engine) {
+        let p = Problem::from_engine(name, &e);
         if !problems[before..]
             .iter()
             .any(|q| q.axis == p.axis && q.key == p.key)
@@ -157,15 +192,6 @@ pub(crate) fn parse(
             problems.push(p);
         }
     }
-    (problems.len() == before).then_some(AxisEntry {
-        name,
-        io,
-        home_order,
-        drift_limit,
-        engine,
-        sim,
-        ethercat,
-    })
 }
 
 /// The axis' EtherCAT keys: allowed on (and, but for a virtual axis,

@@ -22,8 +22,6 @@ pub(crate) const ETHERCAT_KEYS: &[&str] = &[
     "dc_static_sync_iterations",
 ];
 
-const BACKENDS: &[(&str, IoBackend)] =
-    &[("sim", IoBackend::Sim), ("ethercat", IoBackend::Ethercat)];
 const DC_MODES: &[(&str, EthercatDc)] = &[
     ("auto", EthercatDc::Auto),
     ("on", EthercatDc::On),
@@ -170,7 +168,7 @@ pub(crate) fn parse(
                 IoMode::Sim
             }
         };
-        let backend = r.choice("backend", BACKENDS, IoBackend::Sim);
+        let backend = r.choice("backend", IoBackend::NAMES, IoBackend::Sim);
         let who = if names::check_io_name(&name).is_ok() {
             format!("I/O process {name}")
         } else {

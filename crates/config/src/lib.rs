@@ -56,6 +56,12 @@ pub enum IoMode {
     External,
 }
 
+// `[supervisor] io`; `[[io]] spawn` also reads "supervisor" for `Sim`.
+motion_homing::spellings!(IoMode {
+    Sim => "sim",
+    External => "external",
+});
+
 /// The drive backend of an I/O process (`[[io]] backend`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum IoBackend {
@@ -66,15 +72,11 @@ pub enum IoBackend {
     Ethercat,
 }
 
-impl IoBackend {
-    /// The config and command-line spelling (`motion-io --backend NAME`).
-    pub fn name(self) -> &'static str {
-        match self {
-            IoBackend::Sim => "sim",
-            IoBackend::Ethercat => "ethercat",
-        }
-    }
-}
+// The config and command-line spelling (`motion-io --backend NAME`).
+motion_homing::spellings!(IoBackend {
+    Sim => "sim",
+    Ethercat => "ethercat",
+});
 
 /// Distributed clocks of an EtherCAT I/O process (`[[io]] dc`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -1,6 +1,7 @@
 //! A configuration problem, printed as `axis X: home_speed: …`.
 
 use motion_homing::ConfigError;
+use motion_report::ErrorEntry;
 use std::fmt;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -46,6 +47,20 @@ impl Problem {
             None => "file".to_string(),
         };
         Self::new(None, &key, format!("TOML syntax: {msg}"))
+    }
+}
+
+/// A problem as a JSON error entry (interface.md, "Errors as JSON"): how
+/// every binary reports a configuration it refuses.
+impl From<&Problem> for ErrorEntry {
+    fn from(p: &Problem) -> Self {
+        ErrorEntry {
+            axis: p.axis.clone(),
+            key: Some(p.key.clone()),
+            err: p.code.map(|c| c.0),
+            exerr: p.code.map(|c| c.1),
+            message: p.message.clone(),
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 use crate::keys::Reader;
 use crate::limits::*;
 use crate::{check_cpu, names, IoMode, Problem, SupervisorConfig};
+use std::path::PathBuf;
 
 pub(crate) fn parse(
     t: Option<&toml::Table>,
@@ -17,27 +18,48 @@ pub(crate) fn parse(
         r.problem("cpu", e);
     }
     let priority = r.u32_in("priority", 80, 1, 99) as i32;
-    let io = match r.string("io", "sim").as_str() {
-        "sim" => IoMode::Sim,
-        "external" => IoMode::External,
-        other => {
-            r.problem(
-                "io",
-                format!(
-                    "{} is not one of \"sim\", \"external\"",
-                    names::shown(other)
-                ),
-            );
-            IoMode::Sim
-        }
-    };
+    let io = r.choice("io", IoMode::NAMES, IoMode::Sim);
     let service_prefix = r.string("service_prefix", "motion");
     if let Err(e) = names::check_service_prefix(&service_prefix) {
         r.problem("service_prefix", e);
     }
     let cycle_ms = f64::from(cycle_us) / 1000.0;
-    // The loss rule in time. `stale_cycles` (cycles in a row) is still read,
-    // converted to the same time at this cycle.
+    let feedback_timeout_ms = feedback_timeout_ms(&mut r, cycle_ms, warnings);
+    let feedback_loss_drain = r.f64_in("feedback_loss_drain", 0.25, 0.0, 1.0, "");
+    let max_watchdog = ((WATCHDOG_MS / cycle_ms) as u32).max(1);
+    let io_watchdog_cycles = r.u32_in("io_watchdog_cycles", 50.min(max_watchdog), 1, max_watchdog);
+    let lock_memory = r.bool("lock_memory", true);
+    let cpu_dma_latency_us = r.i32("cpu_dma_latency_us", 0);
+    if cpu_dma_latency_us > 10_000 {
+        r.problem(
+            "cpu_dma_latency_us",
+            format!("{cpu_dma_latency_us} µs is above 10000 (negative: leave idle states alone)"),
+        );
+    }
+    let (io_priority, io_cpu) = io_scheduling(&mut r, priority);
+    let (runtime_dir, state_dir) = directories(&mut r);
+    r.finish();
+    SupervisorConfig {
+        cycle_us,
+        cpu: cpu as usize,
+        priority,
+        io,
+        service_prefix,
+        feedback_timeout_ms,
+        feedback_loss_drain,
+        io_watchdog_cycles,
+        lock_memory,
+        io_priority,
+        io_cpu,
+        cpu_dma_latency_us,
+        runtime_dir,
+        state_dir,
+    }
+}
+
+/// The feedback-loss rule in time. The older `stale_cycles` (cycles in a
+/// row) is still read, converted to the same time at this cycle.
+fn feedback_timeout_ms(r: &mut Reader<'_>, cycle_ms: f64, warnings: &mut Vec<String>) -> f64 {
     let mut feedback_timeout_ms = r.f64_in(
         "feedback_timeout_ms",
         10.0,
@@ -70,17 +92,12 @@ pub(crate) fn parse(
             feedback_timeout_ms = ms;
         }
     }
-    let feedback_loss_drain = r.f64_in("feedback_loss_drain", 0.25, 0.0, 1.0, "");
-    let max_watchdog = ((WATCHDOG_MS / cycle_ms) as u32).max(1);
-    let io_watchdog_cycles = r.u32_in("io_watchdog_cycles", 50.min(max_watchdog), 1, max_watchdog);
-    let lock_memory = r.bool("lock_memory", true);
-    let cpu_dma_latency_us = r.i32("cpu_dma_latency_us", 0);
-    if cpu_dma_latency_us > 10_000 {
-        r.problem(
-            "cpu_dma_latency_us",
-            format!("{cpu_dma_latency_us} µs is above 10000 (negative: leave idle states alone)"),
-        );
-    }
+    feedback_timeout_ms
+}
+
+/// `io_priority` (default 10 below the cycle) and `io_cpu` (-1: the
+/// cycle's CPU) of the spawned I/O processes.
+fn io_scheduling(r: &mut Reader<'_>, priority: i32) -> (i32, Option<usize>) {
     let io_priority = r.i32("io_priority", (priority - 10).max(1));
     if !(0..=99).contains(&io_priority) {
         r.problem(
@@ -104,12 +121,17 @@ pub(crate) fn parse(
             None
         }
     };
+    (io_priority, io_cpu)
+}
+
+/// `runtime_dir` (if given) and `state_dir` (else the default).
+fn directories(r: &mut Reader<'_>) -> (Option<PathBuf>, PathBuf) {
     let runtime_dir = r.has("runtime_dir").then(|| {
         let d = r.string("runtime_dir", "");
         if let Err(e) = crate::args::runtime_dir(&d) {
             r.problem("runtime_dir", e);
         }
-        std::path::PathBuf::from(d)
+        PathBuf::from(d)
     });
     let state_dir = if r.has("state_dir") {
         let d = r.string("state_dir", "");
@@ -122,27 +144,11 @@ pub(crate) fn parse(
                 ),
             );
         }
-        std::path::PathBuf::from(d)
+        PathBuf::from(d)
     } else {
         default_state_dir()
     };
-    r.finish();
-    SupervisorConfig {
-        cycle_us,
-        cpu: cpu as usize,
-        priority,
-        io,
-        service_prefix,
-        feedback_timeout_ms,
-        feedback_loss_drain,
-        io_watchdog_cycles,
-        lock_memory,
-        io_priority,
-        io_cpu,
-        cpu_dma_latency_us,
-        runtime_dir,
-        state_dir,
-    }
+    (runtime_dir, state_dir)
 }
 
 /// systemd's `$STATE_DIRECTORY` (the unit's `StateDirectory=motion`), else

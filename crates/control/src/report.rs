@@ -1,41 +1,41 @@
-//! Status frames in the reports' words: `status --json` and the rows of
-//! `home --json` are made from the status frame, by both the daemon and its
-//! clients, with one function each.
+//! Status frames and answers in the reports' words: `status --json` and the
+//! rows of `home --json` are made from the status frame, and a refused
+//! request's errors from its answer, by both the daemon and its clients,
+//! with one function each.
 
 use crate::message::*;
-use motion_report::{AxisResult, AxisStatus, GapCounts, IoStatus, StatusReport};
+use motion_homing::{HomeDirection, HomeMode, HomeSequence};
+use motion_report::{AxisResult, AxisStatus, ErrorEntry, GapCounts, IoStatus, StatusReport};
 
-/// Home Mode by CIP number (interface.md spellings).
-pub fn mode_name(n: u8) -> &'static str {
-    match n {
-        0 => "passive",
-        1 => "active",
-        2 => "absolute",
-        _ => "?",
+impl AxisAnswer {
+    /// A refused axis as an error entry: its name, the Home instruction's
+    /// codes where it has them, the reason in words.
+    pub fn error_entry(&self) -> ErrorEntry {
+        ErrorEntry {
+            axis: Some(get_str(&self.name)),
+            key: None,
+            err: (self.err != 0).then_some(self.err),
+            exerr: (self.err != 0).then_some(self.exerr),
+            message: reason_text(self.reason).into(),
+        }
     }
 }
 
-/// Home Sequence by CIP number.
-pub fn sequence_name(n: u8) -> &'static str {
-    match n {
-        0 => "immediate",
-        1 => "switch",
-        2 => "marker",
-        3 => "switch_then_marker",
-        4 => "torque",
-        5 => "torque_then_marker",
-        _ => "?",
-    }
-}
-
-/// Home Direction by CIP number.
-pub fn direction_name(n: u8) -> &'static str {
-    match n {
-        0 => "unidirectional_forward",
-        1 => "bidirectional_forward",
-        2 => "unidirectional_reverse",
-        3 => "bidirectional_reverse",
-        _ => "?",
+impl ControlResponse {
+    /// A refused request as errors: `"{what} refused: {message}"`, then the
+    /// error entry of every axis answer `which` selects.
+    pub fn refusal(&self, what: &str, which: impl Fn(&AxisAnswer) -> bool) -> Vec<ErrorEntry> {
+        let mut errors = vec![ErrorEntry::message(format!(
+            "{what} refused: {}",
+            self.message_text()
+        ))];
+        errors.extend(
+            self.answers()
+                .iter()
+                .filter(|x| which(x))
+                .map(AxisAnswer::error_entry),
+        );
+        errors
     }
 }
 
@@ -139,9 +139,15 @@ impl AxisStatusEntry {
         let done = !self.has(ST_IP) && (self.has(ST_DN) || self.has(ST_ER));
         AxisResult {
             name: get_str(&self.name),
-            mode: mode_name(self.home_mode).into(),
-            sequence: sequence_name(self.home_sequence).into(),
-            direction: direction_name(self.home_direction).into(),
+            mode: HomeMode::from_number(self.home_mode)
+                .map_or("?", HomeMode::name)
+                .into(),
+            sequence: HomeSequence::from_number(self.home_sequence)
+                .map_or("?", HomeSequence::name)
+                .into(),
+            direction: HomeDirection::from_number(self.home_direction)
+                .map_or("?", HomeDirection::name)
+                .into(),
             io: ios.get(self.io as usize).cloned().unwrap_or_default(),
             pc: self.has(ST_PC),
             er: self.has(ST_ER),

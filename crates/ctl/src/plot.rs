@@ -2,44 +2,13 @@
 //! documents draw homing sequences — each leg a line, the home event and the
 //! switch and marker edges marked — drawn with `plotters` into an SVG.
 
+use motion_report::TraceRow;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// One row of the trace CSV (`motion-supervisor`'s `trace_csv` columns).
-#[derive(Clone, Debug, Default)]
-pub struct Row {
-    pub t: f64,
-    pub phase: String,
-    pub cmd_position: Option<f64>,
-    pub cmd_velocity: Option<f64>,
-    pub position: Option<f64>,
-    pub velocity: Option<f64>,
-    pub switch: bool,
-    pub marker: bool,
-    pub event_raw: Option<f64>,
-}
-
-/// Parses the CSV (header first); malformed lines are skipped.
-pub fn parse_csv(text: &str) -> Vec<Row> {
-    let num = |s: &str| s.parse::<f64>().ok().filter(|x| x.is_finite());
-    text.lines()
-        .skip(1)
-        .filter_map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (f.len() >= 14).then(|| Row {
-                t: num(f[0]).unwrap_or(0.0),
-                phase: f[1].to_string(),
-                cmd_position: num(f[2]),
-                cmd_velocity: num(f[3]),
-                position: num(f[4]),
-                velocity: num(f[5]),
-                switch: f[7] == "1",
-                marker: f[8] == "1",
-                event_raw: if f[10] == "1" { num(f[11]) } else { None },
-            })
-        })
-        .collect()
-}
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+type Drawn = Result<(), DrawingAreaErrorKind<std::io::Error>>;
 
 const PHASE_COLOURS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
@@ -51,38 +20,72 @@ const PHASE_COLOURS: [RGBColor; 8] = [
     RGBColor(227, 119, 194),
     RGBColor(23, 190, 207),
 ];
+const COMMAND_GREY: RGBColor = RGBColor(170, 170, 170);
+
+/// What the plot spans: the positions and velocities of the feedback, and
+/// the margins around them.
+struct Area {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    padx: f64,
+    pady: f64,
+}
+
+impl Area {
+    /// `None` when no row has feedback.
+    fn of(rows: &[TraceRow]) -> Option<Self> {
+        let pts = rows.iter().filter_map(|r| Some((r.position?, r.velocity?)));
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, 0.0f64, 0.0f64);
+        let mut any = false;
+        for (x, y) in pts {
+            any = true;
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        if !any {
+            return None;
+        }
+        // The velocity axis spans what the sequence commanded (with a margin):
+        // a cycle in which the I/O process skipped commands shows as a spike of
+        // the actual velocity, drawn clipped at the edge rather than squashing
+        // the legs the plot is about.
+        let (c0, c1) = rows
+            .iter()
+            .filter_map(|r| r.cmd_velocity)
+            .fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        if c1 > c0 {
+            let m = 0.3 * (c1 - c0);
+            y0 = y0.max(c0 - m);
+            y1 = y1.min(c1 + m);
+        }
+        let padx = ((x1 - x0) * 0.05).max(1e-3);
+        let pady = ((y1 - y0) * 0.1).max(1e-3);
+        Some(Self {
+            x0,
+            x1,
+            y0,
+            y1,
+            padx,
+            pady,
+        })
+    }
+
+    /// The lowest and highest velocity drawn.
+    fn bottom(&self) -> f64 {
+        self.y0 - self.pady
+    }
+    fn top(&self) -> f64 {
+        self.y1 + self.pady
+    }
+}
 
 /// Draws `rows` of axis `axis` into `path` (SVG).
-pub fn draw(rows: &[Row], axis: &str, path: &Path) -> Result<(), String> {
-    let pts: Vec<(f64, f64)> = rows
-        .iter()
-        .filter_map(|r| Some((r.position?, r.velocity?)))
-        .collect();
-    if pts.is_empty() {
-        return Err("the trace has no feedback to plot".into());
-    }
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, 0.0f64, 0.0f64);
-    for &(x, y) in &pts {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    // The velocity axis spans what the sequence commanded (with a margin):
-    // a cycle in which the I/O process skipped commands shows as a spike of
-    // the actual velocity, drawn clipped at the edge rather than squashing
-    // the legs the plot is about.
-    let (c0, c1) = rows
-        .iter()
-        .filter_map(|r| r.cmd_velocity)
-        .fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
-    if c1 > c0 {
-        let m = 0.3 * (c1 - c0);
-        y0 = y0.max(c0 - m);
-        y1 = y1.min(c1 + m);
-    }
-    let padx = ((x1 - x0) * 0.05).max(1e-3);
-    let pady = ((y1 - y0) * 0.1).max(1e-3);
+pub fn draw(rows: &[TraceRow], axis: &str, path: &Path) -> Result<(), String> {
+    let area = Area::of(rows).ok_or("the trace has no feedback to plot")?;
     let e = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
     let root = SVGBackend::new(path, (1000, 500)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(&x))?;
@@ -94,7 +97,10 @@ pub fn draw(rows: &[Row], axis: &str, path: &Path) -> Result<(), String> {
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d((x0 - padx)..(x1 + padx), (y0 - pady)..(y1 + pady))
+        .build_cartesian_2d(
+            (area.x0 - area.padx)..(area.x1 + area.padx),
+            area.bottom()..area.top(),
+        )
         .map_err(|x| e(&x))?;
     chart
         .configure_mesh()
@@ -102,84 +108,10 @@ pub fn draw(rows: &[Row], axis: &str, path: &Path) -> Result<(), String> {
         .y_desc("velocity (units/s)")
         .draw()
         .map_err(|x| e(&x))?;
-
-    // The commanded profile, thin and grey, under the actual motion.
-    let cmd: Vec<(f64, f64)> = rows
-        .iter()
-        .filter_map(|r| Some((r.cmd_position?, r.cmd_velocity?)))
-        .collect();
-    chart
-        .draw_series(LineSeries::new(
-            cmd,
-            RGBColor(170, 170, 170).stroke_width(1),
-        ))
-        .map_err(|x| e(&x))?
-        .label("command")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(170, 170, 170)));
-
-    // One line per leg (consecutive rows of the same phase).
-    let mut seen: Vec<String> = Vec::new();
-    let mut start = 0;
-    while start < rows.len() {
-        let phase = rows[start].phase.clone();
-        let mut end = start;
-        while end < rows.len() && rows[end].phase == phase {
-            end += 1;
-        }
-        let leg: Vec<(f64, f64)> = rows[start..end.min(rows.len())]
-            .iter()
-            .chain(rows.get(end))
-            .filter_map(|r| Some((r.position?, r.velocity?.clamp(y0 - pady, y1 + pady))))
-            .collect();
-        let k = match seen.iter().position(|p| *p == phase) {
-            Some(k) => k,
-            None => {
-                seen.push(phase.clone());
-                seen.len() - 1
-            }
-        };
-        let colour = PHASE_COLOURS[k % PHASE_COLOURS.len()];
-        let s = chart
-            .draw_series(LineSeries::new(leg, colour.stroke_width(2)))
-            .map_err(|x| e(&x))?;
-        if k + 1 == seen.len() {
-            s.label(phase.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
-        }
-        start = end;
-    }
-
-    // Switch edges (where the logical input changes) and markers.
-    let mut marks: Vec<(f64, &str, RGBColor)> = Vec::new();
-    for w in rows.windows(2) {
-        if let Some(p) = w[1].position {
-            if w[0].switch != w[1].switch {
-                marks.push((p, "switch", RGBColor(120, 120, 120)));
-            }
-            if w[1].marker && !w[0].marker {
-                marks.push((p, "marker", RGBColor(0, 150, 0)));
-            }
-        }
-    }
-    for (x, _, colour) in &marks {
-        chart
-            .draw_series(LineSeries::new(
-                vec![(*x, y0 - pady * 0.5), (*x, y0 - pady * 0.1)],
-                colour.stroke_width(2),
-            ))
-            .map_err(|x| e(&x))?;
-    }
-    if let Some(ev) = rows.iter().find_map(|r| r.event_raw) {
-        chart
-            .draw_series(LineSeries::new(
-                vec![(ev, y0 - pady), (ev, y1 + pady)],
-                RED.stroke_width(1),
-            ))
-            .map_err(|x| e(&x))?
-            .label(format!("home event {ev:.4}"))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    }
+    draw_command(&mut chart, rows).map_err(|x| e(&x))?;
+    draw_legs(&mut chart, rows, &area).map_err(|x| e(&x))?;
+    draw_edges(&mut chart, rows, &area).map_err(|x| e(&x))?;
+    draw_event(&mut chart, rows, &area).map_err(|x| e(&x))?;
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
@@ -191,13 +123,101 @@ pub fn draw(rows: &[Row], axis: &str, path: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// The commanded profile, thin and grey, under the actual motion.
+fn draw_command(chart: &mut Chart<'_, '_>, rows: &[TraceRow]) -> Drawn {
+    let cmd: Vec<(f64, f64)> = rows
+        .iter()
+        .filter_map(|r| Some((r.cmd_position?, r.cmd_velocity?)))
+        .collect();
+    chart
+        .draw_series(LineSeries::new(cmd, COMMAND_GREY.stroke_width(1)))?
+        .label("command")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], COMMAND_GREY));
+    Ok(())
+}
+
+/// One line per leg (consecutive rows of the same phase), one colour and
+/// one legend entry per phase.
+fn draw_legs(chart: &mut Chart<'_, '_>, rows: &[TraceRow], area: &Area) -> Drawn {
+    let mut seen = Vec::new();
+    let mut start = 0;
+    while start < rows.len() {
+        let phase = rows[start].phase;
+        let mut end = start;
+        while end < rows.len() && rows[end].phase == phase {
+            end += 1;
+        }
+        let leg: Vec<(f64, f64)> = rows[start..end]
+            .iter()
+            .chain(rows.get(end))
+            .filter_map(|r| Some((r.position?, r.velocity?.clamp(area.bottom(), area.top()))))
+            .collect();
+        let k = match seen.iter().position(|p| *p == phase) {
+            Some(k) => k,
+            None => {
+                seen.push(phase);
+                seen.len() - 1
+            }
+        };
+        let colour = PHASE_COLOURS[k % PHASE_COLOURS.len()];
+        let s = chart.draw_series(LineSeries::new(leg, colour.stroke_width(2)))?;
+        if k + 1 == seen.len() {
+            s.label(rows[start].phase_name()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        }
+        start = end;
+    }
+    Ok(())
+}
+
+/// Ticks under the curve where the switch changes and where a marker passes.
+fn draw_edges(chart: &mut Chart<'_, '_>, rows: &[TraceRow], area: &Area) -> Drawn {
+    let mut marks: Vec<(f64, RGBColor)> = Vec::new();
+    for w in rows.windows(2) {
+        if let Some(p) = w[1].position {
+            if w[0].switch != w[1].switch {
+                marks.push((p, RGBColor(120, 120, 120)));
+            }
+            if w[1].marker && !w[0].marker {
+                marks.push((p, RGBColor(0, 150, 0)));
+            }
+        }
+    }
+    for (x, colour) in marks {
+        chart.draw_series(LineSeries::new(
+            vec![
+                (x, area.y0 - area.pady * 0.5),
+                (x, area.y0 - area.pady * 0.1),
+            ],
+            colour.stroke_width(2),
+        ))?;
+    }
+    Ok(())
+}
+
+/// The home event: a red line across the plot, with its position in the legend.
+fn draw_event(chart: &mut Chart<'_, '_>, rows: &[TraceRow], area: &Area) -> Drawn {
+    if let Some(ev) = rows.iter().find_map(|r| r.event_raw) {
+        chart
+            .draw_series(LineSeries::new(
+                vec![(ev, area.bottom()), (ev, area.top())],
+                RED.stroke_width(1),
+            ))?
+            .label(format!("home event {ev:.4}"))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use motion_report::trace::{parse_csv, HEADER};
 
     #[test]
     fn parses_and_draws() {
-        let mut csv = String::from("t_s,phase,cmd_position,cmd_velocity,position,velocity,torque,switch,marker,fresh,event,event_raw,err,exerr\n");
+        let mut csv = String::from(HEADER);
         for k in 0..200 {
             let x = k as f64 * 0.01;
             let phase = if k < 100 { "seek" } else { "return" };

@@ -1,8 +1,9 @@
 //! Homing attributes of one axis (spec §2) and the axis facts homing depends on.
 //!
 //! Plain data, `Copy`, no heap: a validated [`AxisConfig`] is moved into the
-//! engine once and never changes while the cycle runs. Enum spellings follow
-//! `interface.md` so that the TOML layer can map them one to one.
+//! engine once and never changes while the cycle runs. Each enum's
+//! spellings (interface.md) are its [`spellings!`](crate::spellings) table
+//! right below it, in the order a config error lists them.
 
 /// Axis configuration (CIP "Axis Configuration").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,6 +16,12 @@ pub enum AxisConfiguration {
     Virtual,
 }
 
+crate::spellings!(AxisConfiguration {
+    Servo => "servo",
+    FeedbackOnly => "feedback_only",
+    Virtual => "virtual",
+});
+
 /// Drive control mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ControlMode {
@@ -22,6 +29,12 @@ pub enum ControlMode {
     Velocity,
     Torque,
 }
+
+crate::spellings!(ControlMode {
+    Position => "position",
+    Velocity => "velocity",
+    Torque => "torque",
+});
 
 /// Travel mode. A cyclic axis wraps its *axis* position into `[0, unwind)`;
 /// the raw (drive) position never wraps.
@@ -31,26 +44,45 @@ pub enum TravelMode {
     Cyclic,
 }
 
+crate::spellings!(TravelMode {
+    Linear => "linear",
+    Cyclic => "cyclic",
+});
+
 /// Home Mode attribute: 0 Passive, 1 Active; and the MAH instruction's
-/// Absolute mode.
+/// Absolute mode. The numbers are what the status frame carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HomeMode {
-    Passive,
-    Active,
+    Passive = 0,
+    Active = 1,
     /// An absolute feedback device: sequence Immediate only, no motion; the
     /// reference (the raw → axis offset) is stored by the supervisor and
     /// restored at start-up with [`Axis::restore_reference`](crate::Axis::restore_reference).
-    Absolute,
+    Absolute = 2,
 }
+
+// Active first: the default, as the config lists the choices.
+crate::spellings!(HomeMode {
+    Active => "active",
+    Passive => "passive",
+    Absolute => "absolute",
+});
 
 /// Home Direction attribute (0..=3 in CIP order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HomeDirection {
-    UnidirectionalForward,
-    BidirectionalForward,
-    UnidirectionalReverse,
-    BidirectionalReverse,
+    UnidirectionalForward = 0,
+    BidirectionalForward = 1,
+    UnidirectionalReverse = 2,
+    BidirectionalReverse = 3,
 }
+
+crate::spellings!(HomeDirection {
+    UnidirectionalForward => "unidirectional_forward",
+    BidirectionalForward => "bidirectional_forward",
+    UnidirectionalReverse => "unidirectional_reverse",
+    BidirectionalReverse => "bidirectional_reverse",
+});
 
 impl HomeDirection {
     /// +1.0 for the forward forms, -1.0 for the reverse forms.
@@ -72,13 +104,22 @@ impl HomeDirection {
 /// Home Sequence attribute (0..=5 in CIP order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HomeSequence {
-    Immediate,
-    Switch,
-    Marker,
-    SwitchThenMarker,
-    Torque,
-    TorqueThenMarker,
+    Immediate = 0,
+    Switch = 1,
+    Marker = 2,
+    SwitchThenMarker = 3,
+    Torque = 4,
+    TorqueThenMarker = 5,
 }
+
+crate::spellings!(HomeSequence {
+    Immediate => "immediate",
+    Switch => "switch",
+    Marker => "marker",
+    SwitchThenMarker => "switch_then_marker",
+    Torque => "torque",
+    TorqueThenMarker => "torque_then_marker",
+});
 
 impl HomeSequence {
     pub fn uses_switch(self) -> bool {

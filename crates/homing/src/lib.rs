@@ -17,11 +17,13 @@
 //!   coordination hooks a machine coordinator uses for gantries and home
 //!   order: barrier, timed final move, stop code).
 //! * [`status`]: the instruction's and the axis's status after a cycle.
+//! * [`names`]: every enum's spellings, written once next to the enum.
 
 pub mod axis;
 pub mod codes;
 pub mod config;
 pub mod io;
+pub mod names;
 pub mod plan;
 pub mod position;
 pub mod profile;

@@ -275,18 +275,13 @@ mod tests {
             HomeMode::Active,
             false,
         );
-        assert_eq!(
-            p,
-            [
-                Seek(Torque),
-                Stop,
-                Release,
-                Return(Marker),
-                Stop,
-                Restore,
-                MoveHome
-            ]
-        );
+        // Torque then marker: the torque sequence up to the release (seek
+        // into the stop, stop, release), then back to the marker, stop,
+        // restore the overridden drive values, move home.
+        assert_eq!(&TORQUE[..3], [Seek(Torque), Stop, Release]);
+        let torque_then_marker =
+            [&TORQUE[..3], &[Return(Marker), Stop, Restore, MoveHome]].concat();
+        assert_eq!(p, torque_then_marker);
         assert!(plan(
             S::Immediate,
             D::BidirectionalForward,

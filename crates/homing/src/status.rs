@@ -2,9 +2,9 @@
 //! and the axis status bits homing drives (HomingStatus, HomedStatus).
 
 /// Where the engine is in a sequence, derived from the state machine's state
-/// (the leg of the plan it runs). Names ([`Phase::name`]) are shown to
-/// operators and the numbers are kept stable; the EXERR of a search-limit
-/// failure has its own explicit mapping in [`codes`](crate::codes).
+/// (the leg of the plan it runs). Names (the spellings table below) are
+/// shown to operators and the numbers are kept stable; the EXERR of a
+/// search-limit failure has its own explicit mapping in [`codes`](crate::codes).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[repr(u16)]
 pub enum Phase {
@@ -33,23 +33,19 @@ pub enum Phase {
     Creep = 10,
 }
 
-impl Phase {
-    pub fn name(self) -> &'static str {
-        match self {
-            Phase::Idle => "idle",
-            Phase::Enabling => "enabling",
-            Phase::Seek => "seek",
-            Phase::SeekStop => "seek_stop",
-            Phase::Release => "release",
-            Phase::Return => "return",
-            Phase::ReturnStop => "return_stop",
-            Phase::MoveHome => "move_home",
-            Phase::Passive => "passive",
-            Phase::Stopping => "stopping",
-            Phase::Creep => "creep",
-        }
-    }
-}
+crate::spellings!(Phase {
+    Idle => "idle",
+    Enabling => "enabling",
+    Seek => "seek",
+    SeekStop => "seek_stop",
+    Release => "release",
+    Return => "return",
+    ReturnStop => "return_stop",
+    MoveHome => "move_home",
+    Passive => "passive",
+    Stopping => "stopping",
+    Creep => "creep",
+});
 
 /// Feedback refused as implausible, by kind, counted over the axis's life.
 /// Each one is a frame that was forged, corrupt, or from a broken encoder;
@@ -74,16 +70,17 @@ pub struct Status {
     pub en: bool,
     /// DN: the instruction finished (completed, or aborted / errored).
     pub dn: bool,
-    /// ER: the instruction detected an error; see `err` / `exerr`.
+    /// ER: the instruction detected an error, the codes below say which.
     pub er: bool,
+    /// ERR / EXERR of that error ([`codes`](crate::codes)).
+    pub err: u16,
+    pub exerr: u16,
     /// IP: homing in process.
     pub ip: bool,
     /// PC: process complete — homed *and* at Home Position where the
     /// sequence moves there. A unidirectional sequence that could not reach
     /// Home Position without reversing clears IP without PC.
     pub pc: bool,
-    pub err: u16,
-    pub exerr: u16,
     /// Axis HomingStatus.
     pub homing: bool,
     /// Axis HomedStatus: the machine reference is established.

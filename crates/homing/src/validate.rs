@@ -64,42 +64,79 @@ pub fn moves(cfg: &AxisConfig) -> bool {
     cfg.home_mode == HomeMode::Active && cfg.home_sequence != HomeSequence::Immediate
 }
 
-/// Checks `cfg` and returns every problem found (empty = valid).
+/// Checks `cfg` and returns every problem found (empty = valid), in a
+/// fixed order: numbers, scaling and travel, mode and sequence, then the
+/// rules of a sequence that commands motion.
 pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
     let mut p = Problems(Vec::new());
-
     // Numbers first: later rules only look at usable values.
+    let usable = numbers(&mut p, cfg);
+    conversion(&mut p, cfg);
+    cyclic(&mut p, cfg);
+    travel_limits(&mut p, cfg);
+    mode_and_sequence(&mut p, cfg);
+    if moves(cfg) {
+        motion(&mut p, cfg, &usable);
+        above_max_speed(&mut p, cfg, &usable);
+        torque_levels(&mut p, cfg, &usable);
+    }
+    p.0
+}
+
+/// Which of the numbers later rules look at are usable (finite, and not
+/// negative where that matters).
+struct Usable {
+    speed: bool,
+    return_speed: bool,
+    acceleration: bool,
+    deceleration: bool,
+    torque_level: bool,
+    torque_threshold: bool,
+    max_speed: bool,
+}
+
+/// Every number finite, and not negative where a negative value means
+/// nothing; `max_position` also above zero.
+fn numbers(p: &mut Problems, cfg: &AxisConfig) -> Usable {
     p.number("home_position", cfg.home_position, false);
     p.number("home_offset", cfg.home_offset, false);
-    let speed_ok = p.number("home_speed", cfg.home_speed, true);
-    let rspeed_ok = p.number("home_return_speed", cfg.home_return_speed, true);
-    let acc_ok = p.number("home_acceleration", cfg.home_acceleration, true);
-    let dec_ok = p.number("home_deceleration", cfg.home_deceleration, true);
-    let lvl_ok = p.number("home_torque_level", cfg.home_torque_level, true);
-    let thr_ok = p.number("home_torque_threshold", cfg.home_torque_threshold, true);
-    p.number("home_torque_time", cfg.home_torque_time, true);
-    p.number("home_timeout", cfg.home_timeout, true);
-    p.number("search_limit", cfg.search_limit, true);
-    p.number("home_creep_speed", cfg.home_creep_speed, true);
-    p.number("torque_limit", cfg.torque_limit, true);
-    p.number(
-        "position_error_tolerance",
-        cfg.position_error_tolerance,
-        true,
-    );
-    p.number(
-        "velocity_error_tolerance",
-        cfg.velocity_error_tolerance,
-        true,
-    );
-    p.number("enable_timeout", cfg.enable_timeout, true);
-    p.number("feedback_loss_drain", cfg.feedback_loss_drain, true);
-    let max_speed_ok = p.number("max_speed", cfg.max_speed, true);
+    let speed = p.number("home_speed", cfg.home_speed, true);
+    let return_speed = p.number("home_return_speed", cfg.home_return_speed, true);
+    let acceleration = p.number("home_acceleration", cfg.home_acceleration, true);
+    let deceleration = p.number("home_deceleration", cfg.home_deceleration, true);
+    let torque_level = p.number("home_torque_level", cfg.home_torque_level, true);
+    let torque_threshold = p.number("home_torque_threshold", cfg.home_torque_threshold, true);
+    for (key, v) in [
+        ("home_torque_time", cfg.home_torque_time),
+        ("home_timeout", cfg.home_timeout),
+        ("search_limit", cfg.search_limit),
+        ("home_creep_speed", cfg.home_creep_speed),
+        ("torque_limit", cfg.torque_limit),
+        ("position_error_tolerance", cfg.position_error_tolerance),
+        ("velocity_error_tolerance", cfg.velocity_error_tolerance),
+        ("enable_timeout", cfg.enable_timeout),
+        ("feedback_loss_drain", cfg.feedback_loss_drain),
+    ] {
+        p.number(key, v, true);
+    }
+    let max_speed = p.number("max_speed", cfg.max_speed, true);
     p.number("marker_min_distance", cfg.marker_min_distance, true);
     if p.number("max_position", cfg.max_position, true) && cfg.max_position == 0.0 {
         p.add("max_position", EX_BAD_NUMBER, "must be positive".into());
     }
+    Usable {
+        speed,
+        return_speed,
+        acceleration,
+        deceleration,
+        torque_level,
+        torque_threshold,
+        max_speed,
+    }
+}
 
+/// The conversion constant (counts per unit) is a positive number.
+fn conversion(p: &mut Problems, cfg: &AxisConfig) {
     if !cfg.counts_per_unit.is_finite() || cfg.counts_per_unit <= 0.0 {
         p.add(
             "counts_per_unit",
@@ -110,54 +147,67 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
             ),
         );
     }
+}
 
-    if cfg.travel == TravelMode::Cyclic {
-        if !cfg.unwind.is_finite() || cfg.unwind <= 0.0 {
-            p.add(
-                "unwind",
-                EX_UNWIND,
-                format!("cyclic axis needs a positive unwind, got {}", cfg.unwind),
-            );
-        } else if cfg.home_position.is_finite()
-            && !(cfg.home_position >= 0.0 && cfg.home_position < cfg.unwind)
-        {
-            p.add(
-                "home_position",
-                EX_CYCLIC_HOME_POSITION,
-                format!(
-                    "{} is outside [0, {}) of the cyclic axis",
-                    cfg.home_position, cfg.unwind
-                ),
-            );
-        }
+/// A cyclic axis has a positive unwind, and its Home Position lies in one
+/// revolution.
+fn cyclic(p: &mut Problems, cfg: &AxisConfig) {
+    if cfg.travel != TravelMode::Cyclic {
+        return;
     }
-
-    if let Some((lo, hi)) = cfg.travel_limits {
-        if !lo.is_finite() || !hi.is_finite() || lo >= hi {
-            p.add(
-                "travel_limits",
-                EX_TRAVEL_LIMITS,
-                format!("[{lo}, {hi}] is not an interval"),
-            );
-        } else if cfg.travel == TravelMode::Linear
-            && cfg.home_position.is_finite()
-            && !(lo..=hi).contains(&cfg.home_position)
-        {
-            p.add(
-                "home_position",
-                EX_HOME_POSITION_LIMITS,
-                format!(
-                    "{} is outside the travel limits [{lo}, {hi}]",
-                    cfg.home_position
-                ),
-            );
-        }
+    if !cfg.unwind.is_finite() || cfg.unwind <= 0.0 {
+        p.add(
+            "unwind",
+            EX_UNWIND,
+            format!("cyclic axis needs a positive unwind, got {}", cfg.unwind),
+        );
+    } else if cfg.home_position.is_finite()
+        && !(cfg.home_position >= 0.0 && cfg.home_position < cfg.unwind)
+    {
+        p.add(
+            "home_position",
+            EX_CYCLIC_HOME_POSITION,
+            format!(
+                "{} is outside [0, {}) of the cyclic axis",
+                cfg.home_position, cfg.unwind
+            ),
+        );
     }
+}
 
+/// The travel limits are an interval, and a linear axis's Home Position
+/// lies in it.
+fn travel_limits(p: &mut Problems, cfg: &AxisConfig) {
+    let Some((lo, hi)) = cfg.travel_limits else {
+        return;
+    };
+    if !lo.is_finite() || !hi.is_finite() || lo >= hi {
+        p.add(
+            "travel_limits",
+            EX_TRAVEL_LIMITS,
+            format!("[{lo}, {hi}] is not an interval"),
+        );
+    } else if cfg.travel == TravelMode::Linear
+        && cfg.home_position.is_finite()
+        && !(lo..=hi).contains(&cfg.home_position)
+    {
+        p.add(
+            "home_position",
+            EX_HOME_POSITION_LIMITS,
+            format!(
+                "{} is outside the travel limits [{lo}, {hi}]",
+                cfg.home_position
+            ),
+        );
+    }
+}
+
+/// The home mode and sequence suit the axis: absolute mode on an absolute
+/// encoder with the immediate sequence, active homing on a servo axis,
+/// nothing but immediate on a virtual axis, no torque sequence passive, a
+/// marker for a marker sequence.
+fn mode_and_sequence(p: &mut Problems, cfg: &AxisConfig) {
     let seq = cfg.home_sequence;
-    let active = cfg.home_mode == HomeMode::Active;
-    let passive = cfg.home_mode == HomeMode::Passive;
-
     if cfg.home_mode == HomeMode::Absolute {
         if seq != HomeSequence::Immediate {
             p.add(
@@ -174,8 +224,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
             );
         }
     }
-
-    if active && cfg.configuration == AxisConfiguration::FeedbackOnly {
+    if cfg.home_mode == HomeMode::Active && cfg.configuration == AxisConfiguration::FeedbackOnly {
         p.add(
             "home_mode",
             EX_ACTIVE_ON_FEEDBACK_ONLY,
@@ -189,7 +238,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
             "a virtual axis has no switch, marker or drive: only immediate homing applies".into(),
         );
     }
-    if passive && seq.uses_torque() {
+    if cfg.home_mode == HomeMode::Passive && seq.uses_torque() {
         p.add(
             "home_sequence",
             EX_SEQUENCE_INCOMPATIBLE,
@@ -204,87 +253,102 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
             "marker sequence but the feedback device has no marker (marker = false)".into(),
         );
     }
+}
 
-    if moves(cfg) {
-        if cfg.control_mode == ControlMode::Torque {
+/// A sequence that commands motion: a control mode that follows a
+/// position, a direction that can come back from a hard stop, and speeds,
+/// acceleration and deceleration that are not zero where a leg uses them.
+fn motion(p: &mut Problems, cfg: &AxisConfig, ok: &Usable) {
+    let seq = cfg.home_sequence;
+    if cfg.control_mode == ControlMode::Torque {
+        p.add(
+            "control_mode",
+            EX_TORQUE_CONTROL_MODE,
+            "active homing needs position or velocity control mode".into(),
+        );
+    }
+    if seq.uses_torque() && cfg.home_direction.is_unidirectional() {
+        p.add(
+            "home_direction",
+            EX_UNIDIRECTIONAL_TORQUE,
+            "torque sequences push into a hard stop and come back: only bidirectional directions are valid".into(),
+        );
+    }
+    if ok.speed && cfg.home_speed == 0.0 {
+        p.add(
+            "home_speed",
+            EX_HOME_SPEED_ZERO,
+            "home speed is zero".into(),
+        );
+    }
+    let uses_return = !cfg.home_direction.is_unidirectional() || seq.uses_torque();
+    if ok.return_speed && uses_return && cfg.home_return_speed == 0.0 {
+        p.add(
+            "home_return_speed",
+            EX_RETURN_SPEED_ZERO,
+            "home return speed is zero".into(),
+        );
+    }
+    if ok.acceleration && cfg.home_acceleration == 0.0 {
+        p.add(
+            "home_acceleration",
+            EX_ACCELERATION_ZERO,
+            "home acceleration is zero: the axis could never start".into(),
+        );
+    }
+    if ok.deceleration && cfg.home_deceleration == 0.0 {
+        p.add(
+            "home_deceleration",
+            EX_DECELERATION_ZERO,
+            "home deceleration is zero: the axis could never stop".into(),
+        );
+    }
+}
+
+/// No commanded speed above `max_speed`: the axis's own feedback would be
+/// refused as implausible.
+fn above_max_speed(p: &mut Problems, cfg: &AxisConfig, ok: &Usable) {
+    if !(ok.max_speed && cfg.max_speed > 0.0) {
+        return;
+    }
+    for (key, v) in commanded_speeds(cfg) {
+        if v > cfg.max_speed {
             p.add(
-                "control_mode",
-                EX_TORQUE_CONTROL_MODE,
-                "active homing needs position or velocity control mode".into(),
+                key,
+                EX_ABOVE_MAX_SPEED,
+                format!(
+                    "{v} units/s is above max_speed {} units/s, the fastest the axis \
+                     can move: its own feedback would be refused as implausible",
+                    cfg.max_speed
+                ),
             );
-        }
-        if seq.uses_torque() && cfg.home_direction.is_unidirectional() {
-            p.add(
-                "home_direction",
-                EX_UNIDIRECTIONAL_TORQUE,
-                "torque sequences push into a hard stop and come back: only bidirectional directions are valid".into(),
-            );
-        }
-        if speed_ok && cfg.home_speed == 0.0 {
-            p.add(
-                "home_speed",
-                EX_HOME_SPEED_ZERO,
-                "home speed is zero".into(),
-            );
-        }
-        let uses_return = !cfg.home_direction.is_unidirectional() || seq.uses_torque();
-        if rspeed_ok && uses_return && cfg.home_return_speed == 0.0 {
-            p.add(
-                "home_return_speed",
-                EX_RETURN_SPEED_ZERO,
-                "home return speed is zero".into(),
-            );
-        }
-        if acc_ok && cfg.home_acceleration == 0.0 {
-            p.add(
-                "home_acceleration",
-                EX_ACCELERATION_ZERO,
-                "home acceleration is zero: the axis could never start".into(),
-            );
-        }
-        if dec_ok && cfg.home_deceleration == 0.0 {
-            p.add(
-                "home_deceleration",
-                EX_DECELERATION_ZERO,
-                "home deceleration is zero: the axis could never stop".into(),
-            );
-        }
-        if max_speed_ok && cfg.max_speed > 0.0 {
-            for (key, v) in commanded_speeds(cfg) {
-                if v > cfg.max_speed {
-                    p.add(
-                        key,
-                        EX_ABOVE_MAX_SPEED,
-                        format!(
-                            "{v} units/s is above max_speed {} units/s, the fastest the axis \
-                             can move: its own feedback would be refused as implausible",
-                            cfg.max_speed
-                        ),
-                    );
-                }
-            }
-        }
-        if seq.uses_torque() && lvl_ok && thr_ok {
-            let (lvl, thr) = (cfg.home_torque_level, cfg.home_torque_threshold);
-            if lvl == 0.0 || lvl > 100.0 {
-                p.add(
-                    "home_torque_level",
-                    EX_TORQUE_LEVEL,
-                    format!("{lvl} % is not in (0, 100] %"),
-                );
-            } else if thr == 0.0 || thr > lvl {
-                p.add(
-                    "home_torque_threshold",
-                    EX_TORQUE_LEVEL,
-                    format!(
-                        "{thr} % must be above 0 and at most the torque level {lvl} %, \
-                         or the hard stop can never be detected"
-                    ),
-                );
-            }
         }
     }
-    p.0
+}
+
+/// A torque sequence: a level in (0, 100] % and a threshold above zero and
+/// at most the level, or the hard stop could never be detected.
+fn torque_levels(p: &mut Problems, cfg: &AxisConfig, ok: &Usable) {
+    if !(cfg.home_sequence.uses_torque() && ok.torque_level && ok.torque_threshold) {
+        return;
+    }
+    let (lvl, thr) = (cfg.home_torque_level, cfg.home_torque_threshold);
+    if lvl == 0.0 || lvl > 100.0 {
+        p.add(
+            "home_torque_level",
+            EX_TORQUE_LEVEL,
+            format!("{lvl} % is not in (0, 100] %"),
+        );
+    } else if thr == 0.0 || thr > lvl {
+        p.add(
+            "home_torque_threshold",
+            EX_TORQUE_LEVEL,
+            format!(
+                "{thr} % must be above 0 and at most the torque level {lvl} %, \
+                 or the hard stop can never be detected"
+            ),
+        );
+    }
 }
 
 /// The homing speeds the configured sequence commands, by TOML key: Home

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{run, run_with, Outcome};
+use common::{axis, machine, run, run_with, Outcome};
 use motion_homing::codes::*;
 use motion_homing::*;
 use motion_plant::PlantConfig;
@@ -13,22 +13,13 @@ const T: f64 = 0.001;
 
 fn torque_axis() -> AxisConfig {
     AxisConfig {
-        counts_per_unit: 1000.0,
-        marker: true,
-        home_sequence: HomeSequence::Torque,
-        home_direction: HomeDirection::BidirectionalForward,
-        home_speed: 20.0,
-        home_return_speed: 2.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
         home_torque_level: 30.0,
         home_torque_threshold: 20.0,
         home_torque_time: 0.01,
         torque_limit: 250.0,
         position_error_tolerance: 1.0,
         velocity_error_tolerance: 5.0,
-        travel_limits: Some((-100.0, 100.0)),
-        ..AxisConfig::default()
+        ..axis(HomeSequence::Torque, HomeDirection::BidirectionalForward)
     }
 }
 
@@ -36,17 +27,6 @@ fn switch_axis() -> AxisConfig {
     AxisConfig {
         home_sequence: HomeSequence::Switch,
         ..torque_axis()
-    }
-}
-
-fn machine() -> PlantConfig {
-    PlantConfig {
-        start: -50.0,
-        switch: Some((0.0, 5.0)),
-        marker_every: 10.0,
-        marker_at: 2.5,
-        hard_stop: Some((-100.0, 100.0)),
-        ..PlantConfig::default()
     }
 }
 

@@ -19,29 +19,16 @@ const T: f64 = 0.001;
 
 fn stm(dir: HomeDirection, min: f64, refuse: bool) -> AxisConfig {
     AxisConfig {
-        counts_per_unit: 1000.0,
-        marker: true,
-        home_sequence: HomeSequence::SwitchThenMarker,
-        home_direction: dir,
-        home_speed: 20.0,
-        home_return_speed: 2.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-100.0, 100.0)),
         marker_min_distance: min,
         refuse_ambiguous_marker: refuse,
-        ..AxisConfig::default()
+        ..common::axis(HomeSequence::SwitchThenMarker, dir)
     }
 }
 
 fn machine(marker_at: f64) -> PlantConfig {
     PlantConfig {
-        start: -50.0,
-        switch: Some((0.0, 5.0)),
-        marker_every: 10.0,
         marker_at,
-        hard_stop: Some((-100.0, 100.0)),
-        ..PlantConfig::default()
+        ..common::machine()
     }
 }
 

@@ -9,43 +9,20 @@
 //! plant reaches its command in the cycle, so a cruising jog advances exactly
 //! V × T = 0.02 per cycle).
 
+mod common;
+
+use common::{axis, machine, steps, Steps};
 use motion_homing::codes::*;
 use motion_homing::*;
-use motion_plant::{Plant, PlantConfig};
+use motion_plant::PlantConfig;
 
 const MS: u64 = 1_000_000;
 
 fn switch_axis(dir: HomeDirection) -> AxisConfig {
     AxisConfig {
-        counts_per_unit: 1000.0,
-        home_sequence: HomeSequence::Switch,
-        home_direction: dir,
-        home_speed: 20.0,
-        home_return_speed: 2.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-100.0, 100.0)),
-        ..AxisConfig::default()
+        marker: false,
+        ..axis(HomeSequence::Switch, dir)
     }
-}
-
-fn machine() -> PlantConfig {
-    PlantConfig {
-        start: -50.0,
-        switch: Some((0.0, 5.0)),
-        marker_every: 10.0,
-        marker_at: 2.5,
-        hard_stop: Some((-100.0, 100.0)),
-        ..PlantConfig::default()
-    }
-}
-
-/// Every step's command and status, and the feedback the plant produced
-/// before it (`seen[k]`: position the engine would have seen at step k).
-struct Trace {
-    cmd: Vec<Command>,
-    st: Vec<Status>,
-    seen: Vec<f64>,
 }
 
 /// Steps engine and plant every `cycle_ns` for `steps`, homing from step 0;
@@ -54,30 +31,12 @@ fn trace(
     cfg: AxisConfig,
     plant: PlantConfig,
     cycle_ns: u64,
-    steps: usize,
+    n: usize,
     mut drop: impl FnMut(usize, &Feedback) -> bool,
-) -> Trace {
-    let mut axis = Axis::new(cfg);
-    let mut plant = Plant::new(plant);
-    let mut fb = plant.feedback();
-    let req = Request {
-        home: true,
-        ..Request::default()
-    };
-    let mut t = Trace {
-        cmd: Vec::new(),
-        st: Vec::new(),
-        seen: Vec::new(),
-    };
-    for k in 0..steps {
-        let seen = (!drop(k, &fb)).then_some(fb);
-        let cmd = axis.step(k as u64 * cycle_ns, seen.as_ref(), &req);
-        t.cmd.push(cmd);
-        t.st.push(*axis.status());
-        t.seen.push(fb.position);
-        fb = plant.step(&cmd, cycle_ns as f64 * 1e-9);
-    }
-    t
+) -> Steps {
+    steps(cfg, plant, cycle_ns, n, |k, _, fb| {
+        (!drop(k, &fb)).then_some(fb)
+    })
 }
 
 #[test]
@@ -227,10 +186,7 @@ fn the_rule_means_the_same_at_8_khz() {
     // trips with a gap of 81 x 0.125 = 10.125 ms.
     const STEP: u64 = 125_000;
     let mut axis = Axis::new(AxisConfig::default()); // immediate
-    let home = Request {
-        home: true,
-        ..Request::default()
-    };
+    let home = common::home();
     axis.step(0, Some(&Feedback::default()), &home);
     assert!(axis.status().homed);
     for k in 1..=80 {

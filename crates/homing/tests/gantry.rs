@@ -22,6 +22,8 @@
 //! are 1.004..1.008 (A) and 1.504..1.508 (B) long; at R = 2 with 4 ms ramps
 //! they take at least d / 2 + 4 ms: 506..508 ms (A), 756..758 ms (B).
 
+mod common;
+
 use motion_homing::codes::*;
 use motion_homing::*;
 use motion_plant::{Plant, PlantConfig};
@@ -30,28 +32,19 @@ const T: u64 = 1_000_000;
 
 fn side(offset: f64) -> AxisConfig {
     AxisConfig {
-        counts_per_unit: 1000.0,
-        marker: true,
-        home_sequence: HomeSequence::SwitchThenMarker,
-        home_direction: HomeDirection::BidirectionalForward,
         home_offset: offset,
-        home_speed: 20.0,
-        home_return_speed: 2.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-100.0, 100.0)),
-        ..AxisConfig::default()
+        ..common::axis(
+            HomeSequence::SwitchThenMarker,
+            HomeDirection::BidirectionalForward,
+        )
     }
 }
 
 fn plant(rack: f64) -> PlantConfig {
     PlantConfig {
-        start: -50.0,
         switch: Some((rack, 5.0 + rack)),
-        marker_every: 10.0,
         marker_at: 2.5 + rack,
-        hard_stop: Some((-100.0, 100.0)),
-        ..PlantConfig::default()
+        ..common::machine()
     }
 }
 

@@ -7,72 +7,27 @@
 //! 1 ms apart a position may move 40 x 0.001 x 1.5 + 2 / 1000 = 0.062, and a
 //! latch may lie 40 x 0.001 + 0.002 = 0.042 outside the travel since arming.
 
+mod common;
+
+use common::{axis, machine, steps, Steps};
 use motion_homing::codes::*;
 use motion_homing::*;
 use motion_plant::{Plant, PlantConfig};
 
 const MS: u64 = 1_000_000;
 
-fn axis(seq: HomeSequence, dir: HomeDirection) -> AxisConfig {
-    AxisConfig {
-        counts_per_unit: 1000.0,
-        marker: true,
-        home_sequence: seq,
-        home_direction: dir,
-        home_speed: 20.0,
-        home_return_speed: 2.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-100.0, 100.0)),
-        ..AxisConfig::default()
-    }
-}
-
-fn machine() -> PlantConfig {
-    PlantConfig {
-        start: -50.0,
-        switch: Some((0.0, 5.0)),
-        marker_every: 10.0,
-        marker_at: 2.5,
-        hard_stop: Some((-100.0, 100.0)),
-        ..PlantConfig::default()
-    }
-}
-
-struct Run {
-    st: Vec<Status>,
-    cmd: Vec<Command>,
-}
-
 /// Homes from step 0; `forge(k, previous command, frame)` may rewrite the
 /// frame the engine sees at step k.
 fn run(
     cfg: AxisConfig,
     plant: PlantConfig,
-    steps: usize,
+    n: usize,
     mut forge: impl FnMut(usize, &Command, &mut Feedback),
-) -> Run {
-    let mut axis = Axis::new(cfg);
-    let mut plant = Plant::new(plant);
-    let mut fb = plant.feedback();
-    let req = Request {
-        home: true,
-        ..Request::default()
-    };
-    let mut r = Run {
-        st: Vec::new(),
-        cmd: Vec::new(),
-    };
-    let mut last = Command::default();
-    for k in 0..steps {
-        let mut seen = fb;
-        forge(k, &last, &mut seen);
-        last = axis.step(k as u64 * MS, Some(&seen), &req);
-        r.cmd.push(last);
-        r.st.push(*axis.status());
-        fb = plant.step(&last, 0.001);
-    }
-    r
+) -> Steps {
+    steps(cfg, plant, MS, n, |k, last, mut fb| {
+        forge(k, last, &mut fb);
+        Some(fb)
+    })
 }
 
 #[test]
@@ -126,10 +81,7 @@ fn a_forged_frame_clears_homed_at_rest_without_an_error() {
         ..AxisConfig::default()
     };
     let mut axis = Axis::new(cfg);
-    let home = Request {
-        home: true,
-        ..Request::default()
-    };
+    let home = common::home();
     let at = |p: f64| Feedback {
         position: p,
         ..Feedback::default()
@@ -319,10 +271,7 @@ fn lagging_feedback_catching_up_and_a_stalled_cycle_are_plausible() {
     let cfg = axis(HomeSequence::Switch, HomeDirection::BidirectionalForward);
     let mut axis = Axis::new(cfg);
     let mut plant = Plant::new(machine());
-    let req = Request {
-        home: true,
-        ..Request::default()
-    };
+    let req = common::home();
     let mut frames = vec![plant.feedback()];
     let mut now = 0;
     for k in 0..8000usize {

@@ -39,35 +39,19 @@ const SW_P: f64 = 5.0 * T / 2.0 + 1e-9; // ... passive at 5 u/s
 use HomeDirection::*;
 use HomeSequence::*;
 
+/// The common test axis (it homes at V and R), with the torque settings.
 fn axis(seq: HomeSequence, dir: HomeDirection) -> AxisConfig {
     AxisConfig {
-        counts_per_unit: 1000.0,
-        marker: true,
-        home_mode: HomeMode::Active,
-        home_direction: dir,
-        home_sequence: seq,
-        home_speed: V,
-        home_return_speed: R,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
         home_torque_level: 30.0,
         home_torque_threshold: 20.0,
         home_torque_time: 0.01,
-        travel_limits: Some((-100.0, 100.0)),
         position_error_tolerance: 1.0,
-        ..AxisConfig::default()
+        ..common::axis(seq, dir)
     }
 }
 
 fn plant(start: f64) -> PlantConfig {
-    PlantConfig {
-        start,
-        switch: Some((0.0, 5.0)),
-        marker_every: 10.0,
-        marker_at: 2.5,
-        hard_stop: Some((-100.0, 100.0)),
-        ..PlantConfig::default()
-    }
+    common::machine_at(start)
 }
 
 /// Where a forward (reverse) search starts.

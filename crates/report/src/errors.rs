@@ -70,6 +70,30 @@ pub fn fail(json: bool, errors: Vec<ErrorEntry>, code: i32) -> i32 {
     code
 }
 
+/// A command line clap refused: its message on stderr and exit code 2, or
+/// with `--json` among the arguments one JSON error object on stdout (its
+/// first line). `--help` / `--version` print and exit 0.
+pub fn argument_error(e: clap::Error) -> i32 {
+    use clap::error::ErrorKind;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        let _ = e.print();
+        return 0;
+    }
+    if std::env::args().any(|a| a == "--json") {
+        let text = e.render().to_string();
+        let first = text
+            .lines()
+            .next()
+            .unwrap_or("bad argument")
+            .trim_start_matches("error: ")
+            .to_string();
+        crate::print_json(&ErrorReport::message(first));
+    } else {
+        let _ = e.print();
+    }
+    2
+}
+
 #[cfg(test)]
 mod display_tests {
     use super::*;

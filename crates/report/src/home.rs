@@ -75,26 +75,17 @@ pub struct CpuUse {
     pub wall_s: f64,
 }
 
-/// `motion-supervisor home --json`.
+/// `motion-supervisor home --json`: the rows, then what `run --json` says
+/// of the run (its fields follow `axes` at the same level).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct HomeReport {
     pub axes: Vec<AxisResult>,
-    pub latency: Latency,
-    #[serde(default)]
-    pub io: Vec<IoReport>,
-    pub rt: Option<RtInfo>,
-    #[serde(default)]
-    pub warnings: Vec<String>,
-    #[serde(default)]
-    pub allocations: Allocations,
-    #[serde(default)]
-    pub cpu: CpuUse,
-    /// Problems that ended the run early (I/O process gone, signal, ...).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub errors: Vec<ErrorEntry>,
+    #[serde(flatten)]
+    pub run: RunReport,
 }
 
-/// `motion-supervisor run --json` (printed when the daemon ends).
+/// `motion-supervisor run --json` (printed when the daemon ends), and the
+/// part of `home --json` after the rows.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RunReport {
     pub latency: Latency,
@@ -107,6 +98,7 @@ pub struct RunReport {
     pub allocations: Allocations,
     #[serde(default)]
     pub cpu: CpuUse,
+    /// Problems that ended the run early (I/O process gone, signal, ...).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub errors: Vec<ErrorEntry>,
 }

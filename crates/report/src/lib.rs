@@ -7,9 +7,11 @@
 //! * [`home`] — `home --json`: one row per axis (interface.md).
 //! * [`status`] — `status --json`: the live state of every axis and I/O process.
 //! * [`io`] — per I/O process: attached, frames, gaps by length.
-//! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`.
+//! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`
+//!   (also for a refused command line).
 //! * [`codes`] — ERR/EXERR in plain words.
 //! * [`table`] — the fixed-width text tables of the same reports.
+//! * [`trace`] — the trace CSV, written by the daemon and read by `motionctl`.
 //! * [`panic`] — a panic with `--json`: one error object, like every failure.
 
 pub mod codes;
@@ -20,6 +22,7 @@ pub mod latency;
 pub mod panic;
 pub mod status;
 pub mod table;
+pub mod trace;
 
 pub use errors::{ErrorEntry, ErrorReport};
 pub use home::{
@@ -29,6 +32,7 @@ pub use home::{
 pub use io::{GapCounts, IoReport};
 pub use latency::{LateWakeup, Latency, Percentiles};
 pub use status::{AxisStatus, IoStatus, StatusReport};
+pub use trace::TraceRow;
 
 /// Rounds to `digits` decimals for printing (JSON keeps what a reader can use,
 /// not float noise).

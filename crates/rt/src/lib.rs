@@ -65,6 +65,7 @@ pub mod environment;
 pub mod logging;
 pub mod pm_qos;
 mod pool;
+mod procfs;
 mod remote_free;
 pub mod termination;
 pub mod thread;

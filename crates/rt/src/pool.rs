@@ -38,6 +38,7 @@ use nix::sys::mman::{mlock, mmap_anonymous, MapFlags, ProtFlags};
 use rlsf::Tlsf;
 
 use crate::counting;
+use crate::procfs::page_size;
 use crate::remote_free::{FreeNode, RemoteFreeList, MIN_NODE_ALIGN, MIN_NODE_SIZE};
 
 /// How many threads can own a pool at once (and how many pools can exist).
@@ -445,16 +446,6 @@ pub(crate) fn note_rt_system_call(idx: usize) {
 #[inline]
 pub(crate) fn note_fallback(idx: usize) {
     bump_owned(&SLOTS[idx].counters.fallback_allocs, 1);
-}
-
-fn page_size() -> usize {
-    // SAFETY: plain query.
-    let p = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
-    if p > 0 {
-        p as usize
-    } else {
-        4096
-    }
 }
 
 fn round_up(v: usize, to: usize) -> Option<usize> {

@@ -25,14 +25,14 @@
 use std::fmt;
 use std::mem::MaybeUninit;
 
-use nix::sched::{sched_getaffinity, sched_setaffinity, CpuSet};
+use nix::sched::{sched_setaffinity, CpuSet};
 use nix::sys::mman::{mlockall, MlockAllFlags};
 use nix::sys::resource::{getrlimit, Resource};
 use nix::unistd::Pid;
 
-use crate::environment::{
-    fmt_cpulist, fmt_rlimit, has_capability, online_cpus, read_status_kib, CAP_IPC_LOCK,
-    CAP_SYS_NICE,
+use crate::procfs::{
+    current_affinity, fmt_cpulist, fmt_rlimit, has_capability, online_cpus, page_size,
+    read_status_kib, CAP_IPC_LOCK, CAP_SYS_NICE,
 };
 
 /// What [`enter_realtime`] should apply to the calling thread.
@@ -356,16 +356,6 @@ pub fn keep_off_cpu(cpu: usize) -> Result<Vec<usize>, String> {
     Ok(keep)
 }
 
-/// The calling thread's affinity mask.
-pub(crate) fn current_affinity() -> Vec<usize> {
-    match sched_getaffinity(Pid::from_raw(0)) {
-        Ok(set) => (0..CpuSet::count())
-            .filter(|&c| set.is_set(c).unwrap_or(false))
-            .collect(),
-        Err(_) => Vec::new(),
-    }
-}
-
 /// The calling thread's policy and priority (`pthread_getschedparam`).
 pub fn current_sched() -> (SchedPolicy, i32) {
     let mut policy: libc::c_int = -1;
@@ -376,16 +366,6 @@ pub fn current_sched() -> (SchedPolicy, i32) {
         (SchedPolicy::from_raw(policy), param.sched_priority)
     } else {
         (SchedPolicy::Unknown(-1), 0)
-    }
-}
-
-fn page_size() -> usize {
-    // SAFETY: plain query.
-    let p = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
-    if p > 0 {
-        p as usize
-    } else {
-        4096
     }
 }
 

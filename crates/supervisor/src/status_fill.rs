@@ -5,7 +5,7 @@ use crate::keeper::AxisNote;
 use crate::shared::Snapshot;
 use motion_config::MachineConfig;
 use motion_control::*;
-use motion_homing::{effective_search_limit, HomeMode};
+use motion_homing::effective_search_limit;
 
 /// Fills `f` (zeroed) from `snap` and the keeper's `notes` (per axis);
 /// `uptime_ns` since the supervisor started.
@@ -53,11 +53,7 @@ pub fn fill(
         e.err = s.err;
         e.exerr = s.exerr;
         e.drive_error_code = a.drive_error_code;
-        e.home_mode = match cfg.engine.home_mode {
-            HomeMode::Passive => 0,
-            HomeMode::Active => 1,
-            HomeMode::Absolute => 2,
-        };
+        e.home_mode = cfg.engine.home_mode as u8;
         e.home_sequence = cfg.engine.home_sequence as u8;
         e.home_direction = cfg.engine.home_direction as u8;
         e.aborted_by = a.aborted_by.unwrap_or(NO_AXIS);

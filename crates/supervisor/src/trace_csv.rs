@@ -1,64 +1,36 @@
-//! A recorded homing as CSV (`motionctl trace --out FILE.csv`): one row per
-//! cycle, the columns the plot and a spreadsheet need.
+//! A recorded homing as CSV (`motionctl trace --out FILE.csv`): the cycle's
+//! trace records in the columns of `motion_report::trace`, which also reads
+//! them back.
 
 use crate::shared::TraceRecord;
 use motion_homing::Phase;
+use motion_report::trace::{self, TraceRow};
 
-pub const HEADER: &str = "t_s,phase,cmd_position,cmd_velocity,position,velocity,torque,switch,marker,fresh,event,event_raw,err,exerr\n";
-
-fn phase_name(n: u8) -> &'static str {
-    const ALL: [Phase; 11] = [
-        Phase::Idle,
-        Phase::Enabling,
-        Phase::Seek,
-        Phase::SeekStop,
-        Phase::Release,
-        Phase::Return,
-        Phase::ReturnStop,
-        Phase::MoveHome,
-        Phase::Passive,
-        Phase::Stopping,
-        Phase::Creep,
-    ];
-    ALL.iter()
-        .find(|p| **p as u8 == n)
-        .map_or("?", |p| p.name())
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
 }
 
-fn num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x:.6}")
-    } else {
-        String::new()
+/// One record as a row: non-finite numbers (no feedback) are absent.
+pub fn row(r: &TraceRecord) -> TraceRow {
+    TraceRow {
+        t_s: r.t_ns as f64 * 1e-9,
+        phase: Phase::from_number(r.phase),
+        cmd_position: finite(r.cmd_position),
+        cmd_velocity: finite(r.cmd_velocity),
+        position: finite(r.position),
+        velocity: finite(r.velocity),
+        torque: finite(r.torque),
+        switch: r.switch,
+        marker: r.marker,
+        fresh: r.fresh,
+        event: r.event,
+        event_raw: finite(r.event_raw),
+        err: r.err,
+        exerr: r.exerr,
     }
 }
 
 /// The records as CSV text (header included).
 pub fn csv(records: &[TraceRecord]) -> String {
-    let mut s = String::with_capacity(HEADER.len() + records.len() * 96);
-    s += HEADER;
-    for r in records {
-        s += &format!(
-            "{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.t_ns as f64 * 1e-9,
-            phase_name(r.phase),
-            num(r.cmd_position),
-            num(r.cmd_velocity),
-            num(r.position),
-            num(r.velocity),
-            num(r.torque),
-            u8::from(r.switch),
-            u8::from(r.marker),
-            u8::from(r.fresh),
-            u8::from(r.event),
-            if r.event {
-                num(r.event_raw)
-            } else {
-                String::new()
-            },
-            r.err,
-            r.exerr
-        );
-    }
-    s
+    trace::csv(records.iter().map(row))
 }

@@ -3,7 +3,7 @@ use crate::cli::HomeArgs;
 use motion_control::homing::{home_and_follow, HomeOutcome, HomeRequest};
 use motion_control::progress::Progress;
 use motion_control::*;
-use motion_report::{print_json, table, AcceptedReport, CtlHomeReport, ErrorEntry};
+use motion_report::{print_json, table, AcceptedReport, CtlHomeReport};
 use std::time::Duration;
 
 /// `home [AXIS]... [--json] [--no-wait] [--timeout S] [--parallel]`.
@@ -64,18 +64,9 @@ pub fn home(client: &mut Client, a: &HomeArgs) -> i32 {
 
 /// A refused request: why, per axis where there is a reason.
 fn refused(json: bool, resp: &ControlResponse) -> i32 {
-    let mut errors = vec![ErrorEntry::message(format!(
-        "home refused: {}",
-        resp.message_text()
-    ))];
-    for x in resp.answers().iter().filter(|x| x.reason != REASON_NONE) {
-        errors.push(ErrorEntry {
-            axis: Some(get_str(&x.name)),
-            key: None,
-            err: (x.err != 0).then_some(x.err),
-            exerr: (x.err != 0).then_some(x.exerr),
-            message: reason_text(x.reason).into(),
-        });
-    }
-    fail(json, errors, EXIT_FAILED)
+    fail(
+        json,
+        resp.refusal("home", |x| x.reason != REASON_NONE),
+        EXIT_FAILED,
+    )
 }

@@ -8,8 +8,11 @@ mod trace;
 
 use crate::cli::{Cli, Command, Target};
 use motion_control::{Client, ClientError};
-use motion_report::{print_json, ErrorEntry, ErrorReport};
+use motion_report::ErrorEntry;
 use std::path::PathBuf;
+
+/// How a command fails: a refused command line, and every other failure.
+pub use motion_report::errors::{argument_error, fail};
 
 pub const EXIT_OK: i32 = 0;
 pub const EXIT_FAILED: i32 = 1;
@@ -44,18 +47,8 @@ fn target(t: &Target) -> Result<(String, Option<PathBuf>), Vec<ErrorEntry>> {
     let mut prefix = "motion".to_string();
     let mut runtime_dir = None;
     if let Some(path) = &t.config {
-        let (m, _) = motion_config::load(Some(path)).map_err(|problems| {
-            problems
-                .iter()
-                .map(|p| ErrorEntry {
-                    axis: p.axis.clone(),
-                    key: Some(p.key.clone()),
-                    err: p.code.map(|c| c.0),
-                    exerr: p.code.map(|c| c.1),
-                    message: p.message.clone(),
-                })
-                .collect::<Vec<_>>()
-        })?;
+        let (m, _) = motion_config::load(Some(path))
+            .map_err(|problems| problems.iter().map(ErrorEntry::from).collect::<Vec<_>>())?;
         prefix = m.supervisor.service_prefix.clone();
         runtime_dir = m.supervisor.runtime_dir.clone();
     }
@@ -68,8 +61,6 @@ fn target(t: &Target) -> Result<(String, Option<PathBuf>), Vec<ErrorEntry>> {
     Ok((prefix, runtime_dir))
 }
 
-pub use motion_report::errors::fail;
-
 /// A client error, with the exit code it means.
 pub fn client_error(json: bool, e: &ClientError) -> i32 {
     let code = match e {
@@ -79,28 +70,6 @@ pub fn client_error(json: bool, e: &ClientError) -> i32 {
         _ => EXIT_FAILED,
     };
     fail(json, vec![ErrorEntry::message(e.to_string())], code)
-}
-
-/// A command line clap refused (exit 2; with `--json`, a JSON error object).
-pub fn argument_error(e: clap::Error) -> i32 {
-    use clap::error::ErrorKind;
-    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-        let _ = e.print();
-        return EXIT_OK;
-    }
-    if std::env::args().any(|a| a == "--json") {
-        let text = e.render().to_string();
-        let first = text
-            .lines()
-            .next()
-            .unwrap_or("bad argument")
-            .trim_start_matches("error: ")
-            .to_string();
-        print_json(&ErrorReport::message(first));
-    } else {
-        let _ = e.print();
-    }
-    EXIT_USAGE
 }
 
 /// The signal that interrupted us, as an exit code.

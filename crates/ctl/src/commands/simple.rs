@@ -1,7 +1,7 @@
 use super::{client_error, fail, EXIT_FAILED, EXIT_OK};
 use crate::cli::AxesArgs;
 use motion_control::*;
-use motion_report::{print_json, ErrorEntry};
+use motion_report::print_json;
 use std::time::Duration;
 
 /// `stop` / `unhome`: one request, every axis's answer.
@@ -12,20 +12,7 @@ pub fn axes(client: &mut Client, kind: u32, a: &AxesArgs) -> i32 {
     };
     let what = if kind == REQ_STOP { "stop" } else { "unhome" };
     if resp.result != RESULT_ACCEPTED {
-        let mut errors = vec![ErrorEntry::message(format!(
-            "{what} refused: {}",
-            resp.message_text()
-        ))];
-        for x in resp.answers().iter().filter(|x| x.accepted == 0) {
-            errors.push(ErrorEntry {
-                axis: Some(get_str(&x.name)),
-                key: None,
-                err: (x.err != 0).then_some(x.err),
-                exerr: (x.err != 0).then_some(x.exerr),
-                message: reason_text(x.reason).into(),
-            });
-        }
-        return fail(a.json, errors, EXIT_FAILED);
+        return fail(a.json, resp.refusal(what, |x| x.accepted == 0), EXIT_FAILED);
     }
     let names: Vec<String> = resp.answers().iter().map(|x| get_str(&x.name)).collect();
     if a.json {

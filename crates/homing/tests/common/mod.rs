@@ -1,8 +1,94 @@
-//! Engine + plant in a loop, one cycle at a time.
+//! Engine + plant in a loop, one cycle at a time, and the machine most
+//! engine tests home on.
 #![allow(dead_code)]
 
 use motion_homing::*;
 use motion_plant::{Plant, PlantConfig};
+
+/// The test machine (raw units): hard stops at -100 and +100, the home
+/// switch over [0, 5], markers every 10 at 2.5 (... -7.5, 2.5, 12.5 ...);
+/// the axis starts at `start`.
+pub fn machine_at(start: f64) -> PlantConfig {
+    PlantConfig {
+        start,
+        switch: Some((0.0, 5.0)),
+        marker_every: 10.0,
+        marker_at: 2.5,
+        hard_stop: Some((-100.0, 100.0)),
+        ..PlantConfig::default()
+    }
+}
+
+/// The test machine with the axis at -50: a forward search meets the switch.
+pub fn machine() -> PlantConfig {
+    machine_at(-50.0)
+}
+
+/// An axis homing `seq` in direction `dir` on the test machine: 1000 counts
+/// per unit, a marker, home speed V = 20, return speed R = 2, acceleration
+/// and deceleration 500, travel limits ±100.
+pub fn axis(seq: HomeSequence, dir: HomeDirection) -> AxisConfig {
+    AxisConfig {
+        counts_per_unit: 1000.0,
+        marker: true,
+        home_sequence: seq,
+        home_direction: dir,
+        home_speed: 20.0,
+        home_return_speed: 2.0,
+        home_acceleration: 500.0,
+        home_deceleration: 500.0,
+        travel_limits: Some((-100.0, 100.0)),
+        ..AxisConfig::default()
+    }
+}
+
+/// The request to home, and nothing else.
+pub fn home() -> Request {
+    Request {
+        home: true,
+        ..Request::default()
+    }
+}
+
+/// Every step of a run of fixed length: the command and status after it,
+/// and the position the plant reported before it (`seen[k]`: what the
+/// engine saw at step k unless the frame was withheld or rewritten).
+pub struct Steps {
+    pub cmd: Vec<Command>,
+    pub st: Vec<Status>,
+    pub seen: Vec<f64>,
+}
+
+/// Homes from step 0 and steps engine and plant `n` times, `cycle_ns`
+/// apart. `frame(k, previous command, feedback)` is the frame the engine
+/// sees at step k (`None`: withheld).
+pub fn steps(
+    cfg: AxisConfig,
+    plant: PlantConfig,
+    cycle_ns: u64,
+    n: usize,
+    mut frame: impl FnMut(usize, &Command, Feedback) -> Option<Feedback>,
+) -> Steps {
+    let mut axis = Axis::new(cfg);
+    let mut plant = Plant::new(plant);
+    let mut fb = plant.feedback();
+    let req = home();
+    let mut s = Steps {
+        cmd: Vec::new(),
+        st: Vec::new(),
+        seen: Vec::new(),
+    };
+    let mut last = Command::default();
+    for k in 0..n {
+        let seen = frame(k, &last, fb);
+        last = axis.step(k as u64 * cycle_ns, seen.as_ref(), &req);
+        s.cmd.push(last);
+        s.st.push(*axis.status());
+        s.seen.push(fb.position);
+        fb = plant.step(&last, cycle_ns as f64 * 1e-9);
+    }
+    s
+}
 
 /// Result of one homing run.
 pub struct Outcome {
@@ -37,10 +123,7 @@ pub fn run_with(
     let mut axis = Axis::new(cfg);
     let mut plant = Plant::new(plant_cfg);
     let mut fb = plant.feedback();
-    let mut req = Request {
-        home: true,
-        ..Request::default()
-    };
+    let mut req = home();
     let mut commands = Vec::new();
     let max = (max_s / cycle_s) as usize;
     let mut settle = None;

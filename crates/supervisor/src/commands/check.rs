@@ -1,4 +1,4 @@
-use super::{entries, load};
+use super::load;
 use crate::cli::CheckArgs;
 use motion_report::{print_json, CheckReport};
 use motion_rt::{check_environment, RtConfig};
@@ -31,7 +31,7 @@ pub fn check(a: &CheckArgs) -> i32 {
             notes,
             warnings: m.warnings.clone(),
             environment,
-            errors: entries(&[]),
+            errors: Vec::new(),
         });
         return 0;
     }

@@ -1,10 +1,11 @@
-use super::{allocations, cpu, fail, load, options, rt_info, rt_lines};
+use super::{fail, load, options, print_run, run_report};
 use crate::cli::HomeArgs;
 use crate::session::Session;
+use motion_config::MachineConfig;
 use motion_control::homing::{home_and_follow, HomeOutcome, HomeRequest};
 use motion_control::progress::Progress;
 use motion_control::Client;
-use motion_report::{print_json, table, ErrorEntry, HomeReport};
+use motion_report::{print_json, table, AxisResult, ErrorEntry, HomeReport};
 use motion_rt::termination as signals;
 use std::time::Duration;
 
@@ -16,20 +17,8 @@ pub fn home(a: &HomeArgs) -> i32 {
         Ok(x) => x,
         Err(code) => return code,
     };
-    for n in &a.axes {
-        if m.axis_index(n).is_none() {
-            let known: Vec<&str> = m.axes.iter().map(|x| x.name.as_str()).collect();
-            return fail(
-                a.json,
-                vec![ErrorEntry {
-                    axis: Some(n.clone()),
-                    key: Some("axis".into()),
-                    message: format!("no axis {n} in {source} (axes: {})", known.join(", ")),
-                    ..ErrorEntry::default()
-                }],
-                2,
-            );
-        }
+    if let Err(code) = known_axes(a, &m, &source) {
+        return code;
     }
     let opts = options(&a.common, &m);
     let mut session = match Session::start(m, &opts) {
@@ -53,54 +42,7 @@ pub fn home(a: &HomeArgs) -> i32 {
             " in home order"
         }
     );
-    let mut errors = Vec::new();
-    let mut rows = Vec::new();
-    match Client::connect(&session.domain.prefix, Some(&session.domain.runtime_dir)) {
-        Err(e) => errors.push(ErrorEntry::message(format!("control service: {e}"))),
-        Ok(mut client) => {
-            let mut progress = Progress::new();
-            let said = std::cell::Cell::new(false);
-            let req = HomeRequest {
-                axes: a.axes.clone(),
-                parallel: a.parallel,
-                timeout_s: a.timeout,
-            };
-            match home_and_follow(
-                &mut client,
-                &req,
-                |st, members| progress.show(st, members),
-                || match signals::received() {
-                    Some(sig) => {
-                        if !said.replace(true) {
-                            log::info!("signal {sig}: stopping every axis");
-                        }
-                        true
-                    }
-                    None => false,
-                },
-            ) {
-                Ok(HomeOutcome::Done(r, _)) => rows = r,
-                Ok(HomeOutcome::Refused(resp)) => {
-                    errors.push(ErrorEntry::message(format!(
-                        "home refused: {}",
-                        resp.message_text()
-                    )));
-                    for ans in resp.answers() {
-                        if ans.accepted == 0 && ans.err != 0 {
-                            errors.push(ErrorEntry {
-                                axis: Some(motion_control::get_str(&ans.name)),
-                                key: None,
-                                err: Some(ans.err),
-                                exerr: Some(ans.exerr),
-                                message: motion_control::reason_text(ans.reason).into(),
-                            });
-                        }
-                    }
-                }
-                Err(e) => errors.push(ErrorEntry::message(e.to_string())),
-            }
-        }
-    }
+    let (rows, mut errors) = home_through_control(&session, a);
     for e in session.poll_children(false) {
         log::warn!("{e}");
     }
@@ -112,33 +54,90 @@ pub fn home(a: &HomeArgs) -> i32 {
     let f = session.finish();
     let report = HomeReport {
         axes: rows,
-        latency: f.latency.clone(),
-        io: f.io.clone(),
-        rt: rt_info(&f),
-        warnings: f.warnings.clone(),
-        allocations: allocations(&f),
-        cpu: cpu(&f),
-        errors: errors.clone(),
+        run: run_report(&f, errors),
     };
     if a.json {
         print_json(&report);
     } else {
         print!("{}", table::axis_results(&report.axes));
         println!();
-        print!("{}", report.latency.table());
-        for l in rt_lines(&f) {
-            println!("{l}");
-        }
-        for e in &errors {
+        print_run(&f, &report.run);
+        for e in &report.run.errors {
             log::error!("{}", e.message);
         }
     }
     if let Some(sig) = signals::received() {
         return 128 + sig;
     }
-    if !errors.is_empty() || report.axes.is_empty() || !report.axes.iter().all(|r| r.succeeded()) {
-        1
-    } else {
+    let homed = !report.axes.is_empty() && report.axes.iter().all(|r| r.succeeded());
+    if report.run.errors.is_empty() && homed {
         0
+    } else {
+        1
+    }
+}
+
+/// Every axis named on the command line is in the machine (exit code 2
+/// otherwise).
+fn known_axes(a: &HomeArgs, m: &MachineConfig, source: &str) -> Result<(), i32> {
+    for n in &a.axes {
+        if m.axis_index(n).is_none() {
+            let known: Vec<&str> = m.axes.iter().map(|x| x.name.as_str()).collect();
+            return Err(fail(
+                a.json,
+                vec![ErrorEntry {
+                    axis: Some(n.clone()),
+                    key: Some("axis".into()),
+                    message: format!("no axis {n} in {source} (axes: {})", known.join(", ")),
+                    ..ErrorEntry::default()
+                }],
+                2,
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Homes through the session's own control service and follows the homing
+/// to its end (a signal stops every axis): the rows, and what went wrong.
+fn home_through_control(session: &Session, a: &HomeArgs) -> (Vec<AxisResult>, Vec<ErrorEntry>) {
+    let mut client =
+        match Client::connect(&session.domain.prefix, Some(&session.domain.runtime_dir)) {
+            Ok(c) => c,
+            Err(e) => {
+                return (
+                    Vec::new(),
+                    vec![ErrorEntry::message(format!("control service: {e}"))],
+                )
+            }
+        };
+    let mut progress = Progress::new();
+    let said = std::cell::Cell::new(false);
+    let req = HomeRequest {
+        axes: a.axes.clone(),
+        parallel: a.parallel,
+        timeout_s: a.timeout,
+    };
+    let interrupted = || match signals::received() {
+        Some(sig) => {
+            if !said.replace(true) {
+                log::info!("signal {sig}: stopping every axis");
+            }
+            true
+        }
+        None => false,
+    };
+    match home_and_follow(
+        &mut client,
+        &req,
+        |st, members| progress.show(st, members),
+        interrupted,
+    ) {
+        Ok(HomeOutcome::Done(rows, _)) => (rows, Vec::new()),
+        Ok(HomeOutcome::Refused(resp)) => (
+            Vec::new(),
+            resp.refusal("home", |x| x.accepted == 0 && x.err != 0),
+        ),
+        Err(e) => (Vec::new(), vec![ErrorEntry::message(e.to_string())]),
     }
 }

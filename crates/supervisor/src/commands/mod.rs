@@ -9,7 +9,10 @@ mod run;
 use crate::cli::{Cli, Command, Common};
 use crate::session::{Finished, SessionOptions};
 use motion_config::{MachineConfig, Problem};
-use motion_report::{print_json, Allocations, CpuUse, ErrorEntry, ErrorReport, RtInfo};
+use motion_report::{Allocations, CpuUse, ErrorEntry, RtInfo, RunReport};
+
+/// How a command fails: a refused command line, and every other failure.
+pub use motion_report::errors::{argument_error, fail};
 
 pub fn run(c: Cli) -> i32 {
     match c.command {
@@ -19,48 +22,10 @@ pub fn run(c: Cli) -> i32 {
     }
 }
 
-/// A command line clap refused: its message (exit 2), or with `--json` in
-/// the arguments one JSON error object on stdout. `--help` / `--version`
-/// print and exit 0.
-pub fn argument_error(e: clap::Error) -> i32 {
-    use clap::error::ErrorKind;
-    match e.kind() {
-        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-            let _ = e.print();
-            return 0;
-        }
-        _ => {}
-    }
-    if std::env::args().any(|a| a == "--json") {
-        let text = e.render().to_string();
-        let first = text
-            .lines()
-            .next()
-            .unwrap_or("bad argument")
-            .trim_start_matches("error: ")
-            .to_string();
-        print_json(&ErrorReport::message(first));
-    } else {
-        let _ = e.print();
-    }
-    2
-}
-
 /// Problems as the JSON error entries of interface.md.
 pub fn entries(problems: &[Problem]) -> Vec<ErrorEntry> {
-    problems
-        .iter()
-        .map(|p| ErrorEntry {
-            axis: p.axis.clone(),
-            key: Some(p.key.clone()),
-            err: p.code.map(|c| c.0),
-            exerr: p.code.map(|c| c.1),
-            message: p.message.clone(),
-        })
-        .collect()
+    problems.iter().map(ErrorEntry::from).collect()
 }
-
-pub use motion_report::errors::fail;
 
 /// Loads the machine; on error reports every problem and returns exit code 2.
 fn load(common: &Common, json: bool) -> Result<(MachineConfig, String), i32> {
@@ -141,30 +106,41 @@ fn rt_lines(f: &Finished) -> Vec<String> {
     out
 }
 
-fn rt_info(f: &Finished) -> Option<RtInfo> {
-    f.outcome
-        .as_ref()
-        .and_then(|o| o.report.as_ref())
-        .map(|r| RtInfo {
-            cpu: r.cpu,
-            policy: r.policy.to_string(),
-            priority: r.priority,
-            memory_locked: r.memory_locked,
-            warnings: r.warnings.clone(),
-        })
-}
-
-fn allocations(f: &Finished) -> Allocations {
-    Allocations {
-        system_calls_in_cycle: f.system_calls_in_cycle,
-        pool_allocs_in_cycle: f.pool_allocs_in_cycle,
+/// What `run --json` reports of a finished session, and `home --json`
+/// after its rows.
+fn run_report(f: &Finished, errors: Vec<ErrorEntry>) -> RunReport {
+    RunReport {
+        latency: f.latency.clone(),
+        io: f.io.clone(),
+        rt: f
+            .outcome
+            .as_ref()
+            .and_then(|o| o.report.as_ref())
+            .map(|r| RtInfo {
+                cpu: r.cpu,
+                policy: r.policy.to_string(),
+                priority: r.priority,
+                memory_locked: r.memory_locked,
+                warnings: r.warnings.clone(),
+            }),
+        warnings: f.warnings.clone(),
+        allocations: Allocations {
+            system_calls_in_cycle: f.system_calls_in_cycle,
+            pool_allocs_in_cycle: f.pool_allocs_in_cycle,
+        },
+        cpu: CpuUse {
+            supervisor: f.supervisor_cpu,
+            io: f.io_cpu.clone(),
+            wall_s: f.wall_s,
+        },
+        errors,
     }
 }
 
-fn cpu(f: &Finished) -> CpuUse {
-    CpuUse {
-        supervisor: f.supervisor_cpu,
-        io: f.io_cpu.clone(),
-        wall_s: f.wall_s,
+/// The same as text: the latency table and the real-time lines.
+fn print_run(f: &Finished, report: &RunReport) {
+    print!("{}", report.latency.table());
+    for l in rt_lines(f) {
+        println!("{l}");
     }
 }

@@ -1,7 +1,7 @@
-use super::{allocations, cpu, fail, load, options, rt_info, rt_lines};
+use super::{fail, load, options, print_run, run_report};
 use crate::cli::RunArgs;
 use crate::session::Session;
-use motion_report::{print_json, ErrorEntry, RunReport};
+use motion_report::{print_json, ErrorEntry};
 use motion_rt::termination as signals;
 use std::time::{Duration, Instant};
 
@@ -66,26 +66,15 @@ pub fn run(a: &RunArgs) -> i32 {
         }
     }
     let f = session.finish();
-    let report = RunReport {
-        latency: f.latency.clone(),
-        io: f.io.clone(),
-        rt: rt_info(&f),
-        warnings: f.warnings.clone(),
-        allocations: allocations(&f),
-        cpu: cpu(&f),
-        errors: errors.clone(),
-    };
+    let report = run_report(&f, errors);
     if a.json {
         print_json(&report);
     } else {
-        print!("{}", report.latency.table());
-        for l in rt_lines(&f) {
-            println!("{l}");
-        }
+        print_run(&f, &report);
     }
-    if !errors.is_empty() {
-        1
-    } else {
+    if report.errors.is_empty() {
         0
+    } else {
+        1
     }
 }

@@ -18,14 +18,8 @@ pub fn identity(m: &MachineConfig, i: usize) -> AxisIdentity {
         .with("slot", slot)
         .with("counts_per_unit", e.counts_per_unit)
         .with("home_position", e.home_position)
-        .with(
-            "travel_mode",
-            motion_config::names::name_of(motion_config::names::TRAVEL_MODES, e.travel),
-        )
-        .with(
-            "home_mode",
-            motion_config::names::name_of(motion_config::names::HOME_MODES, e.home_mode),
-        )
+        .with("travel_mode", e.travel.name())
+        .with("home_mode", e.home_mode.name())
         .with("absolute", e.absolute);
     if e.travel == TravelMode::Cyclic {
         id = id.with("unwind", e.unwind);

@@ -5,7 +5,6 @@
 
 use super::{AxisKeep, AxisNote};
 use crate::shared::Snapshot;
-use motion_config::names::{name_of, HOME_DIRECTIONS, HOME_MODES, HOME_SEQUENCES};
 use motion_config::MachineConfig;
 use motion_control::{W_DRIFT, W_SWITCH_DRIFT};
 use motion_homing::{HomeMode, HomeSequence};
@@ -115,9 +114,9 @@ pub(super) fn entry(
         kind: Some(RecordKind::Homing),
         axis: cfg.name.clone(),
         gantry: m.gantry_of(i).map(|g| m.gantries[g].name.clone()),
-        mode: name_of(HOME_MODES, e.home_mode).into(),
-        sequence: name_of(HOME_SEQUENCES, e.home_sequence).into(),
-        direction: name_of(HOME_DIRECTIONS, e.home_direction).into(),
+        mode: e.home_mode.name().into(),
+        sequence: e.home_sequence.name().into(),
+        direction: e.home_direction.name().into(),
         result: result.into(),
         pc: s.pc,
         homed: s.homed,
