@@ -16,6 +16,7 @@
 //! * [`cleanup`] — leaving nothing behind in `/dev/shm`.
 //! * [`error`] — engineer-readable errors.
 
+pub mod backend;
 pub mod cleanup;
 pub mod convert;
 pub mod domain;

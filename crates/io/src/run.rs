@@ -18,9 +18,9 @@
 
 use std::time::Duration;
 
+use motion_frames::backend::Backend;
 use motion_frames::{monotonic_ns, Domain, FeedbackFrame, IoPorts, IpcError};
 
-use crate::backend::Backend;
 use crate::say::{Once, Say};
 use motion_rt::termination as signals;
 
