@@ -2,9 +2,7 @@
 
 use crate::keys::Reader;
 use crate::limits::*;
-use crate::{
-    names, AxisEntry, AxisEthercat, EthercatDrive, IoBackend, IoConfig, Problem, SupervisorConfig,
-};
+use crate::{names, AxisEntry, IoConfig, Problem, SupervisorConfig};
 use motion_homing::{validate, AxisConfig};
 use motion_plant::PlantConfig;
 
@@ -25,7 +23,7 @@ pub(crate) fn parse(
         .then(|| r.u32_in("home_order", 0, 0, 1000));
     let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
     let engine = engine(&mut r, sup);
-    let ethercat = parse_ethercat(&mut r, &engine, ios.get(io));
+    let ethercat = crate::ethercat::parse::axis_keys(&mut r, &engine, ios.get(io));
     let sim_table = r.table("sim");
     r.finish();
     let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
@@ -192,92 +190,6 @@ fn engine_problems(name: &str, engine: &AxisConfig, problems: &mut Vec<Problem>,
             problems.push(p);
         }
     }
-}
-
-/// The axis' EtherCAT keys: allowed on (and, but for a virtual axis,
-/// required by) an axis of an EtherCAT I/O process only.
-fn parse_ethercat(
-    r: &mut Reader<'_>,
-    engine: &AxisConfig,
-    io: Option<&IoConfig>,
-) -> Option<AxisEthercat> {
-    const KEYS: [&str; 3] = [
-        "ethercat_position",
-        "ethercat_name",
-        "ethercat_index_pulse_bit",
-    ];
-    let given: Vec<&str> = KEYS.iter().copied().filter(|k| r.has(k)).collect();
-    let io_name = io.map_or("?", |i| i.name.as_str());
-    let on_ethercat = io.is_some_and(|i| i.backend == IoBackend::Ethercat);
-    if !on_ethercat {
-        let backend = io.map_or("sim", |i| i.backend.name());
-        for k in given {
-            r.mark_used(k);
-            r.problem(
-                k,
-                format!(
-                    "only for an axis of an EtherCAT I/O process (its I/O process {io_name} \
-                     has backend = \"{backend}\")"
-                ),
-            );
-        }
-        return None;
-    }
-    if engine.configuration == motion_homing::AxisConfiguration::Virtual {
-        for k in given {
-            r.mark_used(k);
-            r.problem(k, "a virtual axis has no drive".into());
-        }
-        return None;
-    }
-    let position = r.has("ethercat_position").then(|| {
-        r.u32_in(
-            "ethercat_position",
-            0,
-            ETHERCAT_POSITION.0,
-            ETHERCAT_POSITION.1,
-        ) as u16
-    });
-    let name = r.has("ethercat_name").then(|| {
-        let n = r.string("ethercat_name", "");
-        if let Err(e) = names::check_subdevice_name(&n) {
-            r.problem("ethercat_name", e);
-        }
-        n
-    });
-    let index_pulse_bit = r.has("ethercat_index_pulse_bit").then(|| {
-        r.u32_in(
-            "ethercat_index_pulse_bit",
-            INDEX_PULSE_BIT.0,
-            INDEX_PULSE_BIT.0,
-            INDEX_PULSE_BIT.1,
-        ) as u8
-    });
-    let drive = match (position, name) {
-        (Some(p), None) => EthercatDrive::Position(p),
-        (None, Some(n)) => EthercatDrive::Name(n),
-        (Some(p), Some(_)) => {
-            r.problem(
-                "ethercat_name",
-                "give ethercat_position or ethercat_name, not both".into(),
-            );
-            EthercatDrive::Position(p)
-        }
-        (None, None) => {
-            r.problem(
-                "ethercat_position",
-                format!(
-                    "missing: an axis of EtherCAT I/O process {io_name} names its drive with \
-                     ethercat_position (bus position, 0 = first) or ethercat_name"
-                ),
-            );
-            EthercatDrive::Position(0)
-        }
-    };
-    Some(AxisEthercat {
-        drive,
-        index_pulse_bit,
-    })
 }
 
 fn parse_sim(

@@ -14,6 +14,7 @@ pub mod args;
 mod axis;
 #[cfg(feature = "cli-fuzz")]
 pub mod cli_fuzz;
+pub mod ethercat;
 pub mod file;
 mod gantry;
 mod io;
@@ -23,6 +24,7 @@ pub mod names;
 mod problem;
 mod supervisor;
 
+pub use ethercat::{AxisEthercat, EthercatBus, EthercatDc, EthercatDrive, EthercatIo};
 pub use gantry::{GantryConfig, MAX_SIDES};
 use keys::Reader;
 pub use problem::Problem;
@@ -78,64 +80,6 @@ motion_homing::spellings!(IoBackend {
     Ethercat => "ethercat",
 });
 
-/// Distributed clocks of an EtherCAT I/O process (`[[io]] dc`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum EthercatDc {
-    /// SYNC0 where the drive supports it, free run elsewhere.
-    #[default]
-    Auto,
-    /// SYNC0 on every drive; one without DC is a start-up error.
-    On,
-    /// Free run everywhere.
-    Off,
-}
-
-impl EthercatDc {
-    pub fn name(self) -> &'static str {
-        match self {
-            EthercatDc::Auto => "auto",
-            EthercatDc::On => "on",
-            EthercatDc::Off => "off",
-        }
-    }
-}
-
-/// The `[[io]]` keys of an I/O process with `backend = "ethercat"`
-/// (ranges in [`limits`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct EthercatIo {
-    /// Network interface of the EtherCAT segment (`motion-io --interface`
-    /// overrides it).
-    pub interface: String,
-    pub dc: EthercatDc,
-    /// SyncManager watchdog of the drives: they stop this long after the
-    /// last process data (a dead `motion-io`).
-    pub sm_watchdog_ms: u32,
-    /// A bus frame answered later than this counts as lost; `None`: 90 % of
-    /// the cycle.
-    pub reply_timeout_us: Option<u32>,
-    /// INIT → OP limit.
-    pub startup_timeout_s: u32,
-    /// Also map 0x6060 (modes of operation) into the RxPDO.
-    pub mode_in_pdo: bool,
-    /// Rounds of the distributed clocks' static drift compensation.
-    pub dc_static_sync_iterations: u32,
-}
-
-impl Default for EthercatIo {
-    fn default() -> Self {
-        EthercatIo {
-            interface: String::new(),
-            dc: EthercatDc::Auto,
-            sm_watchdog_ms: 50,
-            reply_timeout_us: None,
-            startup_timeout_s: 30,
-            mode_in_pdo: false,
-            dc_static_sync_iterations: 1000,
-        }
-    }
-}
-
 /// One drive-I/O process (`[[io]]`, or the implicit one named `io`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct IoConfig {
@@ -149,24 +93,6 @@ pub struct IoConfig {
     pub backend: IoBackend,
     /// `Some` exactly when `backend` is `Ethercat`.
     pub ethercat: Option<EthercatIo>,
-}
-
-/// How an axis of an EtherCAT I/O process finds its drive.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum EthercatDrive {
-    /// `ethercat_position`: position on the bus (0 = first after the master).
-    Position(u16),
-    /// `ethercat_name`: the SubDevice's name (unique on the bus).
-    Name(String),
-}
-
-/// The EtherCAT keys of an `[[axis]]`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct AxisEthercat {
-    pub drive: EthercatDrive,
-    /// `ethercat_index_pulse_bit`: manufacturer bit (16..=31) of 0x60FD
-    /// that reports an index pulse per cycle (`marker_latch = false` axes).
-    pub index_pulse_bit: Option<u8>,
 }
 
 /// `[supervisor]`.
@@ -323,7 +249,7 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
             ));
         }
     }
-    ethercat_checks(&ios, &axes, &mut problems);
+    ethercat::parse::checks(&ios, &axes, &mut problems);
     let gantries = gantry::parse(&gantry_tables, &axes, &mut problems);
     for (k, io) in ios.iter().enumerate() {
         if !axes.iter().any(|a| a.io == k) && problems.is_empty() {
@@ -340,48 +266,6 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
         })
     } else {
         Err(problems)
-    }
-}
-
-/// Across the axes of each EtherCAT I/O process: one drive per axis, and
-/// no more axes than the backend drives.
-fn ethercat_checks(ios: &[IoConfig], axes: &[AxisEntry], problems: &mut Vec<Problem>) {
-    for (k, io) in ios.iter().enumerate() {
-        if io.backend != IoBackend::Ethercat {
-            continue;
-        }
-        let mine: Vec<&AxisEntry> = axes.iter().filter(|a| a.io == k).collect();
-        if mine.len() > limits::ETHERCAT_MAX_AXES {
-            problems.push(Problem::new(
-                None,
-                "io",
-                format!(
-                    "EtherCAT I/O process {} drives {} axes, at most {}",
-                    io.name,
-                    mine.len(),
-                    limits::ETHERCAT_MAX_AXES
-                ),
-            ));
-        }
-        for (i, a) in mine.iter().enumerate() {
-            let Some(e) = &a.ethercat else { continue };
-            if let Some(b) = mine[..i]
-                .iter()
-                .find(|b| b.ethercat.as_ref().is_some_and(|f| f.drive == e.drive))
-            {
-                let (key, what) = match &e.drive {
-                    EthercatDrive::Position(p) => ("ethercat_position", format!("position {p}")),
-                    EthercatDrive::Name(n) => {
-                        ("ethercat_name", format!("name {}", names::shown(n)))
-                    }
-                };
-                problems.push(Problem::new(
-                    Some(&a.name),
-                    key,
-                    format!("the SubDevice at {what} already drives axis {}", b.name),
-                ));
-            }
-        }
     }
 }
 

@@ -13,7 +13,7 @@
 //! time: their SM watchdog expires.
 
 use std::io;
-use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::os::fd::AsRawFd;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
@@ -22,8 +22,10 @@ use std::time::{Duration, Instant};
 use crate::drive::{Drive, DriveConfig, DriveView};
 use crate::esc::{Esc, EscStats};
 
-/// EtherType of EtherCAT.
-pub const ETHERTYPE: u16 = 0x88A4;
+// The raw socket is the master's own (`motion_ethercat::socket`): plumbing,
+// not protocol, so sharing it cannot hide a misreading of the standard.
+pub use motion_ethercat::socket::ETHERTYPE;
+use motion_ethercat::socket::{PacketSocket, Wait};
 
 /// Frame-level counters.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -274,41 +276,6 @@ pub struct Emulator {
     thread: Option<JoinHandle<()>>,
 }
 
-fn open_socket(interface: &str) -> io::Result<(OwnedFd, i32)> {
-    let proto = ETHERTYPE.to_be() as i32;
-    // SAFETY: plain socket(2) call; the result is checked.
-    let fd = unsafe { libc::socket(libc::AF_PACKET, libc::SOCK_RAW, proto) };
-    if fd < 0 {
-        return Err(io::Error::last_os_error());
-    }
-    // SAFETY: fd is a fresh, owned descriptor.
-    let fd = unsafe { OwnedFd::from_raw_fd(fd) };
-    let name =
-        std::ffi::CString::new(interface).map_err(|_| io::Error::other("bad interface name"))?;
-    // SAFETY: name is a valid C string.
-    let ifindex = unsafe { libc::if_nametoindex(name.as_ptr()) };
-    if ifindex == 0 {
-        return Err(io::Error::last_os_error());
-    }
-    // SAFETY: zeroed sockaddr_ll is a valid value; fields set below.
-    let mut sa: libc::sockaddr_ll = unsafe { std::mem::zeroed() };
-    sa.sll_family = libc::AF_PACKET as u16;
-    sa.sll_protocol = ETHERTYPE.to_be();
-    sa.sll_ifindex = ifindex as i32;
-    // SAFETY: sa is a valid sockaddr_ll of the given size.
-    let r = unsafe {
-        libc::bind(
-            fd.as_raw_fd(),
-            (&sa as *const libc::sockaddr_ll).cast(),
-            std::mem::size_of::<libc::sockaddr_ll>() as u32,
-        )
-    };
-    if r < 0 {
-        return Err(io::Error::last_os_error());
-    }
-    Ok((fd, ifindex as i32))
-}
-
 fn enter_netns(name: &str) -> io::Result<()> {
     let path = format!("/var/run/netns/{name}");
     let f = std::fs::File::open(&path)?;
@@ -344,9 +311,9 @@ impl Emulator {
                         if let Some(ns) = &cfg.netns {
                             enter_netns(ns)?;
                         }
-                        open_socket(&cfg.interface)
+                        PacketSocket::open(&cfg.interface)
                     })();
-                    let (fd, _ifindex) = match opened {
+                    let socket = match opened {
                         Ok(x) => {
                             let _ = tx.send(Ok(()));
                             x
@@ -359,7 +326,7 @@ impl Emulator {
                     if let Some(p) = cfg.priority {
                         set_fifo(p);
                     }
-                    serve(fd, &chain, &stop);
+                    serve(&socket, &chain, &stop);
                 })?
         };
         match rx.recv() {
@@ -454,55 +421,25 @@ impl Drop for Emulator {
     }
 }
 
-fn serve(fd: OwnedFd, chain: &Mutex<Chain>, stop: &AtomicBool) {
+fn serve(socket: &PacketSocket, chain: &Mutex<Chain>, stop: &AtomicBool) {
     let mut buf = vec![0u8; 2048];
     while !stop.load(Ordering::Relaxed) {
-        let mut pfd = libc::pollfd {
-            fd: fd.as_raw_fd(),
-            events: libc::POLLIN,
-            revents: 0,
-        };
-        // SAFETY: one valid pollfd.
-        let r = unsafe { libc::poll(&mut pfd, 1, 1) };
-        let broken = libc::POLLERR | libc::POLLHUP | libc::POLLNVAL;
-        if r > 0 && pfd.revents & libc::POLLIN == 0 && pfd.revents & broken != 0 {
+        match socket.wait(1_000_000) {
             // interface gone: do not spin
-            std::thread::sleep(Duration::from_millis(1));
-        } else if r > 0 {
-            loop {
-                // SAFETY: zeroed sockaddr_ll is valid; lengths match.
-                let mut sa: libc::sockaddr_ll = unsafe { std::mem::zeroed() };
-                let mut sl = std::mem::size_of::<libc::sockaddr_ll>() as u32;
-                // SAFETY: buf is valid for its length; sa/sl as above.
-                let n = unsafe {
-                    libc::recvfrom(
-                        fd.as_raw_fd(),
-                        buf.as_mut_ptr().cast(),
-                        buf.len(),
-                        libc::MSG_DONTWAIT,
-                        (&mut sa as *mut libc::sockaddr_ll).cast(),
-                        &mut sl,
-                    )
-                };
-                if n <= 0 {
-                    break;
-                }
-                if sa.sll_pkttype == libc::PACKET_OUTGOING {
-                    continue; // our own replies
-                }
-                let n = n as usize;
-                let now = Instant::now();
-                let reply = {
-                    let mut c = chain.lock().unwrap_or_else(|e| e.into_inner());
-                    c.process(&mut buf[..n], now)
-                };
-                if reply {
-                    // SAFETY: sends n valid bytes on the bound socket.
-                    unsafe {
-                        libc::send(fd.as_raw_fd(), buf.as_ptr().cast(), n, 0);
+            Wait::Broken => std::thread::sleep(Duration::from_millis(1)),
+            Wait::Readable => {
+                while let Some(n) = socket.recv(&mut buf) {
+                    let now = Instant::now();
+                    let reply = {
+                        let mut c = chain.lock().unwrap_or_else(|e| e.into_inner());
+                        c.process(&mut buf[..n], now)
+                    };
+                    if reply {
+                        socket.send(&buf[..n]);
                     }
                 }
             }
+            Wait::TimedOut => {}
         }
         let now = Instant::now();
         chain.lock().unwrap_or_else(|e| e.into_inner()).poll(now);

@@ -50,6 +50,14 @@ pub struct CoeServer {
     pub stats: CoeStats,
 }
 
+/// Index and sub-index of an SDO request.
+fn header(sdo: &[u8]) -> Option<(u16, u8)> {
+    Some((
+        u16::from_le_bytes([*sdo.get(1)?, *sdo.get(2)?]),
+        *sdo.get(3)?,
+    ))
+}
+
 fn mbx_header(len: usize, kind: u8, counter: u8) -> Vec<u8> {
     let mut v = Vec::with_capacity(6 + len);
     v.extend_from_slice(&(len as u16).to_le_bytes());
@@ -110,180 +118,15 @@ impl CoeServer {
         preop: bool,
         mbx_size: usize,
     ) -> Option<Vec<u8>> {
-        if req.len() < 6 {
-            return Some(self.mailbox_error(0x0002));
-        }
-        let len = usize::from(u16::from_le_bytes([req[0], req[1]]));
-        let kind = req[5] & 0x0F;
-        if kind != TYPE_COE {
-            // unsupported protocol
-            return Some(self.mailbox_error(0x0002));
-        }
-        if len < 2 || 6 + len > req.len() {
-            return Some(self.mailbox_error(0x0005)); // invalid size
-        }
-        let body = &req[6..6 + len];
-        let service = body[1] >> 4;
-        if service != SERVICE_SDO_REQUEST {
-            return Some(self.mailbox_error(0x0002));
-        }
-        self.stats.requests += 1;
-        if body.len() < 3 {
-            return Some(self.abort(0, 0, abort::INVALID_COMMAND));
-        }
-        let sdo = &body[2..];
-        let cmd = sdo[0];
-        let ccs = cmd >> 5;
-        let header = |sdo: &[u8]| -> Option<(u16, u8)> {
-            Some((
-                u16::from_le_bytes([*sdo.get(1)?, *sdo.get(2)?]),
-                *sdo.get(3)?,
-            ))
+        let sdo = match self.sdo_request(req) {
+            Ok(sdo) => sdo,
+            Err(answer) => return Some(answer),
         };
-        match ccs {
-            // initiate download
-            1 => {
-                let Some((index, sub)) = header(sdo) else {
-                    return Some(self.abort(0, 0, abort::INVALID_COMMAND));
-                };
-                if cmd & 0x10 != 0 {
-                    return Some(self.abort(index, sub, abort::NO_COMPLETE_ACCESS));
-                }
-                self.upload = None;
-                self.download = None;
-                if sdo.len() < 8 {
-                    return Some(self.abort(index, sub, abort::INVALID_COMMAND));
-                }
-                if cmd & 0x02 != 0 {
-                    // expedited
-                    let n = if cmd & 0x01 != 0 {
-                        4 - usize::from((cmd >> 2) & 0x03)
-                    } else {
-                        usize::from(drive.od.bits(index, sub) / 8).clamp(1, 4)
-                    };
-                    let data = &sdo[4..4 + n];
-                    match drive.sdo_download(index, sub, data, preop) {
-                        Ok(()) => Some(self.download_ok(index, sub)),
-                        Err(code) => Some(self.abort(index, sub, code)),
-                    }
-                } else {
-                    let size = u32::from_le_bytes([sdo[4], sdo[5], sdo[6], sdo[7]]) as usize;
-                    let data = &sdo[8..];
-                    if data.len() >= size {
-                        match drive.sdo_download(index, sub, &data[..size], preop) {
-                            Ok(()) => Some(self.download_ok(index, sub)),
-                            Err(code) => Some(self.abort(index, sub, code)),
-                        }
-                    } else {
-                        // the rest follows in segments; check the target now
-                        if let Err(code) = drive.od.entry(index, sub).map(|_| ()) {
-                            return Some(self.abort(index, sub, code));
-                        }
-                        self.download = Some(DownloadState {
-                            index,
-                            sub,
-                            size,
-                            data: data.to_vec(),
-                            toggle: false,
-                        });
-                        Some(self.download_ok(index, sub))
-                    }
-                }
-            }
-            // download segment
-            0 => {
-                let Some(mut st) = self.download.take() else {
-                    return Some(self.abort(0, 0, abort::INVALID_COMMAND));
-                };
-                let toggle = cmd & 0x10 != 0;
-                if toggle != st.toggle {
-                    return Some(self.abort(st.index, st.sub, abort::TOGGLE_BIT));
-                }
-                let last = cmd & 0x01 != 0;
-                let mut seg = &sdo[1..];
-                if seg.len() == 7 {
-                    let unused = usize::from((cmd >> 1) & 0x07);
-                    seg = &seg[..7 - unused];
-                }
-                st.data.extend_from_slice(seg);
-                self.stats.segments_down += 1;
-                let resp = [0x20 | (u8::from(toggle) << 4), 0, 0, 0, 0, 0, 0, 0];
-                if last {
-                    if st.data.len() != st.size {
-                        return Some(self.abort(st.index, st.sub, abort::LENGTH_MISMATCH));
-                    }
-                    if let Err(code) = drive.sdo_download(st.index, st.sub, &st.data, preop) {
-                        return Some(self.abort(st.index, st.sub, code));
-                    }
-                } else {
-                    st.toggle = !st.toggle;
-                    self.download = Some(st);
-                }
-                Some(self.sdo_response(&resp))
-            }
-            // initiate upload
-            2 => {
-                let Some((index, sub)) = header(sdo) else {
-                    return Some(self.abort(0, 0, abort::INVALID_COMMAND));
-                };
-                if cmd & 0x10 != 0 {
-                    return Some(self.abort(index, sub, abort::NO_COMPLETE_ACCESS));
-                }
-                self.upload = None;
-                self.download = None;
-                let data = match drive.od.upload(index, sub) {
-                    Ok(d) => d,
-                    Err(code) => return Some(self.abort(index, sub, code)),
-                };
-                let mut r = vec![0u8; 8];
-                r[1..3].copy_from_slice(&index.to_le_bytes());
-                r[3] = sub;
-                if data.len() <= 4 && !data.is_empty() {
-                    r[0] = 0x40 | 0x02 | 0x01 | (((4 - data.len()) as u8) << 2);
-                    r[4..4 + data.len()].copy_from_slice(&data);
-                    Some(self.sdo_response(&r))
-                } else {
-                    r[0] = 0x41;
-                    r[4..8].copy_from_slice(&(data.len() as u32).to_le_bytes());
-                    // header 6 + CoE 2 + SDO 8 = 16 bytes before the data
-                    if data.len() <= mbx_size.saturating_sub(16) {
-                        r.extend_from_slice(&data);
-                    } else {
-                        self.upload = Some(UploadState {
-                            data,
-                            offset: 0,
-                            toggle: false,
-                        });
-                    }
-                    Some(self.sdo_response(&r))
-                }
-            }
-            // upload segment
-            3 => {
-                let Some(mut st) = self.upload.take() else {
-                    return Some(self.abort(0, 0, abort::INVALID_COMMAND));
-                };
-                let toggle = cmd & 0x10 != 0;
-                if toggle != st.toggle {
-                    return Some(self.abort(0, 0, abort::TOGGLE_BIT));
-                }
-                // header 6 + CoE 2 + command 1
-                let room = mbx_size.saturating_sub(9).max(7);
-                let rest = st.data.len() - st.offset;
-                let n = rest.min(room);
-                let last = n == rest;
-                let unused = 7usize.saturating_sub(n);
-                let mut r = vec![(u8::from(toggle) << 4) | ((unused as u8) << 1) | u8::from(last)];
-                r.extend_from_slice(&st.data[st.offset..st.offset + n]);
-                r.resize(1 + n.max(7), 0);
-                st.offset += n;
-                st.toggle = !st.toggle;
-                self.stats.segments_up += 1;
-                if !last {
-                    self.upload = Some(st);
-                }
-                Some(self.sdo_response(&r))
-            }
+        match sdo[0] >> 5 {
+            1 => Some(self.initiate_download(sdo, drive, preop)),
+            0 => Some(self.download_segment(sdo, drive, preop)),
+            2 => Some(self.initiate_upload(sdo, drive, mbx_size)),
+            3 => Some(self.upload_segment(sdo[0], mbx_size)),
             // abort from the client: drop the transfer, no answer
             4 => {
                 self.upload = None;
@@ -295,6 +138,195 @@ impl CoeServer {
                 Some(self.abort(index, sub, abort::INVALID_COMMAND))
             }
         }
+    }
+
+    /// The SDO of a CoE SDO request (at least the command byte); `Err`: the
+    /// mailbox error or abort to answer instead.
+    fn sdo_request<'r>(&mut self, req: &'r [u8]) -> Result<&'r [u8], Vec<u8>> {
+        if req.len() < 6 {
+            return Err(self.mailbox_error(0x0002));
+        }
+        let len = usize::from(u16::from_le_bytes([req[0], req[1]]));
+        let kind = req[5] & 0x0F;
+        if kind != TYPE_COE {
+            // unsupported protocol
+            return Err(self.mailbox_error(0x0002));
+        }
+        if len < 2 || 6 + len > req.len() {
+            return Err(self.mailbox_error(0x0005)); // invalid size
+        }
+        let body = &req[6..6 + len];
+        let service = body[1] >> 4;
+        if service != SERVICE_SDO_REQUEST {
+            return Err(self.mailbox_error(0x0002));
+        }
+        self.stats.requests += 1;
+        if body.len() < 3 {
+            return Err(self.abort(0, 0, abort::INVALID_COMMAND));
+        }
+        Ok(&body[2..])
+    }
+
+    /// Index and sub-index of an initiate request (no complete access); a
+    /// new transfer ends a running one. `Err`: the abort to answer.
+    fn initiate(&mut self, sdo: &[u8]) -> Result<(u16, u8), Vec<u8>> {
+        let Some((index, sub)) = header(sdo) else {
+            return Err(self.abort(0, 0, abort::INVALID_COMMAND));
+        };
+        if sdo[0] & 0x10 != 0 {
+            return Err(self.abort(index, sub, abort::NO_COMPLETE_ACCESS));
+        }
+        self.upload = None;
+        self.download = None;
+        Ok((index, sub))
+    }
+
+    /// Initiate download: expedited, normal (all data in the request), or
+    /// the first bytes of a segmented one.
+    fn initiate_download(&mut self, sdo: &[u8], drive: &mut Drive, preop: bool) -> Vec<u8> {
+        let (index, sub) = match self.initiate(sdo) {
+            Ok(x) => x,
+            Err(answer) => return answer,
+        };
+        if sdo.len() < 8 {
+            return self.abort(index, sub, abort::INVALID_COMMAND);
+        }
+        let cmd = sdo[0];
+        if cmd & 0x02 != 0 {
+            // expedited
+            let n = if cmd & 0x01 != 0 {
+                4 - usize::from((cmd >> 2) & 0x03)
+            } else {
+                usize::from(drive.od.bits(index, sub) / 8).clamp(1, 4)
+            };
+            return self.download(drive, index, sub, &sdo[4..4 + n], preop);
+        }
+        let size = u32::from_le_bytes([sdo[4], sdo[5], sdo[6], sdo[7]]) as usize;
+        let data = &sdo[8..];
+        if data.len() >= size {
+            return self.download(drive, index, sub, &data[..size], preop);
+        }
+        // the rest follows in segments; check the target now
+        if let Err(code) = drive.od.entry(index, sub).map(|_| ()) {
+            return self.abort(index, sub, code);
+        }
+        self.download = Some(DownloadState {
+            index,
+            sub,
+            size,
+            data: data.to_vec(),
+            toggle: false,
+        });
+        self.download_ok(index, sub)
+    }
+
+    /// The drive takes `data`: the download response, or the abort.
+    fn download(
+        &mut self,
+        drive: &mut Drive,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+        preop: bool,
+    ) -> Vec<u8> {
+        match drive.sdo_download(index, sub, data, preop) {
+            Ok(()) => self.download_ok(index, sub),
+            Err(code) => self.abort(index, sub, code),
+        }
+    }
+
+    /// Download segment: appended; the last one is handed to the drive.
+    fn download_segment(&mut self, sdo: &[u8], drive: &mut Drive, preop: bool) -> Vec<u8> {
+        let Some(mut st) = self.download.take() else {
+            return self.abort(0, 0, abort::INVALID_COMMAND);
+        };
+        let cmd = sdo[0];
+        let toggle = cmd & 0x10 != 0;
+        if toggle != st.toggle {
+            return self.abort(st.index, st.sub, abort::TOGGLE_BIT);
+        }
+        let last = cmd & 0x01 != 0;
+        let mut seg = &sdo[1..];
+        if seg.len() == 7 {
+            let unused = usize::from((cmd >> 1) & 0x07);
+            seg = &seg[..7 - unused];
+        }
+        st.data.extend_from_slice(seg);
+        self.stats.segments_down += 1;
+        let resp = [0x20 | (u8::from(toggle) << 4), 0, 0, 0, 0, 0, 0, 0];
+        if last {
+            if st.data.len() != st.size {
+                return self.abort(st.index, st.sub, abort::LENGTH_MISMATCH);
+            }
+            if let Err(code) = drive.sdo_download(st.index, st.sub, &st.data, preop) {
+                return self.abort(st.index, st.sub, code);
+            }
+        } else {
+            st.toggle = !st.toggle;
+            self.download = Some(st);
+        }
+        self.sdo_response(&resp)
+    }
+
+    /// Initiate upload: expedited (≤ 4 bytes), normal (fits the mailbox),
+    /// or the size now and the data in segments.
+    fn initiate_upload(&mut self, sdo: &[u8], drive: &Drive, mbx_size: usize) -> Vec<u8> {
+        let (index, sub) = match self.initiate(sdo) {
+            Ok(x) => x,
+            Err(answer) => return answer,
+        };
+        let data = match drive.od.upload(index, sub) {
+            Ok(d) => d,
+            Err(code) => return self.abort(index, sub, code),
+        };
+        let mut r = vec![0u8; 8];
+        r[1..3].copy_from_slice(&index.to_le_bytes());
+        r[3] = sub;
+        if data.len() <= 4 && !data.is_empty() {
+            r[0] = 0x40 | 0x02 | 0x01 | (((4 - data.len()) as u8) << 2);
+            r[4..4 + data.len()].copy_from_slice(&data);
+            return self.sdo_response(&r);
+        }
+        r[0] = 0x41;
+        r[4..8].copy_from_slice(&(data.len() as u32).to_le_bytes());
+        // header 6 + CoE 2 + SDO 8 = 16 bytes before the data
+        if data.len() <= mbx_size.saturating_sub(16) {
+            r.extend_from_slice(&data);
+        } else {
+            self.upload = Some(UploadState {
+                data,
+                offset: 0,
+                toggle: false,
+            });
+        }
+        self.sdo_response(&r)
+    }
+
+    /// Upload segment: the next piece of the running upload.
+    fn upload_segment(&mut self, cmd: u8, mbx_size: usize) -> Vec<u8> {
+        let Some(mut st) = self.upload.take() else {
+            return self.abort(0, 0, abort::INVALID_COMMAND);
+        };
+        let toggle = cmd & 0x10 != 0;
+        if toggle != st.toggle {
+            return self.abort(0, 0, abort::TOGGLE_BIT);
+        }
+        // header 6 + CoE 2 + command 1
+        let room = mbx_size.saturating_sub(9).max(7);
+        let rest = st.data.len() - st.offset;
+        let n = rest.min(room);
+        let last = n == rest;
+        let unused = 7usize.saturating_sub(n);
+        let mut r = vec![(u8::from(toggle) << 4) | ((unused as u8) << 1) | u8::from(last)];
+        r.extend_from_slice(&st.data[st.offset..st.offset + n]);
+        r.resize(1 + n.max(7), 0);
+        st.offset += n;
+        st.toggle = !st.toggle;
+        self.stats.segments_up += 1;
+        if !last {
+            self.upload = Some(st);
+        }
+        self.sdo_response(&r)
     }
 
     fn download_ok(&mut self, index: u16, sub: u8) -> Vec<u8> {

@@ -5,13 +5,16 @@
 //!
 //! * [`chain`] — the wire: frames in chain order, datagram commands,
 //!   working counters, unplug / re-plug, the emulator thread
-//!   ([`Emulator`]).
+//!   ([`Emulator`]) on the backend's raw socket (`motion_ethercat::socket`,
+//!   the only piece of the backend it uses).
 //! * [`esc`] — one ESC: registers, SII, FMMUs, sync managers, AL state
 //!   machine, DC registers, SM watchdog.
 //! * [`sii`] — the generated SII EEPROM image.
 //! * [`coe`] — the mailbox CoE SDO server.
 //! * [`od`] — the object dictionary.
-//! * [`drive`] — the CiA 402 drive over the plant, touch probes.
+//! * [`drive`] — the CiA 402 drive over the plant: its config, object
+//!   dictionary, PDO image, SDO rules, state machine (independent of the
+//!   backend's on purpose), motion, touch probes, inputs — a file each.
 //! * [`netns`] — a veth pair with one end in a network namespace (tests).
 
 pub mod chain;

@@ -88,6 +88,14 @@ impl VethPair {
     }
 }
 
+impl VethPair {
+    /// [`VethPair::new`], or `None` after printing why the test calling it
+    /// is skipped (`SKIPPED: needs root and ip netns (…)`).
+    pub fn or_skip() -> Option<VethPair> {
+        VethPair::new().map_err(|skip| eprintln!("{skip}")).ok()
+    }
+}
+
 impl Drop for VethPair {
     fn drop(&mut self) {
         let _ = ip(&["link", "del", &self.master]);

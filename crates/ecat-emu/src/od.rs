@@ -51,6 +51,19 @@ pub struct Entry {
     pub data: Vec<u8>,
 }
 
+impl Entry {
+    /// A numeric entry holding `value` (little endian, `bits / 8` bytes).
+    fn number(bits: u16, access: Access, map: Mappable, value: u64) -> Entry {
+        Entry {
+            bits,
+            access,
+            map,
+            string: false,
+            data: value.to_le_bytes()[..usize::from(bits / 8)].to_vec(),
+        }
+    }
+}
+
 /// The dictionary.
 #[derive(Clone, Debug, Default)]
 pub struct Od {
@@ -74,16 +87,8 @@ impl Od {
         value: u64,
     ) {
         self.names.insert(index, name);
-        self.entries.insert(
-            (index, 0),
-            Entry {
-                bits,
-                access,
-                map,
-                string: false,
-                data: value.to_le_bytes()[..usize::from(bits / 8)].to_vec(),
-            },
-        );
+        self.entries
+            .insert((index, 0), Entry::number(bits, access, map, value));
     }
 
     /// A visible-string object (sub-index 0), read only.
@@ -117,26 +122,12 @@ impl Od {
         subs: &[(u16, Access, Mappable, u64)],
     ) {
         self.names.insert(index, name);
-        self.entries.insert(
-            (index, 0),
-            Entry {
-                bits: 8,
-                access: sub0,
-                map: Mappable::No,
-                string: false,
-                data: vec![subs.len() as u8],
-            },
-        );
+        let count = Entry::number(8, sub0, Mappable::No, subs.len() as u64);
+        self.entries.insert((index, 0), count);
         for (i, &(bits, access, map, value)) in subs.iter().enumerate() {
             self.entries.insert(
                 (index, i as u8 + 1),
-                Entry {
-                    bits,
-                    access,
-                    map,
-                    string: false,
-                    data: value.to_le_bytes()[..usize::from(bits / 8)].to_vec(),
-                },
+                Entry::number(bits, access, map, value),
             );
         }
     }

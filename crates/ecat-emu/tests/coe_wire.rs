@@ -18,12 +18,8 @@ use motion_ethercat::io::BusIo;
 
 #[test]
 fn segmented_upload_through_ethercrab() {
-    let pair = match VethPair::new() {
-        Ok(p) => p,
-        Err(skip) => {
-            eprintln!("{skip}");
-            return;
-        }
+    let Some(pair) = VethPair::or_skip() else {
+        return;
     };
     let mut d = DriveConfig::new("EMU-0");
     let long: String = (0..200)

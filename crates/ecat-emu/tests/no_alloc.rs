@@ -5,7 +5,10 @@
 use std::time::{Duration, Instant};
 
 use ecat_emu::{DriveConfig, Emulator, EmulatorConfig, VethPair};
-use motion_ethercat::{AxisMapping, EthercatBackend, EthercatConfig, SubDeviceSelector};
+use motion_config::ethercat::BusAxis;
+use motion_config::{AxisEthercat, EthercatBus, EthercatDrive};
+use motion_ethercat::EthercatBackend;
+use motion_frames::backend::Backend;
 use motion_frames::{CommandFrame, FeedbackFrame, CW_ENABLE, SW_ENABLED};
 
 #[global_allocator]
@@ -13,12 +16,8 @@ static A: motion_rt::RtAllocator = motion_rt::RtAllocator;
 
 #[test]
 fn exchange_and_bus_cycle_do_not_allocate() {
-    let pair = match VethPair::new() {
-        Ok(p) => p,
-        Err(skip) => {
-            eprintln!("{skip}");
-            return;
-        }
+    let Some(pair) = VethPair::or_skip() else {
+        return;
     };
     let _emu = Emulator::start(EmulatorConfig {
         interface: pair.subdevice.clone(),
@@ -28,19 +27,15 @@ fn exchange_and_bus_cycle_do_not_allocate() {
     })
     .unwrap();
     let axes = (0..2)
-        .map(|i| AxisMapping {
+        .map(|i| BusAxis {
             name: format!("A{i}"),
-            subdevice: SubDeviceSelector::Position(i),
-            counts_per_unit: 1000.0,
-            index_pulse_bit: None,
+            ethercat: AxisEthercat {
+                drive: EthercatDrive::Position(i),
+                index_pulse_bit: None,
+            },
         })
         .collect();
-    let mut b = EthercatBackend::new(EthercatConfig::new(
-        &pair.master,
-        Duration::from_millis(1),
-        axes,
-    ))
-    .expect("start-up");
+    let mut b = EthercatBackend::new(EthercatBus::new(&pair.master, 1000, axes)).expect("start-up");
     let mut cmd = CommandFrame::ZERO;
     cmd.header.axis_count = 2;
     let mut fb = FeedbackFrame::ZERO;

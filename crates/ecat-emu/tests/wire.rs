@@ -12,18 +12,19 @@ use std::process::{Command, Stdio};
 use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use ecat_emu::{DriveConfig, Emulator, EmulatorConfig, State, TorqueObjects, VethPair};
-use motion_ethercat::{
-    AxisMapping, DcMode, EthercatBackend, EthercatConfig, SubDeviceSelector, SyncMode,
-};
+use ecat_emu::{DriveConfig, DriveView, Emulator, EmulatorConfig, State, TorqueObjects, VethPair};
+use motion_config::ethercat::BusAxis;
+use motion_config::{AxisEthercat, EthercatBus, EthercatDc, EthercatDrive};
+use motion_ethercat::{EthercatBackend, SyncMode};
+use motion_frames::backend::Backend;
 use motion_frames::{
-    AxisCommand, CommandFrame, FeedbackFrame, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE,
-    DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED,
-    SW_FAULT, SW_NO_DATA,
+    AxisCommand, AxisFeedback, CommandFrame, FeedbackFrame, CW_ENABLE, DI_HOME_SWITCH,
+    DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING,
+    SW_ENABLED, SW_FAULT, SW_NO_DATA,
 };
 
-const CPU: f64 = 1000.0;
 const CYCLE: Duration = Duration::from_millis(1);
+const CYCLE_US: u32 = 1000;
 
 static TURN: Mutex<()> = Mutex::new(());
 
@@ -52,13 +53,15 @@ struct Rig {
     next: Instant,
 }
 
-fn mapping(n: usize) -> Vec<AxisMapping> {
+/// Axes A0.. on the drives at positions 0.., the index pulse on bit 16.
+fn mapping(n: usize) -> Vec<BusAxis> {
     (0..n)
-        .map(|i| AxisMapping {
+        .map(|i| BusAxis {
             name: format!("A{i}"),
-            subdevice: SubDeviceSelector::Position(i as u16),
-            counts_per_unit: CPU,
-            index_pulse_bit: Some(16),
+            ethercat: AxisEthercat {
+                drive: EthercatDrive::Position(i as u16),
+                index_pulse_bit: Some(16),
+            },
         })
         .collect()
 }
@@ -74,17 +77,11 @@ fn emulator(pair: &VethPair, drives: Vec<DriveConfig>) -> Emulator {
 }
 
 /// Pair + emulator + backend, or `None` (skipped, reason printed).
-fn rig_with(drives: Vec<DriveConfig>, tweak: impl FnOnce(&mut EthercatConfig)) -> Option<Rig> {
-    let pair = match VethPair::new() {
-        Ok(p) => p,
-        Err(skip) => {
-            eprintln!("{skip}");
-            return None;
-        }
-    };
+fn rig_with(drives: Vec<DriveConfig>, tweak: impl FnOnce(&mut EthercatBus)) -> Option<Rig> {
+    let pair = VethPair::or_skip()?;
     let n = drives.len();
     let emu = emulator(&pair, drives);
-    let mut cfg = EthercatConfig::new(&pair.master, CYCLE, mapping(n));
+    let mut cfg = EthercatBus::new(&pair.master, CYCLE_US, mapping(n));
     tweak(&mut cfg);
     let backend = EthercatBackend::new(cfg).unwrap_or_else(|e| panic!("start-up: {e}"));
     let mut cmd = CommandFrame::ZERO;
@@ -131,6 +128,16 @@ impl Rig {
         &mut self.cmd.axes[i]
     }
 
+    /// What emulated drive `i` does.
+    fn drive(&self, i: usize) -> DriveView {
+        self.emu().view(i).expect("drive").drive
+    }
+
+    /// Ticks until axis `i`'s feedback satisfies `pred`, at most 2 s.
+    fn until_axis(&mut self, i: usize, what: &str, pred: impl Fn(&AxisFeedback) -> bool) -> usize {
+        self.until(what, Duration::from_secs(2), |r| pred(&r.fb.axes[i]))
+    }
+
     /// Ticks until `pred` holds (returns the ticks taken) or panics after
     /// `max`.
     fn until(&mut self, what: &str, max: Duration, mut pred: impl FnMut(&Rig) -> bool) -> usize {
@@ -159,16 +166,12 @@ impl Rig {
 
     /// Enables axis `i` the way the engine does: target = actual.
     fn enable(&mut self, i: usize) {
-        self.until("feedback", Duration::from_secs(2), |r| {
-            r.fb.axes[i].status_word & SW_NO_DATA == 0
-        });
+        self.until_axis(i, "feedback", |a| a.status_word & SW_NO_DATA == 0);
         let at = self.fb.axes[i].position;
         let a = self.axis(i);
         a.target_position = at;
         a.control_word = CW_ENABLE;
-        self.until("enabled", Duration::from_secs(2), |r| {
-            r.fb.axes[i].status_word & SW_ENABLED != 0
-        });
+        self.until_axis(i, "enabled", |a| a.status_word & SW_ENABLED != 0);
     }
 
     /// Moves axis `i` to `to` counts at `speed` counts per cycle.
@@ -186,8 +189,8 @@ impl Rig {
 
     fn settle(&mut self, i: usize) {
         let to = self.cmd.axes[i].target_position;
-        self.until("settled", Duration::from_secs(2), |r| {
-            r.fb.axes[i].position == to && r.fb.axes[i].status_word & SW_NO_DATA == 0
+        self.until_axis(i, "settled", |a| {
+            a.position == to && a.status_word & SW_NO_DATA == 0
         });
     }
 }
@@ -236,11 +239,11 @@ fn startup_maps_pdos_and_reports_dc_and_free_run() {
     for (i, a) in r.fb.axes[..2].iter().enumerate() {
         assert_eq!(a.status_word & SW_NO_DATA, 0, "axis {i}");
     }
-    assert!(r.emu().view(0).unwrap().drive.cycles >= 250);
+    assert!(r.drive(0).cycles >= 250);
 
     // dc = "off": both free run
     drop(r);
-    let Some(r) = rig_with(vec![drive("EMU-DC")], |c| c.dc = DcMode::Off) else {
+    let Some(r) = rig_with(vec![drive("EMU-DC")], |c| c.keys.dc = EthercatDc::Off) else {
         return;
     };
     assert_eq!(r.backend.report().axes, [(0, SyncMode::FreeRun)]);
@@ -252,10 +255,7 @@ fn enable_and_move_in_csp() {
     let _t = turn();
     let Some(mut r) = rig(1) else { return };
     r.enable(0);
-    assert_eq!(
-        r.emu().view(0).unwrap().drive.state,
-        State::OperationEnabled
-    );
+    assert_eq!(r.drive(0).state, State::OperationEnabled);
     // 20 units/s = 20 counts per 1 ms cycle, to 30.0 units; the index
     // pulses (markers at 2.5, 12.5, 22.5) show in 0x60FD bit 16
     let mut pulses = 0;
@@ -268,13 +268,13 @@ fn enable_and_move_in_csp() {
     }
     r.settle(0);
     assert!((2..=6).contains(&pulses), "{pulses} index pulse cycles");
-    let v = r.emu().view(0).unwrap().drive;
+    let v = r.drive(0);
     assert_eq!(v.position, 30.0, "the plant followed exactly");
     assert_eq!(r.fb.axes[0].position, 30_000);
     // and back, faster
     r.move_to(0, -5_000, 50);
     r.settle(0);
-    assert_eq!(r.emu().view(0).unwrap().drive.position, -5.0);
+    assert_eq!(r.drive(0).position, -5.0);
     // the velocity reported while moving was the commanded one
     r.move_to(0, 0, 20);
     let st = r.backend.bus_status();
@@ -285,10 +285,8 @@ fn enable_and_move_in_csp() {
     );
     // disable
     r.axis(0).control_word = 0;
-    r.until("disabled", Duration::from_secs(2), |r| {
-        r.fb.axes[0].status_word & SW_ENABLED == 0
-    });
-    assert!(!r.emu().view(0).unwrap().drive.enabled);
+    r.until_axis(0, "disabled", |a| a.status_word & SW_ENABLED == 0);
+    assert!(!r.drive(0).enabled);
 }
 
 #[test]
@@ -297,14 +295,10 @@ fn marker_latch_is_exact_and_ids_never_mix() {
     let Some(mut r) = rig(1) else { return };
     r.enable(0);
     r.axis(0).marker_arm_id = 1;
-    r.until("armed", Duration::from_secs(2), |r| {
-        r.fb.axes[0].marker_latch_id == 1
-    });
+    r.until_axis(0, "armed", |a| a.marker_latch_id == 1);
     assert_eq!(r.fb.axes[0].marker_latched, 0);
     r.move_to(0, 4_000, 10);
-    r.until("latched", Duration::from_secs(2), |r| {
-        r.fb.axes[0].marker_latched != 0
-    });
+    r.until_axis(0, "latched", |a| a.marker_latched != 0);
     assert_eq!(r.fb.axes[0].marker_latch_id, 1);
     assert_eq!(r.fb.axes[0].marker_latch_position, 2_500, "exact marker");
     // re-arm with 2: the old latch never shows under id 2 (id 1 may still be
@@ -329,18 +323,14 @@ fn marker_latch_is_exact_and_ids_never_mix() {
     }
     assert!(armed);
     r.move_to(0, 14_000, 20);
-    r.until("second latch", Duration::from_secs(2), |r| {
-        r.fb.axes[0].marker_latched != 0
-    });
+    r.until_axis(0, "second latch", |a| a.marker_latched != 0);
     assert_eq!(r.fb.axes[0].marker_latch_id, 2);
     assert_eq!(r.fb.axes[0].marker_latch_position, 12_500);
     // disarm
     r.axis(0).marker_arm_id = 0;
-    r.until("disarmed", Duration::from_secs(2), |r| {
-        r.fb.axes[0].marker_latch_id == 0
-    });
+    r.until_axis(0, "disarmed", |a| a.marker_latch_id == 0);
     r.until("probe 1 off in the drive", Duration::from_secs(2), |r| {
-        r.emu().view(0).unwrap().drive.touch_probe_function & 0x00FF == 0
+        r.drive(0).touch_probe_function & 0x00FF == 0
     });
 }
 
@@ -352,9 +342,7 @@ fn registration_latch_on_the_switch_edge() {
     // falling edge: the switch is [5, 8]; moving up it falls at 8
     r.axis(0).switch_arm_id = 7;
     r.axis(0).switch_arm_edge = EDGE_FALLING;
-    r.until("armed", Duration::from_secs(2), |r| {
-        r.fb.axes[0].switch_latch_id == 7
-    });
+    r.until_axis(0, "armed", |a| a.switch_latch_id == 7);
     r.move_to(0, 6_000, 10);
     r.settle(0);
     assert_ne!(
@@ -364,22 +352,16 @@ fn registration_latch_on_the_switch_edge() {
     );
     assert_eq!(r.fb.axes[0].switch_latched, 0, "rising edge not taken");
     r.move_to(0, 9_000, 10);
-    r.until("latched", Duration::from_secs(2), |r| {
-        r.fb.axes[0].switch_latched != 0
-    });
+    r.until_axis(0, "latched", |a| a.switch_latched != 0);
     assert_eq!(r.fb.axes[0].switch_latch_position, 8_000);
     assert_eq!(r.fb.axes[0].digital_inputs & DI_HOME_SWITCH, 0);
     // rising edge moving down: enters at 8 again
     r.axis(0).switch_arm_id = 8;
     r.axis(0).switch_arm_edge = EDGE_RISING;
-    r.until("re-armed", Duration::from_secs(2), |r| {
-        r.fb.axes[0].switch_latch_id == 8
-    });
+    r.until_axis(0, "re-armed", |a| a.switch_latch_id == 8);
     assert_eq!(r.fb.axes[0].switch_latched, 0);
     r.move_to(0, 7_000, 10);
-    r.until("latched", Duration::from_secs(2), |r| {
-        r.fb.axes[0].switch_latched != 0
-    });
+    r.until_axis(0, "latched", |a| a.switch_latched != 0);
     assert_eq!(r.fb.axes[0].switch_latch_position, 8_000);
 }
 
@@ -399,12 +381,12 @@ fn torque_limits_applied_and_restored() {
     r.axis(0).torque_limit_positive = 30.0;
     r.axis(0).torque_limit_negative = 20.0;
     r.until("limits applied", Duration::from_secs(2), |r| {
-        r.emu().view(0).unwrap().drive.torque_limit_positive == 30.0
+        r.drive(0).torque_limit_positive == 30.0
     });
-    assert_eq!(r.emu().view(0).unwrap().drive.torque_limit_negative, 20.0);
+    assert_eq!(r.drive(0).torque_limit_negative, 20.0);
     r.move_to(0, 52_000, 20);
-    r.until("pushing at the limit", Duration::from_secs(2), |r| {
-        (r.fb.axes[0].torque - 30.0).abs() < 0.05
+    r.until_axis(0, "pushing at the limit", |a| {
+        (a.torque - 30.0).abs() < 0.05
     });
     assert_eq!(r.fb.axes[0].position, 50_000, "at the hard stop");
     // restore, back off
@@ -412,13 +394,13 @@ fn torque_limits_applied_and_restored() {
     r.axis(0).torque_limit_negative = 100.0;
     r.move_to(0, 49_000, 20);
     r.until("limits restored", Duration::from_secs(2), |r| {
-        let d = r.emu().view(0).unwrap().drive;
+        let d = r.drive(0);
         d.torque_limit_positive == 100.0 && d.torque_limit_negative == 100.0
     });
     // At rest off the stop: no push left (the cycle that reaches the target
     // may still carry the deceleration's torque).
-    r.until("at rest, not pushing", Duration::from_secs(2), |r| {
-        r.fb.axes[0].position == 49_000 && r.fb.axes[0].torque.abs() < 5.0
+    r.until_axis(0, "at rest, not pushing", |a| {
+        a.position == 49_000 && a.torque.abs() < 5.0
     });
 }
 
@@ -436,7 +418,7 @@ fn max_torque_only_drive_gets_the_larger_limit_through_0x6072() {
     r.axis(0).torque_limit_positive = 30.0;
     r.axis(0).torque_limit_negative = 20.0;
     r.until("0x6072 = 300", Duration::from_secs(2), |r| {
-        let d = r.emu().view(0).unwrap().drive;
+        let d = r.drive(0);
         d.torque_limit_positive == 30.0 && d.torque_limit_negative == 30.0
     });
 }
@@ -476,16 +458,14 @@ fn drive_fault_reports_the_code_and_resets_on_the_enable_edge() {
     r.enable(0);
     r.move_to(0, 3_000, 20);
     r.emu().inject_fault(0, 0x2310);
-    r.until("fault seen", Duration::from_secs(2), |r| {
-        r.fb.axes[0].status_word & SW_FAULT != 0
-    });
+    r.until_axis(0, "fault seen", |a| a.status_word & SW_FAULT != 0);
     let a = r.fb.axes[0];
     assert_eq!(a.status_word & SW_ENABLED, 0);
     assert_eq!(a.error_code, 0x2310);
     // enable stays true: no reset
     r.ticks(50);
     assert_eq!(r.fb.axes[0].status_word & SW_FAULT, SW_FAULT);
-    assert_eq!(r.emu().view(0).unwrap().drive.state, State::Fault);
+    assert_eq!(r.drive(0).state, State::Fault);
     // handshake false → true
     r.axis(0).control_word = 0;
     r.ticks(5);
@@ -493,9 +473,7 @@ fn drive_fault_reports_the_code_and_resets_on_the_enable_edge() {
     let at = r.fb.axes[0].position;
     r.axis(0).target_position = at;
     r.axis(0).control_word = CW_ENABLE;
-    r.until("enabled again", Duration::from_secs(2), |r| {
-        r.fb.axes[0].status_word == SW_ENABLED
-    });
+    r.until_axis(0, "enabled again", |a| a.status_word == SW_ENABLED);
     assert_eq!(r.fb.axes[0].error_code, 0);
 }
 
@@ -581,7 +559,7 @@ fn watchdog_stop_ramps_down_then_disables_with_a_fault() {
         assert!(t0.elapsed() < Duration::from_secs(3), "{:?}", fb.axes[0]);
     }
     eprintln!("watchdog stop done after {calls} calls");
-    let v = r.emu().view(0).unwrap().drive;
+    let v = r.drive(0);
     eprintln!("stopped at {} (last set-point 4.0): {v:?}", v.position);
     assert_eq!(v.velocity, 0.0);
     assert!(!v.enabled);
@@ -603,13 +581,10 @@ fn following_error_window_follows_the_tolerance() {
     let _t = turn();
     let Some(mut r) = rig(1) else { return };
     r.enable(0);
-    assert_eq!(
-        r.emu().view(0).unwrap().drive.following_error_window,
-        u32::MAX
-    );
+    assert_eq!(r.drive(0).following_error_window, u32::MAX);
     r.axis(0).position_error_tolerance = 500.0;
     r.until("window written", Duration::from_secs(3), |r| {
-        r.emu().view(0).unwrap().drive.following_error_window == 500
+        r.drive(0).following_error_window == 500
     });
     r.axis(0).position_error_tolerance = 0.0;
     // The drive applies the SDO write before the master has its answer and
@@ -618,7 +593,7 @@ fn following_error_window_follows_the_tolerance() {
         "window off, two writes counted",
         Duration::from_secs(3),
         |r| {
-            r.emu().view(0).unwrap().drive.following_error_window == u32::MAX
+            r.drive(0).following_error_window == u32::MAX
                 && r.backend.bus_status().axes[0].following_window_writes >= 2
         },
     );
@@ -628,17 +603,13 @@ fn following_error_window_follows_the_tolerance() {
 #[test]
 fn a_drive_without_touch_probe_is_refused_with_the_object_named() {
     let _t = turn();
-    let pair = match VethPair::new() {
-        Ok(p) => p,
-        Err(skip) => {
-            eprintln!("{skip}");
-            return;
-        }
+    let Some(pair) = VethPair::or_skip() else {
+        return;
     };
     let mut d = drive("NOTP");
     d.touch_probe = false;
     let _emu = emulator(&pair, vec![d]);
-    let cfg = EthercatConfig::new(&pair.master, CYCLE, mapping(1));
+    let cfg = EthercatBus::new(&pair.master, CYCLE_US, mapping(1));
     let e = EthercatBackend::new(cfg).err().expect("must be refused");
     eprintln!("{e}");
     assert_eq!(
@@ -652,12 +623,8 @@ fn a_drive_without_touch_probe_is_refused_with_the_object_named() {
 #[test]
 fn killed_master_the_drives_watchdog_stops_it() {
     let _t = turn();
-    let pair = match VethPair::new() {
-        Ok(p) => p,
-        Err(skip) => {
-            eprintln!("{skip}");
-            return;
-        }
+    let Some(pair) = VethPair::or_skip() else {
+        return;
     };
     let emu = emulator(&pair, vec![drive("EMU-0")]);
     let mut cmd = Command::new(std::env::current_exe().unwrap());
@@ -741,7 +708,7 @@ fn child_master() {
     let Ok(interface) = std::env::var("ECAT_CHILD_INTERFACE") else {
         return;
     };
-    let cfg = EthercatConfig::new(&interface, CYCLE, mapping(1));
+    let cfg = EthercatBus::new(&interface, CYCLE_US, mapping(1));
     let backend = EthercatBackend::new(cfg).expect("child start-up");
     let mut r = Rig {
         backend,

@@ -145,7 +145,7 @@ impl AxisLogic {
     }
 
     /// One cycle. `inputs`: this cycle's process data, `None` if it did not
-    /// arrive (or is not valid).
+    /// arrive (or is not valid). Runs on the bus thread: no allocation.
     pub fn step(
         &mut self,
         cmd: &AxisCommand,
@@ -166,54 +166,79 @@ impl AxisLogic {
             fb.status_word |= SW_NO_DATA;
             return (self.outputs, fb);
         };
+        let pos64 = self.extend(inp.position);
+        self.state = State::from_statusword(inp.statusword);
+        let set = self.check_setpoint(cmd, mode, enable, pos64);
+        self.window = following_error_window(cmd.position_error_tolerance);
+        let target = self.cia_target(mode, enable, inp.velocity);
+        let controlword = self.cia.step(inp.statusword, target);
 
-        // positions: extend 32 → 64 bit
+        let following = self.state.is_enabled() && target == Target::Enabled;
+        let target_position = if following && set.target_ok {
+            cmd.target_position as i32 // modulo 2^32, consistent with the extension
+        } else if following {
+            self.outputs.target_position // refused: hold the last good one
+        } else {
+            inp.position
+        };
+        let function = self.probe_function(cmd, inp, pos64);
+        self.outputs = DriveOutputs {
+            controlword,
+            target_position,
+            touch_probe_function: function,
+            torque_limit_positive: set.tpos.unwrap_or(self.outputs.torque_limit_positive),
+            torque_limit_negative: set.tneg.unwrap_or(self.outputs.torque_limit_negative),
+            mode: MODE_CSP,
+        };
+        let fb = self.feedback(inp, pos64);
+        self.last_feedback = fb;
+        (self.outputs, fb)
+    }
+
+    /// The drive's 32-bit position extended to 64 bits by every cycle's
+    /// difference (it never wraps).
+    fn extend(&mut self, position32: i32) -> i64 {
         let pos64 = match self.pos64 {
-            None => i64::from(inp.position),
-            Some(p) => p.wrapping_add(i64::from(inp.position.wrapping_sub(self.pos32))),
+            None => i64::from(position32),
+            Some(p) => p.wrapping_add(i64::from(position32.wrapping_sub(self.pos32))),
         };
         self.pos64 = Some(pos64);
-        self.pos32 = inp.position;
-        self.state = State::from_statusword(inp.statusword);
+        self.pos32 = position32;
+        pos64
+    }
 
-        // set-point checks
-        let mut bad = false;
-        let target64 = cmd.target_position;
-        let target_ok = target64 != INVALID_COUNTS
-            && target64
-                .checked_sub(pos64)
-                .is_some_and(|d| d.abs() <= MAX_TARGET_DISTANCE);
-        let per_mille = |pct: f32| -> Option<u16> {
-            if pct.is_nan() {
-                None
-            } else {
-                Some((f64::from(pct) * 10.0).round().clamp(0.0, 65535.0) as u16)
-            }
+    /// Checks the command's set-points against the actual position
+    /// `pos64`; a bad one while enabled latches the backend's fault.
+    fn check_setpoint(
+        &mut self,
+        cmd: &AxisCommand,
+        mode: Mode,
+        enable: bool,
+        pos64: i64,
+    ) -> Setpoint {
+        let target = cmd.target_position;
+        let set = Setpoint {
+            target_ok: target != INVALID_COUNTS
+                && target
+                    .checked_sub(pos64)
+                    .is_some_and(|d| d.abs() <= MAX_TARGET_DISTANCE),
+            tpos: per_mille(cmd.torque_limit_positive),
+            tneg: per_mille(cmd.torque_limit_negative),
         };
-        let tpos = per_mille(cmd.torque_limit_positive);
-        let tneg = per_mille(cmd.torque_limit_negative);
-        if mode == Mode::Normal
-            && enable
-            && self.state.is_enabled()
-            && (!target_ok || tpos.is_none() || tneg.is_none())
-        {
-            bad = true;
-        }
-        if bad {
+        let bad = !set.target_ok || set.tpos.is_none() || set.tneg.is_none();
+        if mode == Mode::Normal && enable && self.state.is_enabled() && bad {
             self.fault_latch = true;
             self.counters.rejected_setpoints += 1;
         }
-        let tol = cmd.position_error_tolerance;
-        self.window = if tol.is_finite() && tol > 0.0 {
-            tol.round().min(f64::from(u32::MAX - 1)).max(1.0) as u32
-        } else {
-            u32::MAX
-        };
+        set
+    }
 
-        // CiA 402
-        let moving_in_qs = self.state == State::QuickStopActive
-            && f64::from(inp.velocity).abs() >= self.rest_velocity;
-        let target = match mode {
+    /// Where the CiA 402 machine walks the drive this cycle (`velocity`:
+    /// the drive's, counts/s).
+    fn cia_target(&mut self, mode: Mode, enable: bool, velocity: i32) -> Target {
+        let moving_in_qs =
+            self.state == State::QuickStopActive && f64::from(velocity).abs() >= self.rest_velocity;
+        match mode {
             Mode::Normal if enable && !self.fault_latch => Target::Enabled,
             // a refused set-point while enabled: stop on the drive's ramp
             // first, then disable
@@ -237,17 +262,11 @@ impl AxisLogic {
                 }
                 Target::Off
             }
-        };
-        let controlword = self.cia.step(inp.statusword, target);
+        }
+    }
 
-        let following = self.state.is_enabled() && target == Target::Enabled;
-        let target_position = if following && target_ok {
-            target64 as i32 // modulo 2^32, consistent with the extension
-        } else if following {
-            self.outputs.target_position // refused: hold the last good one
-        } else {
-            inp.position
-        };
+    /// The touch probe function (0x60B8) for the command's arm ids.
+    fn probe_function(&mut self, cmd: &AxisCommand, inp: &DriveInputs, pos64: i64) -> u16 {
         let probe_inputs = ProbeInputs {
             status: inp.touch_probe_status,
             probe1_positive: inp.probe1_positive,
@@ -262,34 +281,33 @@ impl AxisLogic {
         } else {
             Edge::Falling
         };
-        let function = self
-            .probes
-            .step(cmd.marker_arm_id, cmd.switch_arm_id, edge, &probe_inputs);
-        self.outputs = DriveOutputs {
-            controlword,
-            target_position,
-            touch_probe_function: function,
-            torque_limit_positive: tpos.unwrap_or(self.outputs.torque_limit_positive),
-            torque_limit_negative: tneg.unwrap_or(self.outputs.torque_limit_negative),
-            mode: MODE_CSP,
-        };
+        self.probes
+            .step(cmd.marker_arm_id, cmd.switch_arm_id, edge, &probe_inputs)
+    }
 
-        // feedback
+    /// The frame's digital inputs from 0x60FD.
+    fn digital_inputs(&self, raw: u32) -> u32 {
         let mut dio = 0;
-        if inp.digital_inputs & di::HOME_SWITCH != 0 {
+        if raw & di::HOME_SWITCH != 0 {
             dio |= DI_HOME_SWITCH;
         }
-        if inp.digital_inputs & di::POSITIVE_LIMIT_SWITCH != 0 {
+        if raw & di::POSITIVE_LIMIT_SWITCH != 0 {
             dio |= DI_OVERTRAVEL_POSITIVE;
         }
-        if inp.digital_inputs & di::NEGATIVE_LIMIT_SWITCH != 0 {
+        if raw & di::NEGATIVE_LIMIT_SWITCH != 0 {
             dio |= DI_OVERTRAVEL_NEGATIVE;
         }
         if let Some(bit) = self.index_pulse_bit {
-            if inp.digital_inputs & (1u32 << (bit & 31)) != 0 {
+            if raw & (1u32 << (bit & 31)) != 0 {
                 dio |= DI_MARKER_PULSE;
             }
         }
+        dio
+    }
+
+    /// This cycle's feedback: the drive's values, its state and fault (or
+    /// the backend's), the latches.
+    fn feedback(&mut self, inp: &DriveInputs, pos64: i64) -> AxisFeedback {
         let drive_fault = self.state.is_fault();
         let mut status = 0;
         if self.state.is_enabled() {
@@ -305,11 +323,11 @@ impl AxisLogic {
         }
         let m = self.probes.marker();
         let s = self.probes.switch();
-        let fb = AxisFeedback {
+        AxisFeedback {
             position: pos64,
             velocity: f64::from(inp.velocity),
             torque: f32::from(inp.torque) / 10.0,
-            digital_inputs: dio,
+            digital_inputs: self.digital_inputs(inp.digital_inputs),
             status_word: status,
             marker_latch_id: m.id,
             marker_latched: u8::from(m.latched),
@@ -322,9 +340,33 @@ impl AxisLogic {
             },
             marker_latch_position: m.position,
             switch_latch_position: s.position,
-        };
-        self.last_feedback = fb;
-        (self.outputs, fb)
+        }
+    }
+}
+
+/// The command's set-points as checked: the target within reach, the
+/// torque limits in per mille (`None`: NaN, refused).
+struct Setpoint {
+    target_ok: bool,
+    tpos: Option<u16>,
+    tneg: Option<u16>,
+}
+
+/// % rated → per mille, clamped to 0..=65535; `None` for NaN.
+fn per_mille(pct: f32) -> Option<u16> {
+    if pct.is_nan() {
+        None
+    } else {
+        Some((f64::from(pct) * 10.0).round().clamp(0.0, 65535.0) as u16)
+    }
+}
+
+/// 0x6065 for a position error tolerance in counts (0, NaN: off = u32::MAX).
+fn following_error_window(tol: f64) -> u32 {
+    if tol.is_finite() && tol > 0.0 {
+        tol.round().min(f64::from(u32::MAX - 1)).max(1.0) as u32
+    } else {
+        u32::MAX
     }
 }
 

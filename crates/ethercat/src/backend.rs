@@ -1,5 +1,5 @@
-//! [`EthercatBackend`]: the methods of motion-io's `Backend` trait, over the
-//! bus thread.
+//! [`EthercatBackend`]: the drive backend ([`motion_frames::backend::Backend`])
+//! over the bus thread.
 //!
 //! `exchange` never waits for the bus: it publishes the commands into one
 //! seqlock double buffer and copies the newest feedback out of the other
@@ -8,49 +8,26 @@
 //! with `SW_NO_DATA` on every axis.
 
 use std::cell::RefCell;
-use std::fmt;
 use std::sync::atomic::Ordering;
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
+use motion_config::EthercatBus;
+use motion_frames::backend::{Backend, ExchangeError, MAX_STOP_CYCLES};
 use motion_frames::{CommandFrame, FeedbackFrame, SW_NO_DATA};
 use motion_rt::now_ns;
 
-use crate::bus::{self, command_to_words, feedback_from_words};
-use crate::config::EthercatConfig;
-use crate::startup::{StartupError, StartupReport};
-use crate::status::{
-    BusStatus, Shared, AXIS_WORDS, FLAG_RUNNING, HEADER_WORDS, MODE_EMERGENCY, MODE_NORMAL,
-    MODE_WATCHDOG_STOP,
-};
+use crate::bus;
+use crate::report::{StartupError, StartupReport};
+use crate::status::{BusStatus, Shared};
+use crate::words::{self, FLAG_RUNNING, MODE_EMERGENCY, MODE_NORMAL, MODE_WATCHDOG_STOP};
 
 /// Feedback older than this many bus cycles counts as missing.
 pub const STALE_CYCLES: u64 = 3;
 /// Upper bound of a paced [`EthercatBackend::shutdown`].
 pub const MAX_SHUTDOWN: Duration = Duration::from_secs(30);
-
-/// Same meaning and message as motion-io's `ExchangeError`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum ExchangeError {
-    /// The frame carries another number of axes than the backend drives.
-    AxisCountMismatch { frame: usize, ours: usize },
-}
-
-impl fmt::Display for ExchangeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ExchangeError::AxisCountMismatch { frame, ours } => write!(
-                f,
-                "command frame has {frame} axes, config has {ours}: ignoring commands \
-                 (are both processes using the same config?)"
-            ),
-        }
-    }
-}
-
-impl std::error::Error for ExchangeError {}
 
 /// The EtherCAT drive backend.
 pub struct EthercatBackend {
@@ -69,20 +46,13 @@ pub struct EthercatBackend {
 
 impl EthercatBackend {
     /// Starts the bus thread and brings every SubDevice to OP (blocking, up
-    /// to `cfg.startup_timeout`). Errors name the SubDevice and the object
-    /// or state that failed.
-    pub fn new(cfg: EthercatConfig) -> Result<EthercatBackend, StartupError> {
-        let problems = cfg.problems();
-        if !problems.is_empty() {
-            return Err(StartupError(format!(
-                "ethercat config: {}",
-                problems.join("; ")
-            )));
-        }
+    /// to the start-up timeout). Errors name the SubDevice and the object or
+    /// state that failed. `cfg` was checked when the config was parsed.
+    pub fn new(cfg: EthercatBus) -> Result<EthercatBackend, StartupError> {
         let n = cfg.axes.len();
         let names = cfg.axes.iter().map(|a| a.name.clone()).collect();
         let shared = Arc::new(Shared::new(n));
-        let cycle_ns = cfg.cycle.as_nanos() as u64;
+        let cycle_ns = cfg.cycle().as_nanos() as u64;
         let (tx, rx) = mpsc::channel();
         let thread = {
             let shared = shared.clone();
@@ -101,8 +71,8 @@ impl EthercatBackend {
                 cycle_ns,
                 generation: 0,
                 mode: MODE_NORMAL,
-                cmd_words: vec![0; HEADER_WORDS + n * AXIS_WORDS],
-                fb_words: RefCell::new(vec![0; HEADER_WORDS + n * AXIS_WORDS]),
+                cmd_words: vec![0; words::len(n)],
+                fb_words: RefCell::new(vec![0; words::len(n)]),
                 stop_from_cycle: None,
             }),
             Ok(Err(e)) => {
@@ -126,51 +96,11 @@ impl EthercatBackend {
         self.shared.snapshot()
     }
 
-    /// Short name for messages.
-    pub fn name(&self) -> &str {
-        "ethercat"
-    }
-
-    pub fn axis_count(&self) -> usize {
-        self.names.len()
-    }
-
-    pub fn axis_names(&self) -> Vec<String> {
-        self.names.clone()
-    }
-
     fn publish(&mut self) {
         self.generation += 1;
         self.cmd_words[0] = self.generation;
         self.cmd_words[1] = self.mode;
         self.shared.commands.write(&self.cmd_words);
-    }
-
-    /// One cycle: hands `cmd` to the bus thread and fills `fb` with the
-    /// newest feedback. Never waits for the bus.
-    pub fn exchange(
-        &mut self,
-        cmd: &CommandFrame,
-        fb: &mut FeedbackFrame,
-    ) -> Result<(), ExchangeError> {
-        let n = self.names.len();
-        let theirs = cmd.header.axis_count as usize;
-        if theirs != n {
-            self.status(fb);
-            return Err(ExchangeError::AxisCountMismatch {
-                frame: theirs,
-                ours: n,
-            });
-        }
-        for (i, c) in cmd.axes[..n].iter().enumerate() {
-            let at = HEADER_WORDS + i * AXIS_WORDS;
-            command_to_words(c, &mut self.cmd_words[at..at + AXIS_WORDS]);
-        }
-        self.mode = MODE_NORMAL;
-        self.stop_from_cycle = None;
-        self.publish();
-        self.status(fb);
-        Ok(())
     }
 
     /// Reads the feedback; returns (bus cycle, at-rest mask, fresh).
@@ -181,8 +111,7 @@ impl EthercatBackend {
         let age = now_ns().saturating_sub(words[1]);
         let fresh = ok && words[2] & FLAG_RUNNING != 0 && age <= STALE_CYCLES * self.cycle_ns;
         for i in 0..n {
-            let at = HEADER_WORDS + i * AXIS_WORDS;
-            let mut a = feedback_from_words(&words[at..at + AXIS_WORDS]);
+            let mut a = words::feedback(&words, i);
             if !fresh {
                 a.status_word |= SW_NO_DATA;
                 self.shared.axis[i].stale.fetch_add(1, Ordering::Relaxed);
@@ -193,15 +122,55 @@ impl EthercatBackend {
         (words[0], words[3], fresh)
     }
 
+    /// Stops the bus thread: SAFE-OP (the drives stop on their own ramps),
+    /// PRE-OP, INIT. Also done on drop.
+    pub fn close(mut self) {
+        self.stop_thread();
+    }
+
+    fn stop_thread(&mut self) {
+        self.shared.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Backend for EthercatBackend {
+    fn name(&self) -> &str {
+        "ethercat"
+    }
+
+    fn axis_count(&self) -> usize {
+        self.names.len()
+    }
+
+    fn axis_names(&self) -> Vec<String> {
+        self.names.clone()
+    }
+
+    /// Hands `cmd` to the bus thread and fills `fb` with the newest
+    /// feedback. Never waits for the bus.
+    fn apply(&mut self, cmd: &CommandFrame, fb: &mut FeedbackFrame) -> Result<(), ExchangeError> {
+        for (i, c) in cmd.axes[..self.names.len()].iter().enumerate() {
+            words::put_command(&mut self.cmd_words, i, c);
+        }
+        self.mode = MODE_NORMAL;
+        self.stop_from_cycle = None;
+        self.publish();
+        self.status(fb);
+        Ok(())
+    }
+
     /// Fills `fb` with the current state without changing anything.
-    pub fn status(&self, fb: &mut FeedbackFrame) {
+    fn status(&self, fb: &mut FeedbackFrame) {
         self.read_feedback(fb);
     }
 
     /// Commands have stopped: every enabled axis quick-stops on its drive's
     /// ramp, is then disabled and reports a fault. `true` once every axis is
     /// at rest and disabled (as seen by a bus cycle after the request).
-    pub fn watchdog_stop(&mut self, _dt_s: f64, fb: &mut FeedbackFrame) -> bool {
+    fn watchdog_stop(&mut self, _dt_s: f64, fb: &mut FeedbackFrame) -> bool {
         if self.mode != MODE_WATCHDOG_STOP {
             self.mode = MODE_WATCHDOG_STOP;
             self.publish();
@@ -218,7 +187,7 @@ impl EthercatBackend {
 
     /// Immediate stop: "disable voltage" on every axis (no ramp), a fault
     /// reported. Waits up to three bus cycles for the bus to apply it.
-    pub fn emergency_stop(&mut self, fb: &mut FeedbackFrame) {
+    fn emergency_stop(&mut self, fb: &mut FeedbackFrame) {
         self.mode = MODE_EMERGENCY;
         self.publish();
         let (first, _, _) = self.read_feedback(fb);
@@ -233,14 +202,16 @@ impl EthercatBackend {
     }
 
     /// Controlled stop of every axis, paced by the bus cycle, at most
-    /// [`MAX_SHUTDOWN`] (or `MAX_STOP_CYCLES` of `dt_s`, the smaller); falls
+    /// [`MAX_SHUTDOWN`] (or [`MAX_STOP_CYCLES`] of `dt_s`, the smaller); falls
     /// back to [`emergency_stop`](Self::emergency_stop). `true` if the
     /// controlled stop completed. The bus keeps running (drives disabled)
     /// until the backend is dropped.
-    pub fn shutdown(&mut self, dt_s: f64, fb: &mut FeedbackFrame) -> bool {
+    fn shutdown(&mut self, dt_s: f64, fb: &mut FeedbackFrame) -> bool {
         let pace = Duration::from_nanos(self.cycle_ns);
         let by_dt = if dt_s.is_finite() && dt_s > 0.0 {
-            Duration::from_secs_f64((dt_s * 100_000.0).min(MAX_SHUTDOWN.as_secs_f64()))
+            Duration::from_secs_f64(
+                (dt_s * f64::from(MAX_STOP_CYCLES)).min(MAX_SHUTDOWN.as_secs_f64()),
+            )
         } else {
             MAX_SHUTDOWN
         };
@@ -253,19 +224,6 @@ impl EthercatBackend {
         }
         self.emergency_stop(fb);
         false
-    }
-
-    /// Stops the bus thread: SAFE-OP (the drives stop on their own ramps),
-    /// PRE-OP, INIT. Also done on drop.
-    pub fn close(mut self) {
-        self.stop_thread();
-    }
-
-    fn stop_thread(&mut self) {
-        self.shared.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
     }
 }
 

@@ -36,6 +36,12 @@
 //! again. A fault is reset only on request ([`Cia402::request_fault_reset`]):
 //! bit 7 low for one cycle, then high (the rising edge is the command) until
 //! the drive leaves Fault or [`FAULT_RESET_CYCLES`] pass.
+//!
+//! Kept apart on purpose from the drive side the test fixture emulates
+//! (`ecat-emu`'s `drive::cia402`), although both spell the same states and
+//! statusword codes: each is written from the standard on its own, so that
+//! one misreading of it shared by both could not pass the wire tests that
+//! pit one against the other.
 
 /// Statusword (0x6041) bits.
 pub mod sw {

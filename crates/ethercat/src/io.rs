@@ -1,5 +1,5 @@
-//! The bus thread's I/O: an AF_PACKET raw socket on the interface
-//! (EtherType 0x88A4) and a minimal single-threaded executor that drives
+//! The bus thread's I/O: the raw socket on the interface
+//! ([`crate::socket`]) and a minimal single-threaded executor that drives
 //! ethercrab's futures.
 //!
 //! ethercrab's own TX/RX task is an async future that allocates a receive
@@ -13,15 +13,13 @@
 
 use std::future::Future;
 use std::io;
-use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::pin::Pin;
 use std::task::{Context, Poll, Waker};
 
 use ethercrab::{PduRx, PduTx};
 use motion_rt::now_ns;
 
-const ETHERTYPE: u16 = 0x88A4;
-const PACKET_QDISC_BYPASS: libc::c_int = 20;
+use crate::socket::{PacketSocket, Wait};
 
 /// Frame-level counters of the socket.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -54,69 +52,18 @@ fn sleep_until(ns: u64) {
 
 /// Socket plus ethercrab's frame queues.
 pub struct BusIo<'sto> {
-    fd: OwnedFd,
+    socket: PacketSocket,
     tx: PduTx<'sto>,
     rx: PduRx<'sto>,
     buf: [u8; 2048],
     pub counters: IoCounters,
 }
 
-fn open(interface: &str) -> io::Result<OwnedFd> {
-    let proto = i32::from(ETHERTYPE.to_be());
-    // SAFETY: plain socket(2); checked.
-    let fd = unsafe { libc::socket(libc::AF_PACKET, libc::SOCK_RAW | libc::SOCK_NONBLOCK, proto) };
-    if fd < 0 {
-        return Err(io::Error::last_os_error());
-    }
-    // SAFETY: a fresh descriptor we own.
-    let fd = unsafe { OwnedFd::from_raw_fd(fd) };
-    let name = std::ffi::CString::new(interface)
-        .map_err(|_| io::Error::new(io::ErrorKind::InvalidInput, "interface name"))?;
-    // SAFETY: valid C string.
-    let ifindex = unsafe { libc::if_nametoindex(name.as_ptr()) };
-    if ifindex == 0 {
-        return Err(io::Error::new(
-            io::ErrorKind::NotFound,
-            format!("no network interface {interface:?}"),
-        ));
-    }
-    // SAFETY: all-zero sockaddr_ll is valid; fields set below.
-    let mut sa: libc::sockaddr_ll = unsafe { std::mem::zeroed() };
-    sa.sll_family = libc::AF_PACKET as u16;
-    sa.sll_protocol = ETHERTYPE.to_be();
-    sa.sll_ifindex = ifindex as i32;
-    // SAFETY: sa is a valid sockaddr_ll of that size.
-    let r = unsafe {
-        libc::bind(
-            fd.as_raw_fd(),
-            (&sa as *const libc::sockaddr_ll).cast(),
-            std::mem::size_of::<libc::sockaddr_ll>() as u32,
-        )
-    };
-    if r < 0 {
-        return Err(io::Error::last_os_error());
-    }
-    // Straight to the driver, past the qdisc (lower latency on real NICs);
-    // not fatal where unsupported.
-    let one: libc::c_int = 1;
-    // SAFETY: valid option value pointer and length.
-    unsafe {
-        libc::setsockopt(
-            fd.as_raw_fd(),
-            libc::SOL_PACKET,
-            PACKET_QDISC_BYPASS,
-            (&one as *const libc::c_int).cast(),
-            std::mem::size_of::<libc::c_int>() as u32,
-        );
-    }
-    Ok(fd)
-}
-
 impl<'sto> BusIo<'sto> {
     /// Opens the raw socket on `interface` (needs CAP_NET_RAW).
     pub fn new(interface: &str, tx: PduTx<'sto>, rx: PduRx<'sto>) -> io::Result<BusIo<'sto>> {
         Ok(BusIo {
-            fd: open(interface)?,
+            socket: PacketSocket::open(interface)?,
             tx,
             rx,
             buf: [0; 2048],
@@ -126,15 +73,13 @@ impl<'sto> BusIo<'sto> {
 
     /// Sends every frame ethercrab has ready.
     pub fn flush(&mut self) {
-        let fd = self.fd.as_raw_fd();
+        let socket = &self.socket;
         while let Some(frame) = self.tx.next_sendable_frame() {
             let r = frame.send_blocking(|bytes| {
-                // SAFETY: bytes is a valid slice; fd a bound packet socket.
-                let n = unsafe { libc::send(fd, bytes.as_ptr().cast(), bytes.len(), 0) };
-                if n < 0 || n as usize != bytes.len() {
-                    Err(ethercrab::error::Error::SendFrame)
+                if socket.send(bytes) {
+                    Ok(bytes.len())
                 } else {
-                    Ok(n as usize)
+                    Err(ethercrab::error::Error::SendFrame)
                 }
             });
             match r {
@@ -149,52 +94,17 @@ impl<'sto> BusIo<'sto> {
     /// frames received.
     pub fn receive(&mut self, until_ns: u64) -> usize {
         let now = now_ns();
-        if until_ns > now {
-            let wait = until_ns - now;
-            let ts = libc::timespec {
-                tv_sec: (wait / 1_000_000_000) as libc::time_t,
-                tv_nsec: (wait % 1_000_000_000) as libc::c_long,
-            };
-            let mut pfd = libc::pollfd {
-                fd: self.fd.as_raw_fd(),
-                events: libc::POLLIN,
-                revents: 0,
-            };
-            // SAFETY: one valid pollfd, valid timespec, no signal mask.
-            let r = unsafe { libc::ppoll(&mut pfd, 1, &ts, std::ptr::null()) };
-            let broken = libc::POLLERR | libc::POLLHUP | libc::POLLNVAL;
-            if r > 0 && pfd.revents & libc::POLLIN == 0 && pfd.revents & broken != 0 {
-                // the interface is gone or down: never spin on it
-                self.counters.socket_errors += 1;
-                sleep_until(until_ns);
-                return 0;
-            }
+        if until_ns > now && self.socket.wait(until_ns - now) == Wait::Broken {
+            // the interface is gone or down: never spin on it
+            self.counters.socket_errors += 1;
+            sleep_until(until_ns);
+            return 0;
         }
         let mut n = 0;
-        loop {
-            // SAFETY: all-zero sockaddr_ll is valid.
-            let mut sa: libc::sockaddr_ll = unsafe { std::mem::zeroed() };
-            let mut sl = std::mem::size_of::<libc::sockaddr_ll>() as u32;
-            // SAFETY: buffer valid for its length; sa/sl as above.
-            let len = unsafe {
-                libc::recvfrom(
-                    self.fd.as_raw_fd(),
-                    self.buf.as_mut_ptr().cast(),
-                    self.buf.len(),
-                    libc::MSG_DONTWAIT,
-                    (&mut sa as *mut libc::sockaddr_ll).cast(),
-                    &mut sl,
-                )
-            };
-            if len <= 0 {
-                break;
-            }
-            if sa.sll_pkttype == libc::PACKET_OUTGOING {
-                continue; // our own transmission
-            }
+        while let Some(len) = self.socket.recv(&mut self.buf) {
             self.counters.received += 1;
             n += 1;
-            match self.rx.receive_frame(&self.buf[..len as usize]) {
+            match self.rx.receive_frame(&self.buf[..len]) {
                 Ok(ethercrab::ReceiveAction::Processed) => {}
                 Ok(ethercrab::ReceiveAction::Ignored) => {}
                 Err(_) => self.counters.unmatched += 1,

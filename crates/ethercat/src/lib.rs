@@ -2,30 +2,45 @@
 //!
 //! ethercrab's `MainDevice` runs on its own real-time thread ([`bus`]) that
 //! cycles the process data at the supervisor's cycle; [`EthercatBackend`]
-//! offers exactly the methods of motion-io's `Backend` trait on top of it.
+//! implements the drive [`Backend`](motion_frames::backend::Backend) on top
+//! of it. Its configuration is `motion_config`'s [`EthercatBus`], checked
+//! when the config file was parsed.
 //!
 //! * [`cia402`] — the master-side CiA 402 state machine (pure, sans-I/O).
 //! * [`pdo`] — the RxPDO / TxPDO layout and the process-image packing.
 //! * [`probe`] — touch probes behind the frames' latch ids.
 //! * [`axis`] — one axis per cycle: command + inputs → outputs + feedback.
-//! * [`startup`] — INIT → OP: PDO mapping over CoE, CSP, DC, SM watchdog.
+//! * [`startup`] — INIT → OP: discovery, the axes' SubDevices, process-data
+//!   sizes, SM watchdog, DC; [`drive_setup`] — one drive over CoE (PDO
+//!   mapping, CSP, sync); [`report`] — what start-up found or why it failed.
+//! * [`bus`] — the bus thread; [`cycle`] — one bus cycle; [`jobs`] —
+//!   recovery and SDO writes between cycles; [`group`] — the SubDevice group
+//!   in OP.
 //! * [`shared`] — the lock-free double buffer between `motion-io` and the
-//!   bus thread; [`status`] — counters.
-//! * [`io`] — raw socket and the bus thread's executor.
+//!   bus thread, [`words`] — its layout; [`status`] — counters.
+//! * [`io`] — the bus thread's executor over [`socket`], the raw socket.
+//! * [`capacity`] — the fixed capacities (SubDevices, process image, frames).
 
 pub mod axis;
 pub mod backend;
 pub mod bus;
+pub mod capacity;
 pub mod cia402;
-pub mod config;
+pub mod cycle;
+pub mod drive_setup;
+pub mod group;
 pub mod io;
+pub mod jobs;
 pub mod pdo;
 pub mod probe;
+pub mod report;
 pub mod shared;
+pub mod socket;
 pub mod startup;
 pub mod status;
+pub mod words;
 
-pub use backend::{EthercatBackend, ExchangeError, STALE_CYCLES};
-pub use config::{AxisMapping, DcMode, EthercatConfig, SubDeviceSelector};
-pub use startup::{StartupError, StartupReport, SubDeviceReport, SyncMode};
+pub use backend::{EthercatBackend, STALE_CYCLES};
+pub use motion_config::EthercatBus;
+pub use report::{StartupError, StartupReport, SubDeviceReport, SyncMode};
 pub use status::{AxisStatus, BusStatus, RoundTrip};

@@ -54,13 +54,9 @@ pub mod status {
 /// process-data latency, in cycles).
 pub const SETTLE_CYCLES: u32 = 3;
 
-/// Edge a latch takes (the frames' `EDGE_RISING` / `EDGE_FALLING`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Edge {
-    #[default]
-    Rising,
-    Falling,
-}
+/// Edge a latch takes (the frames' `EDGE_RISING` / `EDGE_FALLING`): the
+/// engine's own type.
+pub use motion_homing::Edge;
 
 /// A latch as reported in the feedback frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -6,20 +6,7 @@ use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use crate::shared::SeqBuffer;
-
-/// Header words of both buffers.
-pub(crate) const HEADER_WORDS: usize = 4;
-/// Words per axis (an `AxisCommand` / `AxisFeedback`, 48 bytes).
-pub(crate) const AXIS_WORDS: usize = 6;
-
-/// Commands header: `[generation, mode, 0, 0]`.
-pub(crate) const MODE_NORMAL: u64 = 0;
-pub(crate) const MODE_WATCHDOG_STOP: u64 = 1;
-pub(crate) const MODE_EMERGENCY: u64 = 2;
-
-/// Feedback header: `[bus cycle, CLOCK_MONOTONIC ns of the exchange,
-/// flags, at-rest mask]`.
-pub(crate) const FLAG_RUNNING: u64 = 1;
+use crate::words;
 
 /// Round-trip histogram: 1 µs buckets up to this.
 const HIST_US: usize = 10_000;
@@ -63,7 +50,7 @@ pub(crate) struct Shared {
 
 impl Shared {
     pub fn new(axes: usize) -> Shared {
-        let words = HEADER_WORDS + axes * AXIS_WORDS;
+        let words = words::len(axes);
         Shared {
             commands: SeqBuffer::new(words),
             feedback: SeqBuffer::new(words),

@@ -24,6 +24,7 @@
 //! wire-only user compiles no iceoryx2 code at all. The type names and the
 //! layout are the same with and without the feature.
 
+pub mod backend;
 pub mod convert;
 pub mod frame;
 #[cfg(feature = "zero-copy")]

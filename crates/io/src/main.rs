@@ -5,7 +5,7 @@
 //! the backend and answer with a `FeedbackFrame` (`answers_sequence` = the
 //! command's sequence) on `{prefix}/feedback` plus a wake-up on
 //! `{prefix}/feedback_ready`. See `motion-io --help` for the command line,
-//! [`backend::Backend`] for what a drive backend must guarantee and [`run`]
+//! [`Backend`] for what a drive backend must guarantee and [`run`]
 //! for the loop, the watchdog and the signal handling.
 //!
 //! Exit codes: 0 after SIGINT/SIGTERM or when the supervisor is gone
@@ -14,7 +14,6 @@
 //! state) or no supervisor within 10 s (`--exit-with-supervisor`); 2 on a
 //! command-line or config mistake.
 
-mod backend;
 mod cli;
 mod ethercat;
 mod run;
@@ -25,10 +24,10 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use clap::Parser;
+use motion_frames::backend::Backend;
 use motion_ipc::{cleanup_domain, Domain, IoPorts, IpcError};
 use motion_rt::{enter_realtime, RtConfig};
 
-use crate::backend::Backend;
 use crate::cli::{BackendKind, Options};
 use crate::say::Say;
 use crate::sim::SimBackend;
@@ -116,7 +115,7 @@ fn real_main() -> i32 {
     }
     let mut backend: Box<dyn Backend> = match kind {
         BackendKind::Sim => Box::new(SimBackend::new(&mine)),
-        BackendKind::Ethercat => match start_ethercat(&mine, &cfg.ios[io], &opts, say) {
+        BackendKind::Ethercat => match start_ethercat(&cfg, io, &opts, say) {
             Ok(b) => Box::new(b),
             Err(code) => return code,
         },
@@ -155,31 +154,38 @@ fn real_main() -> i32 {
     }
 }
 
-/// Starts the EtherCAT bus for the axes of `mine` (blocking until every
-/// SubDevice is in OP) and logs the start-up report; on failure logs why
-/// and returns the exit code.
+/// Starts the EtherCAT bus for the axes of I/O process `io` (blocking
+/// until every SubDevice is in OP) and logs the start-up report; on
+/// failure logs why and returns the exit code.
 fn start_ethercat(
-    mine: &motion_config::MachineConfig,
-    io: &motion_config::IoConfig,
+    cfg: &motion_config::MachineConfig,
+    io: usize,
     opts: &Options,
     say: Say,
 ) -> Result<ethercat::EthercatIo, i32> {
-    let at = ethercat::Placement {
-        cpu: opts.cpu,
-        priority: opts.priority,
-    };
-    let names = mine.axes.iter().map(|a| a.name.clone()).collect();
-    let started =
-        ethercat::bus_config(mine, io, opts.interface.as_deref(), at).and_then(|(cfg, map)| {
-            say.info(format_args!(
-                "EtherCAT: starting the bus on {} (cycle {} us, dc {:?}, SM watchdog {} ms)",
-                cfg.interface,
-                cfg.cycle.as_micros(),
-                cfg.dc,
-                cfg.sm_watchdog.as_millis()
-            ));
-            ethercat::EthercatIo::start(cfg, map, names)
-        });
+    let names = cfg
+        .axes_of(io)
+        .iter()
+        .map(|&a| cfg.axes[a].name.clone())
+        .collect();
+    let started = motion_config::EthercatBus::for_io(
+        cfg,
+        io,
+        opts.interface.as_deref(),
+        opts.cpu,
+        opts.priority,
+    )
+    .map_err(|message| ethercat::StartError { code: 2, message })
+    .and_then(|(bus, map)| {
+        say.info(format_args!(
+            "EtherCAT: starting the bus on {} (cycle {} us, dc {:?}, SM watchdog {} ms)",
+            bus.keys.interface,
+            bus.cycle().as_micros(),
+            bus.keys.dc,
+            bus.sm_watchdog().as_millis()
+        ));
+        ethercat::EthercatIo::start(bus, map, names)
+    });
     match started {
         Ok(b) => {
             for line in b.report_lines() {

@@ -18,10 +18,10 @@
 
 use std::time::Duration;
 
+use motion_frames::backend::Backend;
 use motion_frames::FeedbackFrame;
 use motion_ipc::{monotonic_ns, Domain, IoPorts, IpcError};
 
-use crate::backend::Backend;
 use crate::say::{Once, Say};
 use motion_rt::termination as signals;
 

@@ -8,11 +8,10 @@
 //! watchdog stop, which advances the stopping axes one cycle per call.
 
 use motion_config::MachineConfig;
+use motion_frames::backend::{Backend, ExchangeError};
 use motion_frames::{axis_to_command, feedback_to_axis, CommandFrame, FeedbackFrame};
 use motion_homing::Command;
 use motion_plant::Plant;
-
-use crate::backend::{Backend, ExchangeError};
 
 /// Deceleration used by the watchdog stop when the axis has no
 /// `home_deceleration` configured, units/s².

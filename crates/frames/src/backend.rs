@@ -1,11 +1,15 @@
-//! The drive backend: what sits behind the frames. `sim` ([`crate::sim`])
-//! simulates the axes; `ethercat` ([`crate::ethercat`]) drives CiA 402
-//! drives on an EtherCAT bus; another fieldbus master (CANopen, ...) would
-//! implement the same trait.
+//! The drive backend: what sits behind the frames of a drive-I/O process.
+//! `motion-io`'s `sim` backend simulates the axes; `motion-ethercat`'s
+//! `EthercatBackend` drives CiA 402 drives on an EtherCAT bus; another
+//! fieldbus master (CANopen, ...) would implement the same trait.
+//!
+//! The trait lives here, beside the frames it takes and returns, so that the
+//! `motion-io` binary and the backend crates share one definition of it and
+//! of [`ExchangeError`] (a backend crate cannot depend on a binary).
 
 use std::fmt;
 
-use motion_frames::{CommandFrame, FeedbackFrame};
+use crate::{CommandFrame, FeedbackFrame};
 
 /// Why [`Backend::exchange`] did not apply a command frame. The feedback is
 /// still filled (the backend's own axes), so the supervisor sees the state.
@@ -56,10 +60,10 @@ pub const MAX_STOP_CYCLES: u32 = 100_000;
 /// * **Never panic on data.** Frames come from another process: NaN or huge
 ///   set-points, odd control bits and out-of-range latch ids must be handled
 ///   (a real drive rejects a bad set-point by faulting). The frame header was
-///   checked already ([`motion_frames::FrameHeader::check`]); the axis count
+///   checked already ([`crate::FrameHeader::check`]); the axis count
 ///   is the backend's to compare.
 /// * **Units on the wire are counts** (positions), counts/s (velocities),
-///   % rated (torque); `motion_frames::convert` maps them to position units
+///   % rated (torque); [`crate::convert`] maps them to position units
 ///   with the axis' `counts_per_unit` where the backend needs units.
 /// * **Honest feedback.** Every field reflects the drive: the enabled and
 ///   fault bits, latch ids echoed exactly as the drive reports them, a latch
@@ -76,7 +80,7 @@ pub trait Backend {
     /// Short name for messages ("sim").
     fn name(&self) -> &str;
 
-    /// Number of axes this backend drives (≤ [`motion_frames::MAX_AXES`]).
+    /// Number of axes this backend drives (≤ [`crate::MAX_AXES`]).
     fn axis_count(&self) -> usize;
 
     /// Axis names in frame order, for messages.

@@ -1,0 +1,344 @@
+//! `Engine`: the bus thread's per-cycle state and one cycle — outputs
+//! into the process image, the exchange, validity per SubDevice, every
+//! axis' step, the feedback published — plus what it decides between cycles
+//! (which background job is due). Everything is allocated in
+//! `Engine::new`; a cycle allocates nothing.
+
+use std::pin::pin;
+use std::sync::atomic::Ordering;
+use std::sync::Arc;
+use std::time::Duration;
+
+use ethercrab::error::Error;
+use ethercrab::{MainDevice, SubDeviceState};
+use motion_config::EthercatBus;
+use motion_frames::AxisCommand;
+use motion_rt::now_ns;
+
+use crate::axis::{AxisLogic, Mode};
+use crate::capacity::MAX_SUBDEVICES;
+use crate::group::{Exchanged, OpGroup};
+use crate::io::BusIo;
+use crate::jobs::{Done, Job};
+use crate::pdo::{DriveOutputs, MODE_CSP};
+use crate::startup::AxisPlan;
+use crate::status::Shared;
+use crate::words::{self, FLAG_RUNNING, MODE_EMERGENCY, MODE_WATCHDOG_STOP};
+
+/// A SubDevice out of OP is looked at again after this long.
+const RECOVERY_INTERVAL_NS: u64 = 20_000_000;
+
+/// Per-cycle state of the bus.
+pub(crate) struct Engine {
+    pub shared: Arc<Shared>,
+    axes: Vec<AxisLogic>,
+    plans: Vec<AxisPlan>,
+    pub sd_of_axis: Vec<usize>,
+    outputs: Vec<DriveOutputs>,
+    /// Working-counter contribution of each SubDevice (1 inputs, 2 outputs).
+    contrib: Vec<u16>,
+    expected_wkc: u16,
+    cmd_words: Vec<u64>,
+    fb_words: Vec<u64>,
+    cmds: Vec<AxisCommand>,
+    mode: Mode,
+    window_written: Vec<Option<u32>>,
+    window_pending: Vec<bool>,
+    /// Per SubDevice: not in OP since (ns).
+    pub not_op_since: Vec<Option<u64>>,
+    /// Per SubDevice: answered its AL status read last cycle.
+    answering: Vec<bool>,
+    /// Per SubDevice: last recovery attempt (ns).
+    last_recovery: Vec<u64>,
+    given_up: Vec<bool>,
+    pub period_ns: u64,
+    reply_ns: u64,
+    pub cycle: u64,
+    /// Counting no-data causes (not while waiting for OP at start-up).
+    pub counting: bool,
+}
+
+/// Validity of this cycle's data per SubDevice.
+struct Validity {
+    /// The frame came back in time.
+    frame_ok: bool,
+    /// In OP with a working counter that matches (or whose shortfall is
+    /// exactly explained by SubDevices that did not answer).
+    valid: [bool; MAX_SUBDEVICES],
+    /// Not in OP (the cause counted when its data is missing).
+    not_op: [bool; MAX_SUBDEVICES],
+}
+
+impl Engine {
+    pub fn new(
+        shared: Arc<Shared>,
+        plans: Vec<AxisPlan>,
+        cfg: &EthercatBus,
+        group: &OpGroup,
+        md: &MainDevice<'_>,
+    ) -> Engine {
+        let n = plans.len();
+        let cycle_s = cfg.cycle().as_secs_f64();
+        let axes = plans
+            .iter()
+            .zip(&cfg.axes)
+            .map(|(p, a)| AxisLogic::new(p.layout, cycle_s, a.ethercat.index_pulse_bit))
+            .collect();
+        let count = group.len();
+        let mut contrib = vec![0u16; count];
+        for (i, c) in contrib.iter_mut().enumerate() {
+            if let Ok(sd) = group.subdevice(md, i) {
+                let io = sd.io_raw();
+                *c = u16::from(!io.inputs().is_empty()) + 2 * u16::from(!io.outputs().is_empty());
+            }
+        }
+        let window_written = plans
+            .iter()
+            .map(|p| p.has_window.then_some(u32::MAX))
+            .collect();
+        Engine {
+            axes,
+            sd_of_axis: plans.iter().map(|p| p.sd).collect(),
+            outputs: plans
+                .iter()
+                .map(|_| DriveOutputs {
+                    mode: MODE_CSP,
+                    ..DriveOutputs::default()
+                })
+                .collect(),
+            plans,
+            expected_wkc: contrib.iter().sum(),
+            contrib,
+            cmd_words: vec![0; words::len(n)],
+            fb_words: vec![0; words::len(n)],
+            cmds: vec![AxisCommand::ZERO; n],
+            mode: Mode::Normal,
+            window_written,
+            window_pending: vec![false; n],
+            not_op_since: vec![None; count],
+            answering: vec![true; count],
+            last_recovery: vec![0; count],
+            given_up: vec![false; count],
+            period_ns: cfg.cycle().as_nanos() as u64,
+            reply_ns: cfg.reply_timeout().as_nanos() as u64,
+            cycle: 0,
+            counting: false,
+            shared,
+        }
+    }
+
+    /// Every SubDevice is in OP.
+    pub fn all_in_op(&self) -> bool {
+        self.not_op_since.iter().all(Option::is_none)
+    }
+
+    /// Takes the newest commands from `motion-io` (never blocks; a failed
+    /// read keeps the previous ones).
+    pub fn read_commands(&mut self) {
+        if self.shared.commands.published() == 0 {
+            return; // nothing from motion-io yet: disabled
+        }
+        if !self.shared.commands.read(&mut self.cmd_words) {
+            self.shared
+                .command_read_failures
+                .fetch_add(1, Ordering::Relaxed);
+            return; // keep the previous commands
+        }
+        self.mode = match self.cmd_words[1] {
+            MODE_WATCHDOG_STOP => Mode::WatchdogStop,
+            MODE_EMERGENCY => Mode::Emergency,
+            _ => Mode::Normal,
+        };
+        for (i, c) in self.cmds.iter_mut().enumerate() {
+            *c = words::command(&self.cmd_words, i);
+        }
+    }
+
+    /// One exchange; returns the DC wait to the next cycle, if any.
+    pub fn cycle(
+        &mut self,
+        io: &mut BusIo<'_>,
+        group: &OpGroup,
+        md: &MainDevice<'_>,
+        start: u64,
+    ) -> Option<Duration> {
+        self.cycle += 1;
+        for (k, plan) in self.plans.iter().enumerate() {
+            if let Ok(sd) = group.subdevice(md, plan.sd) {
+                let mut o = sd.outputs_raw_mut();
+                plan.layout.pack_outputs(&self.outputs[k], &mut o);
+            }
+        }
+        let result = {
+            let fut = pin!(group.exchange(md));
+            io.run(fut, Some(start + self.reply_ns), self.reply_ns)
+        };
+        let done = now_ns();
+        let sh = &self.shared;
+        sh.frames_sent.store(io.counters.sent, Ordering::Relaxed);
+        sh.frames_received
+            .store(io.counters.received, Ordering::Relaxed);
+        sh.late_frames
+            .store(io.counters.unmatched, Ordering::Relaxed);
+        let validity = self.validity(result.as_ref(), start, done);
+        let rest_mask = self.step_axes(&validity, group, md);
+        self.fb_words[0] = self.cycle;
+        self.fb_words[1] = done;
+        self.fb_words[2] = FLAG_RUNNING;
+        self.fb_words[3] = rest_mask;
+        self.shared.feedback.write(&self.fb_words);
+        self.shared.cycles.store(self.cycle, Ordering::Relaxed);
+        match result {
+            Some(Ok(ex)) => ex.next_wait,
+            _ => None,
+        }
+    }
+
+    /// Which SubDevices' data is valid this cycle; notes who left or came
+    /// back to OP (`done`: when the exchange ended).
+    fn validity(
+        &mut self,
+        result: Option<&Result<Exchanged, Error>>,
+        start: u64,
+        done: u64,
+    ) -> Validity {
+        let sh = &self.shared;
+        let mut v = Validity {
+            frame_ok: false,
+            valid: [false; MAX_SUBDEVICES],
+            not_op: [false; MAX_SUBDEVICES],
+        };
+        let Some(Ok(ex)) = result else {
+            if self.counting {
+                sh.lost_frames.fetch_add(1, Ordering::Relaxed);
+            }
+            return v;
+        };
+        v.frame_ok = true;
+        sh.record_roundtrip(done.saturating_sub(start));
+        let count = self.contrib.len();
+        let state = |i: usize| ex.states.get(i).copied().unwrap_or(SubDeviceState::None);
+        let silent: u16 = (0..count)
+            .filter(|&i| state(i) == SubDeviceState::None)
+            .map(|i| self.contrib[i])
+            .sum();
+        let all_ok = ex.wkc == self.expected_wkc;
+        let explained = !all_ok && self.expected_wkc.checked_sub(ex.wkc) == Some(silent);
+        if !all_ok && self.counting {
+            sh.wkc_errors.fetch_add(1, Ordering::Relaxed);
+        }
+        for i in 0..count {
+            self.answering[i] = state(i) != SubDeviceState::None;
+            let op = state(i) == SubDeviceState::Op;
+            v.not_op[i] = !op;
+            v.valid[i] = op && (all_ok || explained);
+            match (op, self.not_op_since[i]) {
+                (true, Some(_)) => {
+                    self.not_op_since[i] = None;
+                    self.given_up[i] = false;
+                }
+                (false, None) => self.not_op_since[i] = Some(done),
+                _ => {}
+            }
+        }
+        v
+    }
+
+    /// Every axis' step (`SW_NO_DATA` and the cause counted where its data
+    /// is not valid); returns the at-rest mask.
+    fn step_axes(&mut self, v: &Validity, group: &OpGroup, md: &MainDevice<'_>) -> u64 {
+        let sh = &self.shared;
+        let mut rest_mask = 0u64;
+        for k in 0..self.axes.len() {
+            let sdi = self.sd_of_axis[k];
+            let inputs = if v.frame_ok && v.valid[sdi] {
+                group
+                    .subdevice(md, sdi)
+                    .ok()
+                    .map(|sd| self.plans[k].layout.unpack_inputs(&sd.inputs_raw()))
+            } else {
+                if self.counting {
+                    let a = &sh.axis[k];
+                    let cause = if !v.frame_ok {
+                        &a.lost
+                    } else if v.not_op[sdi] {
+                        &a.not_op
+                    } else {
+                        &a.wkc
+                    };
+                    cause.fetch_add(1, Ordering::Relaxed);
+                }
+                None
+            };
+            let (out, fb) = self.axes[k].step(&self.cmds[k], self.mode, inputs.as_ref());
+            self.outputs[k] = out;
+            if self.axes[k].at_rest_and_disabled() {
+                rest_mask |= 1 << k;
+            }
+            sh.axis[k]
+                .rejected
+                .store(self.axes[k].counters.rejected_setpoints, Ordering::Relaxed);
+            words::put_feedback(&mut self.fb_words, k, &fb);
+        }
+        rest_mask
+    }
+
+    /// The next background job, if one is due.
+    pub fn next_job(&mut self, now: u64) -> Option<Job> {
+        for i in 0..self.contrib.len() {
+            if let Some(since) = self.not_op_since[i] {
+                if !self.given_up[i]
+                    && self.answering[i]
+                    && now.saturating_sub(since) >= RECOVERY_INTERVAL_NS / 4
+                    && now.saturating_sub(self.last_recovery[i]) >= RECOVERY_INTERVAL_NS
+                {
+                    self.last_recovery[i] = now;
+                    return Some(Job::Recover(i));
+                }
+            }
+        }
+        for (k, a) in self.axes.iter().enumerate() {
+            if let Some(written) = self.window_written[k] {
+                let want = a.following_error_window();
+                if want != written
+                    && !self.window_pending[k]
+                    && self.not_op_since[self.sd_of_axis[k]].is_none()
+                {
+                    self.window_pending[k] = true;
+                    return Some(Job::Window {
+                        axis: k,
+                        value: want,
+                    });
+                }
+            }
+        }
+        None
+    }
+
+    /// Counts how `job` ended (`None`: it timed out).
+    pub fn job_done(&mut self, job: Job, r: Option<Result<Done, Error>>) {
+        let sh = &self.shared;
+        match (job, r) {
+            (Job::Recover(_), Some(Ok(Done::OpRequested))) => {
+                sh.recoveries.fetch_add(1, Ordering::Relaxed);
+            }
+            (Job::Recover(i), Some(Ok(Done::LostConfiguration))) => {
+                sh.needs_restart.fetch_add(1, Ordering::Relaxed);
+                self.given_up[i] = true;
+            }
+            (Job::Recover(_), Some(Ok(_))) => {}
+            (Job::Recover(_), _) => {
+                sh.recovery_failures.fetch_add(1, Ordering::Relaxed);
+            }
+            (Job::Window { axis, value }, Some(Ok(_))) => {
+                self.window_written[axis] = Some(value);
+                self.window_pending[axis] = false;
+                sh.axis[axis].window_writes.fetch_add(1, Ordering::Relaxed);
+            }
+            (Job::Window { axis, .. }, _) => {
+                self.window_pending[axis] = false;
+                sh.window_write_failures.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+    }
+}
