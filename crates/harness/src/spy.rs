@@ -5,8 +5,10 @@
 //! it shows does not depend on when the spy itself ran; frames it missed
 //! show as gaps in the sequence numbers.
 
-use crate::sys;
-use iceoryx2::prelude::ServiceName;
+use iceoryx2::node::Node;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::{ipc, ServiceName, ZeroCopySend};
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
 use motion_frames::ports::{MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED};
 use motion_frames::wait::ppoll_until;
 use motion_frames::{monotonic_ns, CommandFrame, Domain, FeedbackFrame, IoServiceNames};
@@ -84,6 +86,8 @@ impl Recording {
     }
 }
 
+type PubSub<T> = PortFactory<ipc::Service, T, ()>;
+
 /// A running spy thread.
 pub struct Spy {
     stop: Arc<AtomicBool>,
@@ -92,6 +96,35 @@ pub struct Spy {
 
 fn service(name: &str) -> Result<ServiceName, String> {
     ServiceName::new(name).map_err(|e| format!("service name {name:?}: {e:?}"))
+}
+
+/// Opens a frame topic as the frames' services are created (same
+/// settings, or iceoryx2 refuses to open it).
+fn open_topic<T: std::fmt::Debug + ZeroCopySend>(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> Result<PubSub<T>, String> {
+    node.service_builder(&service(name)?)
+        .publish_subscribe::<T>()
+        .enable_safe_overflow(true)
+        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+        .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
+        .history_size(0)
+        .max_publishers(1)
+        .max_subscribers(MAX_SUBSCRIBERS)
+        .open()
+        .map_err(|e| format!("open {name}: {e:?}"))
+}
+
+fn subscribe<T: std::fmt::Debug + ZeroCopySend>(
+    topic: &PubSub<T>,
+    what: &str,
+) -> Result<Subscriber<ipc::Service, T, ()>, String> {
+    topic
+        .subscriber_builder()
+        .buffer_size(SUBSCRIBER_BUFFER)
+        .create()
+        .map_err(|e| format!("{what} subscriber: {e:?}"))
 }
 
 impl Spy {
@@ -172,50 +205,22 @@ fn run<F: FnMut(&Cmd)>(
         fbs: Vec::with_capacity(capacity),
         error: None,
     };
-    for w in sys::enter_rt(Some(cpu), (priority > 0).then_some(priority)) {
+    for w in crate::placement::enter(cpu, (priority > 0).then_some(priority)) {
         eprintln!("spy: warning: {w}");
     }
     let setup = || -> Result<_, String> {
         let domain = Domain::join(prefix, None).map_err(|e| e.to_string())?;
         let node = domain.create_node("mb-spy").map_err(|e| e.to_string())?;
         let n = IoServiceNames::new(prefix, io);
-        let cmd_topic = node
-            .service_builder(&service(&n.command)?)
-            .publish_subscribe::<CommandFrame>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(0)
-            .max_publishers(1)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open()
-            .map_err(|e| format!("open {}: {e:?}", n.command))?;
-        let fb_topic = node
-            .service_builder(&service(&n.feedback)?)
-            .publish_subscribe::<FeedbackFrame>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(0)
-            .max_publishers(1)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open()
-            .map_err(|e| format!("open {}: {e:?}", n.feedback))?;
+        let cmd_topic = open_topic::<CommandFrame>(&node, &n.command)?;
+        let fb_topic = open_topic::<FeedbackFrame>(&node, &n.feedback)?;
         let event = node
             .service_builder(&service(&n.command_ready)?)
             .event()
             .open()
             .map_err(|e| format!("open {}: {e:?}", n.command_ready))?;
-        let cmd_sub = cmd_topic
-            .subscriber_builder()
-            .buffer_size(SUBSCRIBER_BUFFER)
-            .create()
-            .map_err(|e| format!("command subscriber: {e:?}"))?;
-        let fb_sub = fb_topic
-            .subscriber_builder()
-            .buffer_size(SUBSCRIBER_BUFFER)
-            .create()
-            .map_err(|e| format!("feedback subscriber: {e:?}"))?;
+        let cmd_sub = subscribe(&cmd_topic, "command")?;
+        let fb_sub = subscribe(&fb_topic, "feedback")?;
         let listener = event
             .listener_builder()
             .create()
