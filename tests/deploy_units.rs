@@ -1,7 +1,7 @@
 //! The systemd units in deploy/ are valid: `systemd-analyze verify` accepts
 //! them (with the binary paths pointed at this build).
 
-use motion_tests::bin;
+use motion_harness::bins::test_bin as bin;
 use std::process::Command;
 
 #[test]
