@@ -11,7 +11,9 @@ use motion_frames::{
     monotonic_ns, AxisCommand, CommandFrame, Domain, FeedbackFrame, Sent, SupervisorPorts,
 };
 
+use crate::commands::spawn_io;
 use crate::leftovers::clean_and_assert_empty;
+use crate::process::Running;
 
 /// The played supervisor; its session is withdrawn on drop.
 pub struct SupervisorPeer {
@@ -30,7 +32,8 @@ pub struct Answer {
 }
 
 impl SupervisorPeer {
-    /// Establishes the domain of `prefix` and the services of I/O process `io`.
+    /// Establishes the domain of `prefix` and the services of the I/O
+    /// process named `io`.
     pub fn new(prefix: &str) -> Self {
         let domain = Domain::establish(prefix, None).unwrap();
         let node = domain.create_node("test-supervisor").unwrap();
@@ -115,6 +118,36 @@ impl Drop for SupervisorPeer {
     fn drop(&mut self) {
         self.domain.withdraw();
     }
+}
+
+/// Starts `motion-io <args>`, waits until it waits for its supervisor, and
+/// plays the supervisor of `prefix` for it.
+#[track_caller]
+pub fn io_with_peer(args: &[&str], prefix: &str) -> (Running, SupervisorPeer) {
+    let io = spawn_io(args);
+    let waiting = io.wait_line("waiting for the supervisor", Duration::from_secs(10));
+    assert!(
+        waiting.is_some(),
+        "motion-io did not start: {}",
+        io.stderr()
+    );
+    (io, SupervisorPeer::new(prefix))
+}
+
+/// Runs the calling thread — the test's, playing the supervisor — at
+/// SCHED_FIFO 80 like the real supervisor's cycle, where the OS allows it
+/// (root, `RLIMIT_RTPRIO`); elsewhere it stays as it is. Returns whether it
+/// got it. For a test whose verdict hangs on the played supervisor's
+/// cadence (20 ms of silence trips `motion-io`'s watchdog): on a loaded
+/// 2-CPU machine a normal thread can be off the CPU that long.
+pub fn pace_like_the_supervisor() -> bool {
+    let got = motion_rt::enter_realtime(&motion_rt::RtConfig {
+        cpu: None,
+        priority: 80,
+        lock_memory: false,
+        prefault_stack: 0,
+    });
+    got.policy == motion_rt::SchedPolicy::Fifo
 }
 
 /// Paces a loop at `period` with absolute deadlines.
