@@ -228,8 +228,19 @@ fn forged_commands_never_move_an_axis() {
 // Another local user
 // ---------------------------------------------------------------------------
 
-/// Creates the attacker user (root only); `None` with the reason otherwise.
-fn attacker_user() -> Result<(), String> {
+/// Creates the attacker user; false, with `SKIPPED: …` printed, where
+/// it cannot (not root).
+fn attacker_user() -> bool {
+    match create_attacker_user() {
+        Ok(()) => true,
+        Err(why) => {
+            eprintln!("SKIPPED: another-user attacks need root to create a user ({why})");
+            false
+        }
+    }
+}
+
+fn create_attacker_user() -> Result<(), String> {
     if !nix::unistd::geteuid().is_root() {
         return Err("not running as root".into());
     }
@@ -367,8 +378,7 @@ fn attacker_part() {
 /// attach subscribers. Everything is refused, and homing is exact.
 #[test]
 fn another_user_can_open_nothing_of_a_running_supervisor() {
-    if let Err(why) = attacker_user() {
-        eprintln!("SKIPPED: another-user attacks need root to create a user ({why})");
+    if !attacker_user() {
         return;
     }
     let _serial = serial();
@@ -403,8 +413,7 @@ fn another_user_can_open_nothing_of_a_running_supervisor() {
 /// (or that others may write) is refused with a clear message.
 #[test]
 fn a_runtime_dir_another_user_created_is_refused() {
-    if let Err(why) = attacker_user() {
-        eprintln!("SKIPPED: needs root to create a user ({why})");
+    if !attacker_user() {
         return;
     }
     let _serial = serial();
@@ -602,33 +611,13 @@ fn hostile_arguments_and_files_are_refused_at_once() {
     let _serial = serial();
     let cfg = x_axis("args");
     let path = cfg.arg();
+    let home = |extra: &[&'static str]| [&["home", "--json", "--config", path], extra].concat();
     for args in [
-        vec!["home", "--json", "--config", path, "--timeout", "1e308"],
-        vec!["home", "--json", "--config", path, "--timeout", "1e19"],
-        vec![
-            "home",
-            "--json",
-            "--config",
-            path,
-            "--service-prefix",
-            "../../tmp/x",
-        ],
-        vec![
-            "home",
-            "--json",
-            "--config",
-            path,
-            "--service-prefix",
-            "a/b",
-        ],
-        vec![
-            "home",
-            "--json",
-            "--config",
-            path,
-            "--service-prefix",
-            "x y",
-        ],
+        home(&["--timeout", "1e308"]),
+        home(&["--timeout", "1e19"]),
+        home(&["--service-prefix", "../../tmp/x"]),
+        home(&["--service-prefix", "a/b"]),
+        home(&["--service-prefix", "x y"]),
         vec!["home", "--json", "--config", "--json"],
         vec!["run", "--json", "--config", path, "--duration", "nan"],
     ] {

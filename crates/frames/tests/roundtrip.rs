@@ -130,16 +130,30 @@ fn io_answer(cmd: &CommandFrame) -> Feedback {
     }
 }
 
+/// A supervisor's and an I/O process's nodes and ports on `env`'s domain,
+/// connected. Bind all four: the ports go before their nodes.
+fn connected(
+    env: &TestEnv,
+) -> (
+    Node<ipc::Service>,
+    Node<ipc::Service>,
+    SupervisorPorts,
+    IoPorts,
+) {
+    let sup_node = env.domain.create_node("motion-supervisor").unwrap();
+    let io_node = env.domain.create_node("motion-io").unwrap();
+    let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
+    let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
+    sup.update_connections().unwrap();
+    io.update_connections().unwrap();
+    (sup_node, io_node, sup, io)
+}
+
 #[test]
 fn thousand_round_trips_in_one_process_and_nothing_left_behind() {
     let env = TestEnv::new("rt");
     {
-        let sup_node = env.domain.create_node("motion-supervisor").unwrap();
-        let io_node = env.domain.create_node("motion-io").unwrap();
-        let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
-        let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
-        sup.update_connections().unwrap();
-        io.update_connections().unwrap();
+        let (_sup_node, _io_node, mut sup, mut io) = connected(&env);
 
         let timeout = Duration::from_secs(2);
         let mut last_cmd_ts = 0;
@@ -210,12 +224,7 @@ fn thousand_round_trips_in_one_process_and_nothing_left_behind() {
 fn heap_allocations_per_operation() {
     let env = TestEnv::new("al");
     {
-        let sup_node = env.domain.create_node("motion-supervisor").unwrap();
-        let io_node = env.domain.create_node("motion-io").unwrap();
-        let mut sup = SupervisorPorts::create(&sup_node, &env.domain, "io").unwrap();
-        let mut io = IoPorts::open(&io_node, &env.domain, "io").unwrap();
-        sup.update_connections().unwrap();
-        io.update_connections().unwrap();
+        let (_sup_node, _io_node, mut sup, mut io) = connected(&env);
 
         let timeout = Duration::from_secs(2);
         let mut t_publish = Tally::new("SupervisorPorts::publish (loan+init+send)");

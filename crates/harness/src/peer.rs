@@ -9,11 +9,14 @@ use iceoryx2::node::Node;
 use iceoryx2::prelude::ipc;
 use motion_frames::{
     monotonic_ns, AxisCommand, CommandFrame, Domain, FeedbackFrame, Sent, SupervisorPorts,
+    CW_ENABLE,
 };
 
 use crate::commands::spawn_io;
-use crate::leftovers::clean_and_assert_empty;
+use crate::leftovers::{clean_and_assert_empty, DomainGuard};
+use crate::machines::{Machine, TempConfig};
 use crate::process::Running;
+use crate::unique_prefix;
 
 /// The played supervisor; its session is withdrawn on drop.
 pub struct SupervisorPeer {
@@ -117,6 +120,44 @@ impl SupervisorPeer {
 impl Drop for SupervisorPeer {
     fn drop(&mut self) {
         self.domain.withdraw();
+    }
+}
+
+/// `motion-io --config <machine> --service-prefix P`, P a prefix of its own
+/// (the command line wins over the config's), once it waits for its
+/// supervisor, and the supervisor of P played for it. Bind all four
+/// (`let (_cfg, _guard, mut io, mut sup) = …`): the peer and the child go
+/// first, then the guard tidies the domain after a panic.
+#[track_caller]
+pub fn io_on_own_prefix(machine: &Machine) -> (TempConfig, DomainGuard, Running, SupervisorPeer) {
+    let cfg = machine.write("iotest_cfg");
+    let prefix = unique_prefix("iotest");
+    let guard = DomainGuard(prefix.clone());
+    let (io, sup) = io_with_peer(
+        &["--config", cfg.arg(), "--service-prefix", &prefix],
+        &prefix,
+    );
+    (cfg, guard, io, sup)
+}
+
+/// Axis command: enabled, full torque both ways, at `position` (counts)
+/// moving at `velocity` (counts/s).
+pub fn enabled(position: i64, velocity: f64) -> AxisCommand {
+    AxisCommand {
+        target_position: position,
+        target_velocity: velocity,
+        torque_limit_positive: 100.0,
+        torque_limit_negative: 100.0,
+        control_word: CW_ENABLE,
+        ..AxisCommand::ZERO
+    }
+}
+
+/// Fills a one-axis command frame with `axis`.
+pub fn one_axis(axis: AxisCommand) -> impl FnOnce(&mut CommandFrame) {
+    move |f| {
+        f.header.axis_count = 1;
+        f.axes[0] = axis;
     }
 }
 

@@ -5,11 +5,10 @@
 //! it shows does not depend on when the spy itself ran; frames it missed
 //! show as gaps in the sequence numbers.
 
-use iceoryx2::node::Node;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::{ipc, ServiceName, ZeroCopySend};
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
-use motion_frames::ports::{MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED};
+use motion_frames::ports::{open_topic, SUBSCRIBER_BUFFER};
 use motion_frames::wait::ppoll_until;
 use motion_frames::{monotonic_ns, CommandFrame, Domain, FeedbackFrame, IoServiceNames};
 use std::io::Write;
@@ -96,24 +95,6 @@ pub struct Spy {
 
 fn service(name: &str) -> Result<ServiceName, String> {
     ServiceName::new(name).map_err(|e| format!("service name {name:?}: {e:?}"))
-}
-
-/// Opens a frame topic as the frames' services are created (same
-/// settings, or iceoryx2 refuses to open it).
-fn open_topic<T: std::fmt::Debug + ZeroCopySend>(
-    node: &Node<ipc::Service>,
-    name: &str,
-) -> Result<PubSub<T>, String> {
-    node.service_builder(&service(name)?)
-        .publish_subscribe::<T>()
-        .enable_safe_overflow(true)
-        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-        .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-        .history_size(0)
-        .max_publishers(1)
-        .max_subscribers(MAX_SUBSCRIBERS)
-        .open()
-        .map_err(|e| format!("open {name}: {e:?}"))
 }
 
 fn subscribe<T: std::fmt::Debug + ZeroCopySend>(
@@ -212,8 +193,9 @@ fn run<F: FnMut(&Cmd)>(
         let domain = Domain::join(prefix, None).map_err(|e| e.to_string())?;
         let node = domain.create_node("mb-spy").map_err(|e| e.to_string())?;
         let n = IoServiceNames::new(prefix, io);
-        let cmd_topic = open_topic::<CommandFrame>(&node, &n.command)?;
-        let fb_topic = open_topic::<FeedbackFrame>(&node, &n.feedback)?;
+        let cmd_topic = open_topic::<CommandFrame>(&node, &n.command).map_err(|e| e.to_string())?;
+        let fb_topic =
+            open_topic::<FeedbackFrame>(&node, &n.feedback).map_err(|e| e.to_string())?;
         let event = node
             .service_builder(&service(&n.command_ready)?)
             .event()

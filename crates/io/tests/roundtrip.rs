@@ -5,7 +5,9 @@
 use std::time::Duration;
 
 use motion_frames::{AxisCommand, CW_ENABLE, SW_ENABLED};
-use motion_harness::peer::{io_with_peer, pace_like_the_supervisor, quantile, Pacer};
+use motion_harness::peer::{
+    enabled, io_on_own_prefix, io_with_peer, one_axis, pace_like_the_supervisor, quantile, Pacer,
+};
 use motion_harness::*;
 use nix::sys::signal::Signal;
 
@@ -57,18 +59,10 @@ fn round_trip(spin: bool) {
         let pos = target(k);
         let a = sup
             .exchange(
-                |f| {
-                    f.header.axis_count = 1;
-                    f.axes[0] = AxisCommand {
-                        target_position: pos,
-                        target_velocity: if k >= HOLD { (STEP * 1000) as f64 } else { 0.0 },
-                        torque_limit_positive: 100.0,
-                        torque_limit_negative: 100.0,
-                        control_word: CW_ENABLE,
-                        marker_arm_id: if k >= 5 { 1 } else { 0 },
-                        ..AxisCommand::ZERO
-                    };
-                },
+                one_axis(AxisCommand {
+                    marker_arm_id: if k >= 5 { 1 } else { 0 },
+                    ..enabled(pos, if k >= HOLD { (STEP * 1000) as f64 } else { 0.0 })
+                }),
                 ANSWER_TIMEOUT,
             )
             .unwrap_or_else(|| panic!("no answer to command {k}"));
@@ -156,12 +150,7 @@ fn round_trip_spin_mode() {
 
 #[test]
 fn wrong_axis_count_and_bad_frames_are_ignored() {
-    // the prefix on the command line wins over the config's
-    let cfg = Machine::fixture("io_marker").write("iotest_unused");
-    let prefix = unique_prefix("iotest");
-    let _guard = DomainGuard(prefix.clone());
-    let args = ["--config", cfg.arg(), "--service-prefix", &prefix];
-    let (mut io, mut sup) = io_with_peer(&args, &prefix);
+    let (_cfg, _guard, mut io, mut sup) = io_on_own_prefix(&Machine::fixture("io_marker"));
     sup.connect(1);
 
     // two axes for a one-axis config: answered with our one axis, not applied

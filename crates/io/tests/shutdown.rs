@@ -3,8 +3,11 @@
 
 use std::time::{Duration, Instant};
 
-use motion_frames::{cleanup_domain, AxisCommand, CW_ENABLE, SW_ENABLED};
-use motion_harness::peer::{io_with_peer, pace_like_the_supervisor, Pacer, SupervisorPeer};
+use motion_frames::{cleanup_domain, SW_ENABLED};
+use motion_harness::peer::{
+    enabled, io_on_own_prefix, io_with_peer, one_axis, pace_like_the_supervisor, Pacer,
+    SupervisorPeer,
+};
 use motion_harness::*;
 use nix::sys::signal::Signal;
 
@@ -14,11 +17,7 @@ const STOP_LINE: &str = "motion-io: signal: every axis stopped";
 fn sigterm_while_moving_stops_every_axis_and_exits_0() {
     // 50 ms of silence would trip motion-io's watchdog mid-move
     pace_like_the_supervisor();
-    let cfg = Machine::fixture("io_marker").write("iotest_unused");
-    let prefix = unique_prefix("iotest");
-    let _guard = DomainGuard(prefix.clone());
-    let args = ["--config", cfg.arg(), "--service-prefix", &prefix];
-    let (mut io, mut sup) = io_with_peer(&args, &prefix);
+    let (_cfg, _guard, mut io, mut sup) = io_on_own_prefix(&Machine::fixture("io_marker"));
     sup.connect(1);
     let mut pacer = Pacer::new(Duration::from_millis(1));
     let mut pos = 0;
@@ -26,20 +25,7 @@ fn sigterm_while_moving_stops_every_axis_and_exits_0() {
         pacer.wait();
         pos += 30;
         let a = sup
-            .exchange(
-                |f| {
-                    f.header.axis_count = 1;
-                    f.axes[0] = AxisCommand {
-                        target_position: pos,
-                        target_velocity: 30_000.0,
-                        torque_limit_positive: 100.0,
-                        torque_limit_negative: 100.0,
-                        control_word: CW_ENABLE,
-                        ..AxisCommand::ZERO
-                    };
-                },
-                Duration::from_secs(2),
-            )
+            .exchange(one_axis(enabled(pos, 30_000.0)), Duration::from_secs(2))
             .expect("answer");
         if k >= 2 {
             assert_eq!(a.fb.axes[0].status_word, SW_ENABLED);

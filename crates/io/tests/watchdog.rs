@@ -6,7 +6,9 @@ use std::time::{Duration, Instant};
 
 use motion_frames::{AxisCommand, FeedbackFrame, CW_ENABLE, SW_ENABLED, SW_FAULT};
 use motion_harness::leftovers::clean_and_assert_empty;
-use motion_harness::peer::{io_with_peer, pace_like_the_supervisor, Pacer, SupervisorPeer};
+use motion_harness::peer::{
+    enabled, io_on_own_prefix, one_axis, pace_like_the_supervisor, Pacer, SupervisorPeer,
+};
 use motion_harness::*;
 use nix::sys::signal::Signal;
 
@@ -16,24 +18,12 @@ const WATCHDOG_LINE: &str = "motion-io: warning: watchdog: no command for ";
 const STOPPED_LINE: &str = "motion-io: warning: watchdog: every axis stopped and disabled";
 
 /// `tests/machines/io_marker.toml` with a watchdog of [`WATCHDOG_CYCLES`].
-fn config(tag: &str) -> TempConfig {
-    Machine::fixture("io_marker")
-        .set("supervisor.io_watchdog_cycles", i64::from(WATCHDOG_CYCLES))
-        .write(tag)
+fn machine() -> Machine {
+    Machine::fixture("io_marker").set("supervisor.io_watchdog_cycles", i64::from(WATCHDOG_CYCLES))
 }
 
 fn moving(pos: i64) -> impl FnOnce(&mut motion_frames::CommandFrame) {
-    move |f| {
-        f.header.axis_count = 1;
-        f.axes[0] = AxisCommand {
-            target_position: pos,
-            target_velocity: (STEP * 1000) as f64,
-            torque_limit_positive: 100.0,
-            torque_limit_negative: 100.0,
-            control_word: CW_ENABLE,
-            ..AxisCommand::ZERO
-        };
-    }
+    one_axis(enabled(pos, (STEP * 1000) as f64))
 }
 
 /// 100 commands, enabled and moving; returns the last commanded position
@@ -129,7 +119,7 @@ fn watchdog_stop_and_exit(spin: bool) {
     // starve this test's commands that long) and pace like the supervisor.
     let _serial = serial();
     pace_like_the_supervisor();
-    let cfg = config("iotest_unused");
+    let cfg = machine().write("iotest_unused");
     let prefix = unique_prefix("iotest");
     let _guard = DomainGuard(prefix.clone());
     // --quiet: no start line to wait for, so the supervisor side comes first
@@ -197,11 +187,7 @@ fn watchdog_in_spin_mode() {
 fn watchdog_then_commands_resume_with_the_fault_handshake() {
     let _serial = serial();
     pace_like_the_supervisor();
-    let cfg = config("iotest_unused");
-    let prefix = unique_prefix("iotest");
-    let _guard = DomainGuard(prefix.clone());
-    let args = ["--config", cfg.arg(), "--service-prefix", &prefix];
-    let (mut io, mut sup) = io_with_peer(&args, &prefix);
+    let (_cfg, _guard, mut io, mut sup) = io_on_own_prefix(&machine());
     sup.connect(1);
     let (last_pos, _) = drive_100(&mut sup);
     let frames = collect_until(&mut sup, &io, Duration::from_secs(10), |io| {
@@ -223,16 +209,10 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
     );
 
     let hold = |enable: bool| {
-        move |f: &mut motion_frames::CommandFrame| {
-            f.header.axis_count = 1;
-            f.axes[0] = AxisCommand {
-                target_position: at,
-                torque_limit_positive: 100.0,
-                torque_limit_negative: 100.0,
-                control_word: if enable { CW_ENABLE } else { 0 },
-                ..AxisCommand::ZERO
-            };
-        }
+        one_axis(AxisCommand {
+            control_word: if enable { CW_ENABLE } else { 0 },
+            ..enabled(at, 0.0)
+        })
     };
     let t = Duration::from_secs(2);
     // enable still requested: no edge, the fault stays
@@ -267,7 +247,7 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
 
 #[test]
 fn exit_with_supervisor_but_no_supervisor_exits_1_after_10_s() {
-    let cfg = config("iotest_unused");
+    let cfg = machine().write("iotest_unused");
     let prefix = unique_prefix("iotest");
     let _guard = DomainGuard(prefix.clone());
     let t0 = Instant::now();
