@@ -634,15 +634,15 @@ fn hostile_arguments_and_files_are_refused_at_once() {
         assert!(t.elapsed() < Duration::from_secs(5));
     }
     // A FIFO and /dev/zero as the config: refused at once, not read forever.
-    let fifo = std::env::temp_dir().join(format!("{}.fifo", cfg.prefix));
-    nix::unistd::mkfifo(&fifo, nix::sys::stat::Mode::S_IRWXU).unwrap();
-    for file in [fifo.to_str().unwrap(), "/dev/zero"] {
+    let dir = TempDir::new("fifo");
+    let fifo = dir.file("config.fifo");
+    nix::unistd::mkfifo(fifo.as_str(), nix::sys::stat::Mode::S_IRWXU).unwrap();
+    for file in [fifo.as_str(), "/dev/zero"] {
         let t = Instant::now();
         let run = supervisor(&["check", "--json", "--config", file]);
         assert_eq!(run.code(), Some(2), "{file}: {}", run.stdout);
         assert!(run.stdout.contains("not a regular file"), "{}", run.stdout);
         assert!(t.elapsed() < Duration::from_secs(5));
     }
-    let _ = std::fs::remove_file(&fifo);
     assert!(shm_leftovers(&cfg.prefix).is_empty());
 }

@@ -49,18 +49,10 @@ fn motionctl_homes_stops_unhomes_reports_and_traces() {
     assert_close!(x, raw, -20.0, COUNT);
 
     // home X with a trace: CSV and plot
-    let dir = std::env::temp_dir();
-    let csv = dir.join(format!("{p}.csv"));
-    let svg = dir.join(format!("{p}.svg"));
+    let dir = TempDir::new("ctl_files");
+    let (csv, svg) = (dir.file("trace.csv"), dir.file("trace.svg"));
     let r = d.ctl(&[
-        "trace",
-        "X",
-        "--home",
-        "--out",
-        csv.to_str().unwrap(),
-        "--plot",
-        svg.to_str().unwrap(),
-        "--json",
+        "trace", "X", "--home", "--out", &csv, "--plot", &svg, "--json",
     ]);
     let t: TraceReport = r.expect_code(0).report();
     assert!(
@@ -82,8 +74,6 @@ fn motionctl_homes_stops_unhomes_reports_and_traces() {
     assert!(std::fs::read_to_string(&svg)
         .unwrap()
         .contains("home event -7.5000"));
-    let _ = std::fs::remove_file(&csv);
-    let _ = std::fs::remove_file(&svg);
     let x = d.axis("X");
     assert!(x.pc && x.homed, "{x:#?}");
 
@@ -125,14 +115,13 @@ fn motionctl_homes_stops_unhomes_reports_and_traces() {
     // from the JSON itself: the typed field would read 0 were it missing
     let calls = &r.json()["allocations"]["system_calls_in_cycle"];
     assert_eq!(calls, 0, "{}", r.stdout);
-    let hlog = dir.join(format!("{p}.hlog"));
-    let r = d.ctl(&["stats", "--since-reset", "--hlog", hlog.to_str().unwrap()]);
+    let hlog = dir.file("stats.hlog");
+    let r = d.ctl(&["stats", "--since-reset", "--hlog", &hlog]);
     r.expect_code(0);
     assert!(r.stdout.contains("since reset"), "{}", r.stdout);
     assert!(std::fs::read_to_string(&hlog)
         .unwrap()
         .contains("#[StartTime"));
-    let _ = std::fs::remove_file(&hlog);
 
     d.stop().expect_code(0);
     assert_clean(&p);

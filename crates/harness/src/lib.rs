@@ -12,7 +12,8 @@
 //! * [`machines`] — the fixture machines (`tests/machines/*.toml`) with
 //!   stated overrides, written as a test's temporary config;
 //!   [`generated`] — the machines the benches generate.
-//! * [`leftovers`] — what a prefix left in `/dev/shm`, and the checks.
+//! * [`leftovers`] — what a prefix left in `/dev/shm`, and the checks;
+//!   [`temp`] — a test's scratch directory.
 //! * [`check`] — rows by name, positions within a tolerance, homed axes.
 //! * [`peer`] — the supervisor's side of a `motion-io`, played by a test.
 //! * [`homing`] — homing runs and their tally (the benches).
@@ -41,6 +42,7 @@ mod placement;
 pub mod process;
 pub mod procs;
 pub mod spy;
+pub mod temp;
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -51,6 +53,7 @@ pub use leftovers::{assert_clean, shm_leftovers, DomainGuard};
 pub use machines::{Machine, TempConfig};
 pub use process::{Ended, Running};
 pub use procs::{find_process, signal_pid};
+pub use temp::TempDir;
 
 /// A service prefix no other test (or run) uses: `<tag>_<pid>_<n>`.
 pub fn unique_prefix(tag: &str) -> String {
