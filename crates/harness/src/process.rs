@@ -297,20 +297,26 @@ impl Running {
     /// it exited, also for its stderr to reach its end (every process that
     /// shares the pipe gone). `None`: still running.
     pub fn wait_exit(&mut self, timeout: Duration) -> Option<ExitStatus> {
+        let status = self.reap(timeout)?;
+        self.drain_stderr();
+        Some(status)
+    }
+
+    /// Reaps the child if it exits within `timeout` (stderr not waited for).
+    fn reap(&mut self, timeout: Duration) -> Option<ExitStatus> {
         let until = Instant::now() + timeout;
         loop {
-            if let Some(s) = self.status {
-                return Some(s);
+            if self.status.is_some() {
+                return self.status;
             }
             match self.child.as_mut()?.try_wait() {
                 Ok(Some(s)) => {
-                    self.reaped(Some(s));
+                    self.status = Some(s);
                     return Some(s);
                 }
                 Ok(None) => {}
                 Err(_) => {
                     self.child = None;
-                    self.reaped(None);
                     return None;
                 }
             }
@@ -318,6 +324,12 @@ impl Running {
                 return None;
             }
             std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+
+    fn drain_stderr(&mut self) {
+        if let Some(r) = self.stderr_reader.take() {
+            let _ = r.join();
         }
     }
 
@@ -352,16 +364,17 @@ impl Running {
         self.finish()
     }
 
-    /// SIGTERM, up to `grace` for it to end, then SIGKILL; reaps the child.
+    /// SIGTERM, up to `grace` for it to end, then SIGKILL; reaps the child
+    /// (without waiting for others that still hold its stderr).
     pub fn terminate(&mut self, grace: Duration) -> Option<ExitStatus> {
         if self.status.is_some() || self.child.is_none() {
             return self.status;
         }
-        if let Some(s) = self.wait_exit(Duration::ZERO) {
+        if let Some(s) = self.reap(Duration::ZERO) {
             return Some(s);
         }
         self.signal(Signal::SIGTERM);
-        if let Some(s) = self.wait_exit(grace) {
+        if let Some(s) = self.reap(grace) {
             if self.group {
                 // stragglers of the group (e.g. stress-ng workers)
                 self.signal_group_or_child(Signal::SIGKILL);
@@ -375,18 +388,13 @@ impl Running {
     pub fn kill(&mut self) -> Option<ExitStatus> {
         self.signal(Signal::SIGKILL);
         let s = self.child.as_mut()?.wait().ok();
-        self.reaped(s);
+        self.status = self.status.or(s);
         s
     }
 
-    fn reaped(&mut self, status: Option<ExitStatus>) {
-        self.status = status;
-        if let Some(r) = self.stderr_reader.take() {
-            let _ = r.join();
-        }
-    }
-
+    /// Everything it printed, to the end of its pipes.
     fn ended(mut self, timed_out: bool, interrupted: bool) -> Ended {
+        self.drain_stderr();
         self.child = None;
         let stdout = self
             .stdout
@@ -408,5 +416,53 @@ impl Drop for Running {
         if self.child.is_some() {
             let _ = self.terminate(Duration::from_secs(3));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sh(script: &str) -> Running {
+        Running::start(Command::new("sh").args(["-c", script]), "sh")
+    }
+
+    #[test]
+    fn output_lines_and_exit_code_are_collected() {
+        let r = sh("echo out; echo one >&2; printf 'two\\377' >&2; exit 3");
+        assert!(r.wait_line("one", Duration::from_secs(5)).is_some());
+        let e = r.finish();
+        assert_eq!((e.code(), e.stdout.as_str()), (Some(3), "out\n"));
+        assert_eq!(e.stderr, "one\ntwo\u{fffd}\n");
+        assert_eq!(e.describe(), "exit code 3");
+    }
+
+    #[test]
+    fn a_child_past_its_time_is_ended_and_so_is_a_dropped_one() {
+        let e = sh("exec sleep 30").wait(Duration::from_millis(100), Duration::from_secs(1));
+        assert!(
+            e.timed_out && e.status.and_then(|s| s.signal()) == Some(15),
+            "{e:?}"
+        );
+        // deaf to SIGTERM, and its own child holds the pipes for 8 s
+        let r = sh("trap '' TERM; echo deaf >&2; sleep 8; true");
+        assert!(r.wait_line("deaf", Duration::from_secs(5)).is_some());
+        let (pid, t0) = (Pid::from_raw(r.pid() as i32), Instant::now());
+        drop(r);
+        let took = t0.elapsed();
+        assert!(
+            took >= Duration::from_secs(3) && took < Duration::from_secs(6),
+            "{took:?}"
+        );
+        // reaped: the pid is gone (or, at worst, reused by someone else)
+        assert!(nix::sys::signal::kill(pid, None).is_err());
+    }
+
+    #[test]
+    fn wait_exit_leaves_a_running_child_alone() {
+        let mut r = sh("exec sleep 30");
+        assert!(r.wait_exit(Duration::from_millis(50)).is_none());
+        assert!(r.running());
+        assert_eq!(r.kill().and_then(|s| s.signal()), Some(9));
     }
 }
