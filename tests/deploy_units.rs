@@ -1,7 +1,8 @@
 //! The systemd units in deploy/ are valid: `systemd-analyze verify` accepts
 //! them (with the binary paths pointed at this build).
 
-use motion_tests::bin;
+use motion_harness::bins::test_bin as bin;
+use motion_harness::TempDir;
 use std::process::Command;
 
 #[test]
@@ -15,8 +16,7 @@ fn systemd_units_verify() {
         return;
     }
     let deploy = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy");
-    let dir = std::env::temp_dir().join(format!("units-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("units");
     let mut files = Vec::new();
     for (unit, as_name) in [
         ("motion-supervisor.service", "motion-supervisor.service"),
@@ -28,7 +28,7 @@ fn systemd_units_verify() {
         let text = text
             .replace("/usr/local/bin/motion-supervisor", sup.to_str().unwrap())
             .replace("/usr/local/bin/motion-io", io.to_str().unwrap());
-        let path = dir.join(as_name);
+        let path = dir.path().join(as_name);
         std::fs::write(&path, text).unwrap();
         files.push(path);
     }
@@ -46,6 +46,5 @@ fn systemd_units_verify() {
         .filter(|l| !l.trim().is_empty())
         .filter(|l| !(l.contains("resolve user") || l.contains("resolve group")))
         .collect();
-    let _ = std::fs::remove_dir_all(&dir);
     assert!(out.status.success() && problems.is_empty(), "{err}");
 }

@@ -6,8 +6,8 @@
 //! root, as CI is) and run this test binary as that user for the attacker's
 //! part; they say clearly when they are skipped.
 
-use motion_tests::*;
-use nix::sys::signal::Signal;
+use motion_harness::{assert_close, *};
+use motion_report::{CtlHomeReport, ErrorReport, HomeReport};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -16,24 +16,11 @@ use std::time::{Duration, Instant};
 const ROLE: &str = "MOTION_ATTACK_ROLE";
 const ATTACKER: &str = "motion-attacker";
 
-/// X of the demo machine: switch then marker, event exactly at -7.5.
-const X_AXIS: &str = r#"
-[[axis]]
-name = "X"
-counts_per_unit = 1000.0
-marker = true
-home_sequence = "switch_then_marker"
-home_speed = 20.0
-home_return_speed = 4.0
-home_acceleration = 500.0
-home_deceleration = 500.0
-home_timeout = 30.0
-[axis.sim]
-start = -20.0
-switch = [0.0, 5.0]
-marker_every = 10.0
-marker_at = 2.5
-"#;
+/// X of the demo machine (`tests/machines/demo_x.toml`): switch then
+/// marker, event exactly at -7.5.
+fn x_axis(tag: &str) -> TempConfig {
+    Machine::fixture("demo_x").write(tag)
+}
 
 fn iox_config(file_prefix: &str, root: &str) -> iceoryx2::config::Config {
     use iceoryx2::prelude::*;
@@ -53,7 +40,7 @@ fn iox_config(file_prefix: &str, root: &str) -> iceoryx2::config::Config {
 fn squatting_the_services_first_changes_nothing() {
     use iceoryx2::prelude::*;
     let _serial = serial();
-    let cfg = config("squat", "", X_AXIS);
+    let cfg = x_axis("squat");
     let p = cfg.prefix.clone();
     let root = "/run/motion/";
     let _ = std::fs::create_dir_all(root);
@@ -107,22 +94,18 @@ fn squatting_the_services_first_changes_nothing() {
         }
     };
     forge(&squatters);
-    let cfg_path = cfg.path.clone();
-    let homing = std::thread::spawn(move || {
-        supervisor(&["home", "--json", "--config", cfg_path.to_str().unwrap()])
-    });
+    let cfg_path = cfg.arg().to_string();
+    let homing = std::thread::spawn(move || supervisor(&["home", "--json", "--config", &cfg_path]));
     let until = Instant::now() + Duration::from_secs(60);
     while !homing.is_finished() && Instant::now() < until {
         forge(&squatters);
         std::thread::sleep(Duration::from_millis(1));
     }
     let run = homing.join().unwrap();
-    assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
-    let v = run.json();
-    let x = axis(&v, "X");
-    close(x, "event_raw", -7.5, COUNT);
+    let v: HomeReport = run.expect_code(0).report();
+    assert_close!(named(&v.axes, "X"), event_raw, -7.5, COUNT);
     assert_eq!(
-        v["io"][0]["frames_refused"], 0,
+        v.run.io[0].frames_refused, 0,
         "nothing forged even reached it"
     );
     for (_, pubs) in &squatters {
@@ -155,10 +138,11 @@ fn squatting_the_services_first_changes_nothing() {
 #[test]
 fn forged_commands_never_move_an_axis() {
     let _serial = serial();
-    let cfg = config("forge", "", X_AXIS);
+    let cfg = x_axis("forge");
     let p = cfg.prefix.clone();
-    let mut io = spawn_io(&["--config", cfg.path.to_str().unwrap()]);
-    assert!(io.wait_line("waiting for the supervisor", Duration::from_secs(10)));
+    let io = spawn_io(&["--config", cfg.arg()]);
+    let waiting = io.wait_line("waiting for the supervisor", Duration::from_secs(10));
+    assert!(waiting.is_some(), "{}", io.stderr());
     // A forger with no session: motion-io has not even created a node.
     std::thread::sleep(Duration::from_millis(500));
     assert!(motion_ipc::Domain::shm_files_of_prefix(&p).is_empty());
@@ -170,7 +154,9 @@ fn forged_commands_never_move_an_axis() {
     forged_domain.key = [0xdead, 0xbeef];
     let node = forged_domain.create_node("forger").unwrap();
     let mut ports = motion_ipc::SupervisorPorts::create(&node, &forged_domain, "io").unwrap();
-    assert!(io.wait_line("backend sim", Duration::from_secs(10)));
+    assert!(io
+        .wait_line("backend sim", Duration::from_secs(10))
+        .is_some());
     for _ in 0..300 {
         let _ = ports.send(|f| {
             f.header.axis_count = 1;
@@ -182,9 +168,10 @@ fn forged_commands_never_move_an_axis() {
         std::thread::sleep(Duration::from_millis(1));
     }
     assert!(
-        io.wait_line("does not carry this session's key", Duration::from_secs(5)),
+        io.wait_line("does not carry this session's key", Duration::from_secs(5))
+            .is_some(),
         "refusal not reported: {}",
-        io.lines.lock().unwrap().join("\n")
+        io.stderr()
     );
     // Nothing was answered: every forged frame was refused.
     assert!(ports.receive_latest().unwrap().is_none());
@@ -234,8 +221,7 @@ fn forged_commands_never_move_an_axis() {
         "the axis is where it started: -20 units"
     );
     drop((publisher, subscriber, notifier, cmd, fbk, ev, node));
-    signal(io.child.id() as i32, Signal::SIGTERM);
-    let _ = io.child.wait();
+    io.stop();
     real.withdraw();
     let _ = motion_ipc::cleanup_domain(&real);
     assert_clean(&p);
@@ -245,8 +231,19 @@ fn forged_commands_never_move_an_axis() {
 // Another local user
 // ---------------------------------------------------------------------------
 
-/// Creates the attacker user (root only); `None` with the reason otherwise.
-fn attacker_user() -> Result<(), String> {
+/// Creates the attacker user; false, with `SKIPPED: …` printed, where
+/// it cannot (not root).
+fn attacker_user() -> bool {
+    match create_attacker_user() {
+        Ok(()) => true,
+        Err(why) => {
+            eprintln!("SKIPPED: another-user attacks need root to create a user ({why})");
+            false
+        }
+    }
+}
+
+fn create_attacker_user() -> Result<(), String> {
     if !nix::unistd::geteuid().is_root() {
         return Err("not running as root".into());
     }
@@ -384,12 +381,11 @@ fn attacker_part() {
 /// attach subscribers. Everything is refused, and homing is exact.
 #[test]
 fn another_user_can_open_nothing_of_a_running_supervisor() {
-    if let Err(why) = attacker_user() {
-        eprintln!("SKIPPED: another-user attacks need root to create a user ({why})");
+    if !attacker_user() {
         return;
     }
     let _serial = serial();
-    let cfg = config("otheruser", "", X_AXIS);
+    let cfg = x_axis("otheruser");
     let p = cfg.prefix.clone();
     let d = Daemon::start(&cfg, &["io"]);
     let out = as_attacker(&[("PREFIX", p.clone()), ("RUNTIME", "/run/motion".into())]);
@@ -409,9 +405,9 @@ fn another_user_can_open_nothing_of_a_running_supervisor() {
     assert!(get("create_node_raw").starts_with("refused"), "{out}");
     assert!(get("runtime_dir_listing").starts_with("refused"), "{out}");
     // The daemon is unharmed: X homes exactly.
-    let r = ctl(&p, &["home", "X", "--json"]);
-    assert_eq!(r.code, Some(0), "{}\n{}", r.stdout, r.stderr);
-    close(axis(&r.json(), "X"), "event_raw", -7.5, COUNT);
+    let r = d.ctl(&["home", "X", "--json"]);
+    let v: CtlHomeReport = r.expect_code(0).report();
+    assert_close!(named(&v.axes, "X"), event_raw, -7.5, COUNT);
     d.stop();
     assert_clean(&p);
 }
@@ -420,8 +416,7 @@ fn another_user_can_open_nothing_of_a_running_supervisor() {
 /// (or that others may write) is refused with a clear message.
 #[test]
 fn a_runtime_dir_another_user_created_is_refused() {
-    if let Err(why) = attacker_user() {
-        eprintln!("SKIPPED: needs root to create a user ({why})");
+    if !attacker_user() {
         return;
     }
     let _serial = serial();
@@ -436,20 +431,17 @@ fn a_runtime_dir_another_user_created_is_refused() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let cfg = config("squatdir", "", X_AXIS);
+    let cfg = x_axis("squatdir");
     let run = supervisor(&[
         "home",
         "--json",
         "--config",
-        cfg.path.to_str().unwrap(),
+        cfg.arg(),
         "--runtime-dir",
         &dir,
     ]);
-    assert_eq!(run.code, Some(1), "{}\n{}", run.stdout, run.stderr);
-    let msg = run.json()["errors"][0]["message"]
-        .as_str()
-        .unwrap()
-        .to_string();
+    let v: ErrorReport = run.expect_code(1).report();
+    let msg = &v.errors[0].message;
     assert!(msg.contains("belongs to uid"), "{msg}");
     let _ = std::fs::remove_dir_all(&dir);
     assert_clean(&cfg.prefix);
@@ -460,19 +452,12 @@ fn a_runtime_dir_another_user_created_is_refused() {
 #[test]
 fn a_second_supervisor_under_the_same_prefix_is_refused() {
     let _serial = serial();
-    let cfg = config("twice", "", X_AXIS);
+    let cfg = x_axis("twice");
     let d = Daemon::start(&cfg, &["io"]);
-    let run = supervisor(&[
-        "run",
-        "--json",
-        "--duration",
-        "1",
-        "--config",
-        cfg.path.to_str().unwrap(),
-    ]);
-    assert_eq!(run.code, Some(1), "{}\n{}", run.stdout, run.stderr);
+    let run = supervisor(&["run", "--json", "--duration", "1", "--config", cfg.arg()]);
+    run.expect_code(1);
     assert!(run.stdout.contains("already runs"), "{}", run.stdout);
-    assert_eq!(d.status()["io"][0]["attached"], true);
+    assert!(d.status().io[0].attached);
     d.stop();
     assert_clean(&cfg.prefix);
 }
@@ -600,10 +585,10 @@ fn hostile_configs_are_refused_by_key_before_anything_starts() {
         ),
     ];
     for (sup, axes, key) in cases {
-        let cfg = config("hostile", &sup, &axes);
-        let path = cfg.path.to_str().unwrap();
+        let cfg = Machine::parse(&format!("[supervisor]\n{sup}\n{axes}")).write("hostile");
+        let path = cfg.arg();
         let run = supervisor(&["check", "--config", path]);
-        assert_eq!(run.code, Some(2), "{key}: {}", run.stderr);
+        assert_eq!(run.code(), Some(2), "{key}: {}", run.stderr);
         assert!(run.stderr.contains(key), "{key}: {}", run.stderr);
         assert!(!run.stderr.contains('\u{1b}'), "an escape was echoed");
         assert!(
@@ -612,14 +597,11 @@ fn hostile_configs_are_refused_by_key_before_anything_starts() {
             run.stderr.len()
         );
         let run = supervisor(&["home", "--json", "--config", path]);
-        assert_eq!(run.code, Some(2), "{key}: {}", run.stdout);
-        let v = run.json();
-        let errors = v["errors"].as_array().expect("errors");
+        assert_eq!(run.code(), Some(2), "{key}: {}", run.stdout);
+        let v: ErrorReport = run.report();
         assert!(
-            errors
-                .iter()
-                .any(|e| e["key"].as_str().is_some_and(|k| k.contains(key))),
-            "{key}: {v}"
+            (v.errors.iter()).any(|e| e.key.as_deref().is_some_and(|k| k.contains(key))),
+            "{key}: {v:#?}"
         );
         assert!(shm_leftovers(&cfg.prefix).is_empty());
     }
@@ -630,60 +612,40 @@ fn hostile_configs_are_refused_by_key_before_anything_starts() {
 #[test]
 fn hostile_arguments_and_files_are_refused_at_once() {
     let _serial = serial();
-    let cfg = config("args", "", X_AXIS);
-    let path = cfg.path.to_str().unwrap();
+    let cfg = x_axis("args");
+    let path = cfg.arg();
+    let home = |extra: &[&'static str]| [&["home", "--json", "--config", path], extra].concat();
     for args in [
-        vec!["home", "--json", "--config", path, "--timeout", "1e308"],
-        vec!["home", "--json", "--config", path, "--timeout", "1e19"],
-        vec![
-            "home",
-            "--json",
-            "--config",
-            path,
-            "--service-prefix",
-            "../../tmp/x",
-        ],
-        vec![
-            "home",
-            "--json",
-            "--config",
-            path,
-            "--service-prefix",
-            "a/b",
-        ],
-        vec![
-            "home",
-            "--json",
-            "--config",
-            path,
-            "--service-prefix",
-            "x y",
-        ],
+        home(&["--timeout", "1e308"]),
+        home(&["--timeout", "1e19"]),
+        home(&["--service-prefix", "../../tmp/x"]),
+        home(&["--service-prefix", "a/b"]),
+        home(&["--service-prefix", "x y"]),
         vec!["home", "--json", "--config", "--json"],
         vec!["run", "--json", "--config", path, "--duration", "nan"],
     ] {
         let t = Instant::now();
         let run = supervisor(&args);
         assert_eq!(
-            run.code,
+            run.code(),
             Some(2),
             "{args:?}: {}\n{}",
             run.stdout,
             run.stderr
         );
-        assert!(run.json()["errors"].is_array(), "{args:?}: {}", run.stdout);
+        let _: ErrorReport = run.report();
         assert!(t.elapsed() < Duration::from_secs(5));
     }
     // A FIFO and /dev/zero as the config: refused at once, not read forever.
-    let fifo = std::env::temp_dir().join(format!("{}.fifo", cfg.prefix));
-    nix::unistd::mkfifo(&fifo, nix::sys::stat::Mode::S_IRWXU).unwrap();
-    for file in [fifo.to_str().unwrap(), "/dev/zero"] {
+    let dir = TempDir::new("fifo");
+    let fifo = dir.file("config.fifo");
+    nix::unistd::mkfifo(fifo.as_str(), nix::sys::stat::Mode::S_IRWXU).unwrap();
+    for file in [fifo.as_str(), "/dev/zero"] {
         let t = Instant::now();
         let run = supervisor(&["check", "--json", "--config", file]);
-        assert_eq!(run.code, Some(2), "{file}: {}", run.stdout);
+        assert_eq!(run.code(), Some(2), "{file}: {}", run.stdout);
         assert!(run.stdout.contains("not a regular file"), "{}", run.stdout);
         assert!(t.elapsed() < Duration::from_secs(5));
     }
-    let _ = std::fs::remove_file(&fifo);
     assert!(shm_leftovers(&cfg.prefix).is_empty());
 }

@@ -1,125 +1,65 @@
 //! The deployed controller end to end: `motion-supervisor run` commanded and
 //! watched with `motionctl`, several I/O processes attaching and detaching,
 //! and a client nobody here wrote (Python, the iceoryx2 package only).
+//!
+//! The machine is `tests/machines/two_buses.toml`: X (switch then marker,
+//! event -7.5, about 3 s) and Z (a slow switch) on bus0, Y (a slow switch,
+//! about 9 s) on bus1.
 
-use motion_tests::*;
-use nix::sys::signal::Signal;
-use std::process::{Command, Stdio};
+use motion_harness::{assert_close, *};
+use motion_report::{AcceptedReport, StatsReport, TraceReport};
 use std::time::Duration;
 
-/// X: switch then marker 20 units away (about 3 s), on bus0.
-/// Y: switch 40 units away at 5 u/s (about 9 s), on bus1.
-/// Z: a slow switch axis on bus0, for stop during homing.
-fn two_buses(tag: &str, spawn: &str) -> TempConfig {
-    // A generous loss bound: these tests are about which axes a lost I/O
-    // process takes down, not about a loaded CI machine's scheduling gaps.
-    config(
-        tag,
-        "feedback_timeout_ms = 100\n",
-        &format!(
-            r#"
-[[io]]
-name = "bus0"
-spawn = "{spawn}"
-[[io]]
-name = "bus1"
-spawn = "{spawn}"
-
-[[axis]]
-name = "X"
-io = "bus0"
-counts_per_unit = 1000.0
-marker = true
-home_sequence = "switch_then_marker"
-home_speed = 20.0
-home_return_speed = 4.0
-home_acceleration = 500.0
-home_deceleration = 500.0
-home_timeout = 30.0
-[axis.sim]
-start = -20.0
-switch = [0.0, 5.0]
-marker_every = 10.0
-marker_at = 2.5
-
-[[axis]]
-name = "Y"
-io = "bus1"
-counts_per_unit = 1000.0
-home_sequence = "switch"
-home_speed = 5.0
-home_return_speed = 1.0
-home_acceleration = 100.0
-home_deceleration = 100.0
-home_timeout = 60.0
-[axis.sim]
-start = -40.0
-switch = [0.0, 5.0]
-
-[[axis]]
-name = "Z"
-io = "bus0"
-counts_per_unit = 1000.0
-home_sequence = "switch"
-home_speed = 5.0
-home_return_speed = 1.0
-home_acceleration = 100.0
-home_deceleration = 100.0
-home_timeout = 60.0
-[axis.sim]
-start = -40.0
-switch = [0.0, 5.0]
-"#
-        ),
-    )
+fn two_buses(tag: &str) -> TempConfig {
+    Machine::fixture("two_buses").write(tag)
 }
 
-fn axis_status<'a>(v: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
-    axis(v, name)
+/// `motionctl home|stop|unhome …` refused (exit 1), saying `why`.
+#[track_caller]
+fn refused(d: &Daemon, args: &[&str], why: &[&str]) {
+    let r = d.ctl(args);
+    r.expect_code(1);
+    assert!(why.iter().any(|w| r.stdout.contains(w)), "{}", r.stdout);
 }
 
 #[test]
 fn motionctl_homes_stops_unhomes_reports_and_traces() {
     let _serial = serial();
-    let cfg = two_buses("ctl", "sim");
+    let cfg = two_buses("ctl");
     let d = Daemon::start(&cfg, &["bus0", "bus1"]);
     let p = cfg.prefix.clone();
 
-    // status --json: the fixed keys of interface.md
-    let v = d.status();
-    let x = axis_status(&v, "X");
+    // status --json: the fixed keys of interface.md (read from the JSON
+    // itself: a typed field would have a default where a key was missing)
+    let raw = d.ctl(&["status", "--json"]).json();
+    let x = raw["axes"]
+        .as_array()
+        .and_then(|a| a.iter().find(|r| r["name"] == "X"))
+        .unwrap_or_else(|| panic!("no X in {raw}"));
     for k in [
         "name", "io", "phase", "homing", "homed", "en", "dn", "er", "ip", "pc", "err", "exerr",
         "position", "raw",
     ] {
         assert!(x.get(k).is_some(), "status has no {k}: {x}");
     }
-    assert_eq!(x["io"], "bus0");
-    assert_eq!(x["phase"], "idle");
-    assert_eq!(x["homed"], false);
-    close(x, "raw", -20.0, COUNT);
+    let x = d.axis("X");
+    assert_eq!(x.io, "bus0");
+    assert_eq!(x.phase, "idle");
+    assert!(!x.homed);
+    assert_close!(x, raw, -20.0, COUNT);
 
     // home X with a trace: CSV and plot
-    let dir = std::env::temp_dir();
-    let csv = dir.join(format!("{p}.csv"));
-    let svg = dir.join(format!("{p}.svg"));
-    let r = ctl(
-        &p,
-        &[
-            "trace",
-            "X",
-            "--home",
-            "--out",
-            csv.to_str().unwrap(),
-            "--plot",
-            svg.to_str().unwrap(),
-            "--json",
-        ],
+    let dir = TempDir::new("ctl_files");
+    let (csv, svg) = (dir.file("trace.csv"), dir.file("trace.svg"));
+    let r = d.ctl(&[
+        "trace", "X", "--home", "--out", &csv, "--plot", &svg, "--json",
+    ]);
+    let t: TraceReport = r.expect_code(0).report();
+    assert!(
+        t.event_raw.is_some_and(|e| (e + 7.5).abs() <= COUNT),
+        "{t:#?}"
     );
-    assert_eq!(r.code, Some(0), "{}\n{}", r.stdout, r.stderr);
-    let t = r.json();
-    close(&t, "event_raw", -7.5, COUNT);
-    assert!(t["cycles"].as_u64().unwrap() > 1000, "{t}");
+    assert!(t.cycles > 1000, "{t:#?}");
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.starts_with("t_s,phase,cmd_position"));
     assert_eq!(
@@ -134,79 +74,56 @@ fn motionctl_homes_stops_unhomes_reports_and_traces() {
     assert!(std::fs::read_to_string(&svg)
         .unwrap()
         .contains("home event -7.5000"));
-    let _ = std::fs::remove_file(&csv);
-    let _ = std::fs::remove_file(&svg);
-    let x = axis_status(&d.status(), "X").clone();
-    assert_eq!(
-        (x["pc"].clone(), x["homed"].clone()),
-        (true.into(), true.into())
-    );
+    let x = d.axis("X");
+    assert!(x.pc && x.homed, "{x:#?}");
 
     // home Y and Z; stop Z while it seeks: ERR 12 / EXERR 1
-    let r = ctl(&p, &["home", "Y", "Z", "--parallel", "--no-wait", "--json"]);
-    assert_eq!(r.code, Some(0), "{}\n{}", r.stdout, r.stderr);
-    assert!(wait_for(Duration::from_secs(10), || axis_status(
-        &d.status(),
-        "Z"
-    )["phase"]
-        == "seek"));
+    let r = d.ctl(&["home", "Y", "Z", "--parallel", "--no-wait", "--json"]);
+    let _: AcceptedReport = r.expect_code(0).report();
+    assert!(wait_for(Duration::from_secs(10), || d.axis("Z").phase == "seek"));
     // a second home of a homing axis is refused, with the reason
-    let r = ctl(&p, &["home", "Z", "--no-wait", "--json"]);
-    assert_eq!(r.code, Some(1));
-    assert!(
-        r.stdout.contains("already homing") || r.stdout.contains("another home sequence"),
-        "{}",
-        r.stdout
+    refused(
+        &d,
+        &["home", "Z", "--no-wait", "--json"],
+        &["already homing", "another home sequence"],
     );
-    let r = ctl(&p, &["stop", "Z"]);
-    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    d.ctl(&["stop", "Z"]).expect_code(0);
     assert!(wait_for(Duration::from_secs(10), || {
-        let z = axis_status(&d.status(), "Z").clone();
-        z["er"] == true && z["ip"] == false
+        let z = d.axis("Z");
+        z.er && !z.ip
     }));
-    let z = axis_status(&d.status(), "Z").clone();
-    assert_eq!((num(&z, "err"), num(&z, "exerr")), (12.0, 1.0), "{z}");
+    let z = d.axis("Z");
+    assert_eq!((z.err, z.exerr), (12, 1), "{z:#?}");
 
     // Y was homing beside Z: a stop of Z does not stop it (parallel request
     // of named axes; Z's stop is not an I/O loss, so the sequence ends — but
     // Y's homing is its own and completes or is stopped with a reason)
-    assert!(wait_for(Duration::from_secs(30), || axis_status(
-        &d.status(),
-        "Y"
-    )["ip"]
-        == false));
+    assert!(wait_for(Duration::from_secs(30), || !d.axis("Y").ip));
 
     // unhome X
-    let r = ctl(&p, &["unhome", "X", "--json"]);
-    assert_eq!(r.code, Some(0), "{}", r.stderr);
-    assert_eq!(axis_status(&d.status(), "X")["homed"], false);
+    d.ctl(&["unhome", "X", "--json"]).expect_code(0);
+    assert!(!d.axis("X").homed);
 
     // unknown axis: refused with the reason
-    let r = ctl(&p, &["home", "W", "--json"]);
-    assert_eq!(r.code, Some(1));
-    assert!(r.stdout.contains("unknown axis"), "{}", r.stdout);
+    refused(&d, &["home", "W", "--json"], &["unknown axis"]);
 
     // stats: since start, then reset
-    let r = ctl(&p, &["stats", "--json", "--reset"]);
-    assert_eq!(r.code, Some(0), "{}", r.stderr);
-    let s = r.json();
-    assert_eq!(s["since"], "start");
-    assert!(s["latency"]["cycles"].as_u64().unwrap() > 1000, "{s}");
-    assert_eq!(s["allocations"]["system_calls_in_cycle"], 0, "{s}");
-    let hlog = dir.join(format!("{p}.hlog"));
-    let r = ctl(
-        &p,
-        &["stats", "--since-reset", "--hlog", hlog.to_str().unwrap()],
-    );
-    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let r = d.ctl(&["stats", "--json", "--reset"]);
+    let s: StatsReport = r.expect_code(0).report();
+    assert_eq!(s.since, "start");
+    assert!(s.latency.cycles > 1000, "{s:#?}");
+    // from the JSON itself: the typed field would read 0 were it missing
+    let calls = &r.json()["allocations"]["system_calls_in_cycle"];
+    assert_eq!(calls, 0, "{}", r.stdout);
+    let hlog = dir.file("stats.hlog");
+    let r = d.ctl(&["stats", "--since-reset", "--hlog", &hlog]);
+    r.expect_code(0);
     assert!(r.stdout.contains("since reset"), "{}", r.stdout);
     assert!(std::fs::read_to_string(&hlog)
         .unwrap()
         .contains("#[StartTime"));
-    let _ = std::fs::remove_file(&hlog);
 
-    let run = d.stop();
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    d.stop().expect_code(0);
     assert_clean(&p);
     assert!(!std::path::Path::new(&format!("/run/motion/{p}.session")).exists());
 }
@@ -216,70 +133,43 @@ fn motionctl_homes_stops_unhomes_reports_and_traces() {
 #[test]
 fn losing_one_of_two_io_processes_aborts_only_its_axes() {
     let _serial = serial();
-    let cfg = two_buses("twoio", "external");
-    let p = cfg.prefix.clone();
-    let conf = cfg.path.to_str().unwrap();
-    let w = Watched::new(spawn_supervisor(&["run", "--config", conf]));
-    let d = Daemon {
-        watched: Some(w),
-        prefix: p.clone(),
-    };
-    let io_args = |io: &'static str| ["--config", conf, "--io", io, "--priority", "60"];
+    let cfg = Machine::fixture("two_buses")
+        .set("io.bus0.spawn", "external")
+        .set("io.bus1.spawn", "external")
+        .write("twoio");
+    let mut d = Daemon::spawn(&cfg);
+    let io_args = |io: &'static str| ["--config", cfg.arg(), "--io", io, "--priority", "60"];
     let bus0 = spawn_io(&io_args("bus0"));
     let mut bus1 = spawn_io(&io_args("bus1"));
-    assert!(
-        wait_for(Duration::from_secs(20), || {
-            let r = ctl(&p, &["status", "--json"]);
-            r.code == Some(0)
-                && r.json()["io"]
-                    .as_array()
-                    .is_some_and(|a| a.iter().all(|x| x["attached"] == true))
-        }),
-        "I/O processes never attached: {}",
-        d.stderr()
-    );
+    d.wait_ready(Attached::All);
     // home X and Y together; kill bus1 while Y seeks (X takes ~3 s, Y ~9 s)
-    let r = ctl(&p, &["home", "X", "Y", "--parallel", "--no-wait"]);
-    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    d.ctl(&["home", "X", "Y", "--parallel", "--no-wait"])
+        .expect_code(0);
     std::thread::sleep(Duration::from_millis(1000));
-    signal(bus1.child.id() as i32, Signal::SIGKILL);
-    let _ = bus1.child.wait();
+    bus1.kill();
     assert!(wait_for(Duration::from_secs(20), || {
         let v = d.status();
-        axis(&v, "X")["ip"] == false && axis(&v, "Y")["ip"] == false
+        !named(&v.axes, "X").ip && !named(&v.axes, "Y").ip
     }));
     let v = d.status();
-    let x = axis(&v, "X");
-    let y = axis(&v, "Y");
-    assert_eq!(
-        (x["pc"].clone(), x["homed"].clone()),
-        (true.into(), true.into()),
-        "{x}"
-    );
-    assert_eq!((num(y, "err"), num(y, "exerr")), (12.0, 40.0), "{y}");
-    assert_eq!(y["homed"], false);
-    let io1 = v["io"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|i| i["name"] == "bus1")
-        .unwrap()
-        .clone();
-    assert_eq!(io1["attached"], false);
+    let x = named(&v.axes, "X");
+    let y = named(&v.axes, "Y");
+    assert!(x.pc && x.homed, "{x:#?}");
+    assert_eq!((y.err, y.exerr), (12, 40), "{y:#?}");
+    assert!(!y.homed);
+    assert!(!named(&v.io, "bus1").attached);
     assert!(
         d.wait_line("I/O process bus1 detached", Duration::from_secs(5)),
         "{}",
         d.stderr()
     );
     // Home Y while bus1 is gone: refused, naming the reason
-    let r = ctl(&p, &["home", "Y", "--json"]);
-    assert_eq!(r.code, Some(1));
-    assert!(r.stdout.contains("not attached"), "{}", r.stdout);
+    refused(&d, &["home", "Y", "--json"], &["not attached"]);
 
     // bus1 comes back: attached again (reported), Y not homed, X still homed
     let bus1b = spawn_io(&io_args("bus1"));
     assert!(wait_for(Duration::from_secs(20), || {
-        d.status()["io"][1]["attached"] == true
+        named(&d.status().io, "bus1").attached
     }));
     assert!(
         d.wait_line("I/O process bus1 attached again", Duration::from_secs(5)),
@@ -287,18 +177,16 @@ fn losing_one_of_two_io_processes_aborts_only_its_axes() {
         d.stderr()
     );
     let v = d.status();
-    assert_eq!(v["io"][1]["attachments"], 2, "{}", v["io"][1]);
-    assert_eq!(axis(&v, "X")["homed"], true);
-    assert_eq!(axis(&v, "Y")["homed"], false);
-    let run = d.stop();
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let io1 = named(&v.io, "bus1");
+    assert_eq!(io1.attachments, 2, "{io1:#?}");
+    assert!(named(&v.axes, "X").homed);
+    assert!(!named(&v.axes, "Y").homed);
+    d.stop().expect_code(0);
     // the I/O processes stop their axes and leave when the supervisor is gone
     for w in [bus0, bus1b] {
-        let mut w = w;
-        signal(w.child.id() as i32, Signal::SIGTERM);
-        let _ = w.child.wait();
+        w.stop();
     }
-    assert_clean(&p);
+    assert_clean(&cfg.prefix);
 }
 
 /// An HMI that outlives the daemon (`status --watch` notices it is gone
@@ -307,29 +195,19 @@ fn losing_one_of_two_io_processes_aborts_only_its_axes() {
 #[test]
 fn an_hmi_outliving_the_daemon_leaves_nothing_behind() {
     let _serial = serial();
-    let cfg = two_buses("hmi", "sim");
+    let cfg = two_buses("hmi");
     let d = Daemon::start(&cfg, &["bus0", "bus1"]);
-    let p = cfg.prefix.clone();
-    let hmi = Command::new(bin("motionctl"))
-        .args(["--service-prefix", &p, "status", "--watch"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("motionctl status --watch");
-    let mut hmi = Watched::new(hmi);
+    let mut hmi = spawn_motionctl(&["--service-prefix", &cfg.prefix, "status", "--watch"]);
     std::thread::sleep(Duration::from_millis(500));
-    let run = d.stop();
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    d.stop().expect_code(0);
     // The watcher finds the status service gone within its 2 s wait.
     assert!(
-        wait_for(Duration::from_secs(15), || {
-            hmi.child.try_wait().map_or(true, |s| s.is_some())
-        }),
+        hmi.wait_exit(Duration::from_secs(15)).is_some(),
         "motionctl status --watch did not notice the supervisor was gone"
     );
     let ended = hmi.finish();
-    assert_ne!(ended.code, Some(0), "it must say the supervisor is gone");
-    assert_clean(&p);
+    assert_ne!(ended.code(), Some(0), "it must say the supervisor is gone");
+    assert_clean(&cfg.prefix);
 }
 
 /// A client nobody here wrote: the Python example, with nothing but the
@@ -347,30 +225,25 @@ fn the_python_client_reads_status_and_homes() {
         return;
     };
     let _serial = serial();
-    let cfg = two_buses("py", "sim");
+    let cfg = two_buses("py");
     let d = Daemon::start(&cfg, &["bus0", "bus1"]);
     let script = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../examples/python/motion_client.py"
     );
-    let out: Run = std::process::Command::new(&python)
-        .args([script, "--prefix", &cfg.prefix, "--home", "X"])
-        .output()
-        .expect("run python")
-        .into();
-    assert_eq!(out.code, Some(0), "{}\n{}", out.stdout, out.stderr);
+    let python = |args: &[&str]| {
+        let mut cmd = std::process::Command::new(&python);
+        cmd.arg(script).args(args);
+        Running::start(&mut cmd, "python").finish()
+    };
+    let out = python(&["--prefix", &cfg.prefix, "--home", "X"]);
+    out.expect_code(0);
     assert!(out.stdout.contains("io bus0: attached"), "{}", out.stdout);
     assert!(out.stdout.contains("X: homed: PC 1"), "{}", out.stdout);
     assert!(out.stdout.contains("event_raw -7.500000"), "{}", out.stdout);
-    let v = d.status();
-    assert_eq!(axis(&v, "X")["pc"], true);
+    assert!(d.axis("X").pc);
     // and without a supervisor: exit 3
-    let none: Run = std::process::Command::new(&python)
-        .args([script, "--prefix", "nobody_here"])
-        .output()
-        .expect("run python")
-        .into();
-    assert_eq!(none.code, Some(3), "{}", none.stderr);
+    python(&["--prefix", "nobody_here"]).expect_code(3);
     d.stop();
     assert_clean(&cfg.prefix);
 }

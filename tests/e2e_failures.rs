@@ -2,48 +2,24 @@
 //! a broken config. Nothing may hang, move on bad data, or leave shared
 //! memory behind.
 
-use motion_tests::*;
+use motion_harness::*;
+use motion_report::HomeReport;
 use nix::sys::signal::Signal;
 use std::time::Duration;
 
-/// One slow linear axis: a switch 40 units away at 5 u/s (8 s of seeking).
-fn slow_axis(tag: &str) -> TempConfig {
-    config(
-        tag,
-        "feedback_timeout_ms = 20\nio_watchdog_cycles = 50\n",
-        r#"
-[[axis]]
-name = "S"
-counts_per_unit = 1000.0
-home_sequence = "switch"
-home_direction = "bidirectional_forward"
-home_speed = 5.0
-home_return_speed = 1.0
-home_acceleration = 100.0
-home_deceleration = 100.0
-home_timeout = 60.0
-[axis.sim]
-start = -40.0
-switch = [0.0, 5.0]
-"#,
-    )
-}
-
-/// Starts `home --json` on `cfg` and returns once homing has begun.
-fn homing(cfg: &TempConfig) -> Watched {
-    let w = Watched::new(spawn_supervisor(&[
-        "home",
-        "--json",
-        "--config",
-        cfg.path.to_str().unwrap(),
-    ]));
+/// Starts `home --json` on the slow switch axis (`tests/machines/
+/// slow_switch.toml`: 8 s of seeking) and returns once it seeks.
+fn homing(tag: &str) -> (Running, TempConfig) {
+    let cfg = Machine::fixture("slow_switch").write(tag);
+    let w = spawn_supervisor(&["home", "--json", "--config", cfg.arg()]);
     assert!(
-        w.wait_line("home S: accepted", Duration::from_secs(20)),
+        w.wait_line("home S: accepted", Duration::from_secs(20))
+            .is_some(),
         "homing never started"
     );
     // Into the seek.
     std::thread::sleep(Duration::from_millis(500));
-    w
+    (w, cfg)
 }
 
 fn io_pid(prefix: &str) -> i32 {
@@ -58,34 +34,33 @@ fn io_pid(prefix: &str) -> i32 {
     pid.unwrap()
 }
 
+fn io_gone(prefix: &str) -> bool {
+    wait_for(Duration::from_secs(5), || {
+        find_process("motion-io", prefix).is_none()
+    })
+}
+
 #[test]
 fn io_killed_mid_homing_aborts_the_axis_and_exits_cleanly() {
     let _serial = serial();
-    let cfg = slow_axis("killio");
-    let w = homing(&cfg);
-    signal(io_pid(&cfg.prefix), Signal::SIGKILL);
+    let (w, cfg) = homing("killio");
+    signal_pid(io_pid(&cfg.prefix), Signal::SIGKILL);
     let run = w.finish();
-    assert_eq!(run.code, Some(1), "{}\n{}", run.stdout, run.stderr);
-    let v = run.json();
-    let s = axis(&v, "S");
-    assert_eq!(s["er"], true, "{s}");
-    assert_eq!(
-        (num(s, "err"), num(s, "exerr")),
-        (12.0, 40.0),
-        "feedback lost: {s}"
-    );
+    let v: HomeReport = run.expect_code(1).report();
+    let s = named(&v.axes, "S");
+    assert!(s.er, "{s:#?}");
+    assert_eq!((s.err, s.exerr), (12, 40), "feedback lost: {s:#?}");
     // The error says how long the feedback was missing (on a dead peer
     // about feedback_timeout_ms, 20 here; less if earlier gaps had left the
     // leaky bucket part full, so only its presence is checked).
-    let e = s["error"].as_str().unwrap_or_default();
-    let ms: f64 = e
+    let ms: f64 = (s.error.as_deref().unwrap_or_default())
         .split("no valid feedback for ")
         .nth(1)
         .and_then(|t| t.split(" ms").next())
         .and_then(|t| t.parse().ok())
-        .unwrap_or_else(|| panic!("no gap in the error: {s}"));
-    assert!(ms > 0.0 && ms < 5000.0, "{s}");
-    assert_eq!(s["homed"], false);
+        .unwrap_or_else(|| panic!("no gap in the error: {s:#?}"));
+    assert!(ms > 0.0 && ms < 5000.0, "{s:#?}");
+    assert!(!s.homed);
     assert!(run.stderr.contains("motion-io"), "{}", run.stderr);
     assert_clean(&cfg.prefix);
 }
@@ -93,10 +68,9 @@ fn io_killed_mid_homing_aborts_the_axis_and_exits_cleanly() {
 #[test]
 fn supervisor_killed_mid_homing_makes_io_stop_its_axes() {
     let _serial = serial();
-    let cfg = slow_axis("killsup");
-    let w = homing(&cfg);
+    let (w, cfg) = homing("killsup");
     let io = io_pid(&cfg.prefix);
-    signal(w.child.id() as i32, Signal::SIGKILL);
+    w.signal(Signal::SIGKILL);
     // motion-io shares the supervisor's stderr: reading it to the end waits
     // for motion-io to stop its axes and exit on its own.
     let run = w.finish();
@@ -110,48 +84,32 @@ fn supervisor_killed_mid_homing_makes_io_stop_its_axes() {
         "axes not reported stopped:\n{}",
         run.stderr
     );
-    assert!(
-        wait_for(Duration::from_secs(5), || find_process(
-            "motion-io",
-            &cfg.prefix
-        )
-        .is_none()),
-        "motion-io {io} still running"
-    );
+    assert!(io_gone(&cfg.prefix), "motion-io {io} still running");
     assert_clean(&cfg.prefix);
 }
 
 #[test]
 fn sigterm_stops_every_axis_and_exits_cleanly() {
     let _serial = serial();
-    let cfg = slow_axis("sigterm");
-    let w = homing(&cfg);
-    signal(w.child.id() as i32, Signal::SIGTERM);
+    let (w, cfg) = homing("sigterm");
+    w.signal(Signal::SIGTERM);
     let run = w.finish();
-    assert_eq!(run.code, Some(128 + 15), "{}\n{}", run.stdout, run.stderr);
-    let v = run.json();
-    let s = axis(&v, "S");
-    assert_eq!(
-        (num(s, "err"), num(s, "exerr")),
-        (12.0, 1.0),
-        "stopped on request: {s}"
-    );
+    let v: HomeReport = run.expect_code(128 + 15).report();
+    let s = named(&v.axes, "S");
+    assert_eq!((s.err, s.exerr), (12, 1), "stopped on request: {s:#?}");
     assert!(run.stderr.contains("stopping every axis"), "{}", run.stderr);
-    assert!(wait_for(Duration::from_secs(5), || find_process(
-        "motion-io",
-        &cfg.prefix
-    )
-    .is_none()));
+    assert!(io_gone(&cfg.prefix));
     assert_clean(&cfg.prefix);
 }
 
 #[test]
 fn a_config_with_several_mistakes_prints_all_of_them() {
     let _serial = serial();
-    let cfg = config(
-        "badcfg",
-        "stale_cycles = -1\n",
+    let cfg = Machine::parse(
         r#"
+[supervisor]
+stale_cycles = -1
+
 [[axis]]
 name = "X"
 home_sequence = "marker"
@@ -168,10 +126,11 @@ unwind = 360.0
 home_position = 400.0
 home_direction = "sideways"
 "#,
-    );
+    )
+    .write("badcfg");
     for cmd in ["check", "home"] {
-        let run = supervisor(&[cmd, "--config", cfg.path.to_str().unwrap()]);
-        assert_eq!(run.code, Some(2), "{cmd}: {}\n{}", run.stdout, run.stderr);
+        let run = supervisor(&[cmd, "--config", cfg.arg()]);
+        run.expect_code(2);
         for want in [
             "supervisor.stale_cycles: -1 is not a non-negative 32-bit integer",
             "axis X: home_mood: unknown key",
@@ -191,7 +150,7 @@ home_direction = "sideways"
 fn check_accepts_the_default_machine() {
     let _serial = serial();
     let run = supervisor(&["check"]);
-    assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
+    run.expect_code(0);
     assert!(run.stdout.contains("4 axes"), "{}", run.stdout);
     assert!(
         run.stdout.contains("real-time environment"),
@@ -210,6 +169,6 @@ fn unknown_axis_is_refused() {
         "--service-prefix",
         &unique_prefix("noaxis"),
     ]);
-    assert_eq!(run.code, Some(2));
+    run.expect_code(2);
     assert!(run.stderr.contains("no axis W"), "{}", run.stderr);
 }

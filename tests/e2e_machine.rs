@@ -5,22 +5,16 @@
 //! Positions: 1000 counts per unit, so every reported position is known to
 //! ± one count. Expected values are worked out next to each check.
 
-use motion_tests::*;
+use motion_harness::{assert_close, *};
+use motion_report::HomeReport;
+use motion_state::record::{RecordEntry, RecordKind};
 use std::time::Duration;
 
-/// The example's axes and gantry under a test's own `[supervisor]` (unique
-/// prefix, its own state directory); `edit` changes the axis text.
-fn gantry_machine(tag: &str, edit: impl Fn(&str) -> String) -> TempConfig {
-    let text = motion_config::GANTRY_TOML;
-    let axes = &text[text.find("[[axis]]").expect("axes")..];
-    config(tag, "", &edit(axes))
-}
-
-fn record(cfg: &TempConfig) -> Vec<serde_json::Value> {
-    std::fs::read_to_string(cfg.state_dir.join("homing-record.jsonl"))
+fn record(cfg: &TempConfig) -> Vec<RecordEntry> {
+    std::fs::read_to_string(cfg.state_dir.join(motion_state::record::FILE))
         .unwrap_or_default()
         .lines()
-        .map(|l| serde_json::from_str(l).expect("record line is JSON"))
+        .map(|l| serde_json::from_str(l).expect("a record line"))
         .collect()
 }
 
@@ -35,56 +29,48 @@ fn record(cfg: &TempConfig) -> Vec<serde_json::Value> {
 #[test]
 fn a_two_order_machine_with_a_racked_gantry_homes_in_order() {
     let _serial = serial();
-    let cfg = gantry_machine("gantry", str::to_string);
-    let run = supervisor(&["home", "--json", "--config", cfg.path.to_str().unwrap()]);
-    assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
-    let v = run.json();
-    let names: Vec<&str> = v["axes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|a| a["name"].as_str().unwrap())
-        .collect();
-    assert!(!names.contains(&"W"), "W has no home order: {names:?}");
+    let cfg = Machine::gantry().write("gantry");
+    let run = supervisor(&["home", "--json", "--config", cfg.arg()]);
+    let v: HomeReport = run.expect_code(0).report();
+    assert!(
+        v.axes.iter().all(|a| a.name != "W"),
+        "W has no home order: {v:#?}"
+    );
     for n in ["Z", "Y1", "Y2", "X"] {
-        let a = axis(&v, n);
-        assert_eq!(
-            (a["pc"].clone(), a["homed"].clone()),
-            (true.into(), true.into()),
-            "{a}"
-        );
+        let a = named(&v.axes, n);
+        assert!(a.pc && a.homed, "{a:#?}");
     }
-    let (y1, y2) = (axis(&v, "Y1"), axis(&v, "Y2"));
-    close(y1, "event_raw", -7.5, COUNT);
-    close(y2, "event_raw", -7.2, COUNT);
-    close(y1, "final_raw", -6.5, COUNT);
-    close(y2, "final_raw", -5.7, COUNT);
-    close(y1, "final_position", 0.0, COUNT);
-    close(y2, "final_position", 0.0, COUNT);
-    close(y1, "skew", 0.3, 0.005);
-    close(y2, "skew", 0.3, 0.005);
+    let (y1, y2) = (named(&v.axes, "Y1"), named(&v.axes, "Y2"));
+    assert_close!(y1, event_raw, -7.5, COUNT);
+    assert_close!(y2, event_raw, -7.2, COUNT);
+    assert_close!(y1, final_raw, -6.5, COUNT);
+    assert_close!(y2, final_raw, -5.7, COUNT);
+    assert_close!(y1, final_position, 0.0, COUNT);
+    assert_close!(y2, final_position, 0.0, COUNT);
+    assert_close!(y1, skew, 0.3, 0.005);
+    assert_close!(y2, skew, 0.3, 0.005);
 
     // The record: one line per homing, Z's first. Each line is written when
     // the homing was seen to end (within a few ms); order 1 started after
     // Z ended: its start (end - duration) is not before Z's end.
     let rec = record(&cfg);
     assert_eq!(rec.len(), 4, "{rec:#?}");
-    assert_eq!(rec[0]["axis"], "Z");
-    let end_ms = |e: &serde_json::Value| e["unix_ms"].as_f64().unwrap();
-    let start_ms = |e: &serde_json::Value| end_ms(e) - num(e, "duration_s") * 1000.0;
+    assert_eq!(rec[0].axis, "Z");
+    let end_ms = |e: &RecordEntry| e.unix_ms as f64;
+    let start_ms = |e: &RecordEntry| end_ms(e) - value(e.duration_s, e) * 1000.0;
     for e in &rec[1..] {
-        assert_eq!(e["kind"], "homing");
-        assert_eq!(e["result"], "homed", "{e}");
+        assert_eq!(e.kind, Some(RecordKind::Homing));
+        assert_eq!(e.result, "homed", "{e:#?}");
         assert!(
             start_ms(e) >= end_ms(&rec[0]) - 30.0,
-            "{} started before Z ended: {e} / {}",
-            e["axis"],
+            "{} started before Z ended: {e:#?} / {:#?}",
+            e.axis,
             rec[0]
         );
     }
-    let y2 = rec.iter().find(|e| e["axis"] == "Y2").unwrap();
-    assert_eq!(y2["gantry"], "Y");
-    close(y2, "skew", 0.3, 0.005);
+    let y2 = rec.iter().find(|e| e.axis == "Y2").unwrap();
+    assert_eq!(y2.gantry.as_deref(), Some("Y"));
+    assert!((value(y2.skew, y2) - 0.3).abs() <= 0.005, "{y2:#?}");
     assert_clean(&cfg.prefix);
 }
 
@@ -96,43 +82,41 @@ fn a_two_order_machine_with_a_racked_gantry_homes_in_order() {
 #[test]
 fn an_absolute_axis_is_homed_at_start_until_its_configuration_changes() {
     let _serial = serial();
-    let cfg = gantry_machine("absolute", str::to_string);
+    let cfg = Machine::gantry().write("absolute");
     let d = Daemon::start(&cfg, &["io"]);
-    assert_eq!(axis(&d.status(), "W")["homed"], false);
-    let r = ctl(&cfg.prefix, &["home", "W", "--json"]);
-    assert_eq!(r.code, Some(0), "{}\n{}", r.stdout, r.stderr);
-    let w = axis(&d.status(), "W").clone();
-    close(&w, "position", 250.0, COUNT);
-    close(&w, "raw", 37.5, COUNT);
-    assert_eq!(w["restored"], false);
-    assert_eq!(d.stop().code, Some(0));
+    assert!(!d.axis("W").homed);
+    d.ctl(&["home", "W", "--json"]).expect_code(0);
+    let w = d.axis("W");
+    assert_close!(w, position, 250.0, COUNT);
+    assert_close!(w, raw, 37.5, COUNT);
+    assert!(!w.restored);
+    d.stop().expect_code(0);
 
     let d = Daemon::start(&cfg, &["io"]);
     assert!(
-        wait_for(Duration::from_secs(5), || axis(&d.status(), "W")["homed"]
-            == true),
+        wait_for(Duration::from_secs(5), || d.axis("W").homed),
         "W not restored: {}",
         d.stderr()
     );
     let v = d.status();
-    let w = axis(&v, "W");
-    assert_eq!(w["restored"], true, "{w}");
-    assert_eq!(w["pc"], false, "no instruction ran");
-    close(w, "position", 250.0, COUNT);
-    assert_eq!(axis(&v, "Y1")["homed"], false);
-    assert_eq!(d.stop().code, Some(0));
+    let w = named(&v.axes, "W");
+    assert!(w.restored, "{w:#?}");
+    assert!(!w.pc, "no instruction ran");
+    assert_close!(w, position, 250.0, COUNT);
+    assert!(!named(&v.axes, "Y1").homed);
+    d.stop().expect_code(0);
     let rec = record(&cfg);
-    assert_eq!(rec.last().unwrap()["kind"], "restored", "{rec:#?}");
-
-    let changed = gantry_machine("absolute_changed", |axes| {
-        axes.replace("home_position = 250.0", "home_position = 260.0")
-    });
-    // Same state directory as before, another prefix.
-    let text = std::fs::read_to_string(&changed.path).unwrap().replace(
-        &changed.state_dir.display().to_string(),
-        &cfg.state_dir.display().to_string(),
+    assert_eq!(
+        rec.last().unwrap().kind,
+        Some(RecordKind::Restored),
+        "{rec:#?}"
     );
-    std::fs::write(&changed.path, text).unwrap();
+
+    // Home Position changed; the same state directory as before, another prefix.
+    let changed = Machine::gantry()
+        .set("axis.W.home_position", 260.0)
+        .set("supervisor.state_dir", cfg.state_dir.display().to_string())
+        .write("absolute_changed");
     let d = Daemon::start(&changed, &["io"]);
     assert!(
         d.wait_line(
@@ -143,22 +127,21 @@ fn an_absolute_axis_is_homed_at_start_until_its_configuration_changes() {
         d.stderr()
     );
     std::thread::sleep(Duration::from_millis(300));
-    let v = d.status();
-    let w = axis(&v, "W");
-    assert_eq!(w["homed"], false, "{w}");
+    let w = d.axis("W");
+    assert!(!w.homed, "{w:#?}");
     assert!(
-        w["warnings"]
-            .to_string()
-            .contains("stored reference invalidated"),
-        "{w}"
+        w.warnings
+            .iter()
+            .any(|x| x.contains("stored reference invalidated")),
+        "{w:#?}"
     );
-    assert_eq!(d.stop().code, Some(0));
+    d.stop().expect_code(0);
     let rec = record(&cfg);
     let last = rec.last().unwrap();
-    assert_eq!(last["kind"], "invalidated");
+    assert_eq!(last.kind, Some(RecordKind::Invalidated));
     assert_eq!(
-        last["reason"],
-        "axis configuration changed: home_position 250 → 260"
+        last.reason.as_deref(),
+        Some("axis configuration changed: home_position 250 → 260")
     );
     assert_clean(&cfg.prefix);
     assert_clean(&changed.prefix);

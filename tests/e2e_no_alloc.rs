@@ -5,18 +5,18 @@
 //! real-time thread, every call that reached the system allocator after
 //! warm-up, over thousands of cycles of homing the default machine.
 
-use motion_tests::*;
+use motion_harness::*;
+use motion_report::{HomeReport, RunReport};
 
 #[test]
 fn homing_the_default_machine_makes_no_system_allocator_call() {
     let _serial = serial();
     let prefix = unique_prefix("noalloc");
     let run = supervisor(&["home", "--json", "--service-prefix", &prefix]);
-    assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
-    let v = run.json();
-    let cycles = v["latency"]["cycles"].as_u64().unwrap();
-    let sys = v["allocations"]["system_calls_in_cycle"].as_u64().unwrap();
-    let pool = v["allocations"]["pool_allocs_in_cycle"].as_u64().unwrap();
+    let v: HomeReport = run.expect_code(0).report();
+    let cycles = v.run.latency.cycles;
+    let sys = v.run.allocations.system_calls_in_cycle;
+    let pool = v.run.allocations.pool_allocs_in_cycle;
     assert!(cycles > 5000, "too few cycles measured: {cycles}");
     assert_eq!(sys, 0, "system-allocator calls in {cycles} cycles");
     // The counter is not vacuous: iceoryx2's per-sample allocation is there,
@@ -40,10 +40,10 @@ fn run_mode_makes_no_system_allocator_call() {
         "--service-prefix",
         &prefix,
     ]);
-    assert_eq!(run.code, Some(0), "{}\n{}", run.stdout, run.stderr);
-    let v = run.json();
-    let cycles = v["latency"]["cycles"].as_u64().unwrap();
-    assert!(cycles > 2000, "{v}");
-    assert_eq!(v["allocations"]["system_calls_in_cycle"], 0, "{v}");
+    let v: RunReport = run.expect_code(0).report();
+    assert!(v.latency.cycles > 2000, "{v:#?}");
+    // From the JSON itself: the typed field would read 0 were it missing.
+    let calls = &run.json()["allocations"]["system_calls_in_cycle"];
+    assert_eq!(calls, 0, "{}", run.stdout);
     assert_clean(&prefix);
 }

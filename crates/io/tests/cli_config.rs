@@ -1,19 +1,15 @@
 //! Command-line and config mistakes: exit 2, every mistake printed, nothing
 //! created in /dev/shm.
 
-mod common;
-
 use std::time::Duration;
 
-use common::*;
+use motion_harness::leftovers::clean_and_assert_empty;
+use motion_harness::*;
 
 /// A config with several independent mistakes.
-fn bad_toml(prefix: &str) -> String {
-    format!(
-        r#"
+const BAD: &str = r#"
 [supervisor]
 cycle_us = 5
-service_prefix = "{prefix}"
 io = "bogus"
 io_watchdog_cycles = 0
 colour = "blue"
@@ -27,26 +23,24 @@ home_direction = "sideways"
 
 [axis.sim]
 marker_every = -1.0
-"#
-    )
-}
+"#;
 
 #[test]
 fn config_with_several_mistakes_exits_2_and_prints_every_one() {
-    let prefix = unique_prefix();
+    let cfg = Machine::parse(BAD).write("iotest_bad");
+    let prefix = cfg.prefix.clone();
     let _guard = DomainGuard(prefix.clone());
-    let text = bad_toml(&prefix);
+    let text = std::fs::read_to_string(&cfg.path).unwrap();
     let expected = motion_config::parse(&text).expect_err("the config has mistakes");
     assert!(expected.len() >= 5, "{expected:?}");
-    let cfg = TempConfig::new("bad", &text);
-    let mut io = Io::spawn(&["--config", &cfg.arg()]);
+    let mut io = spawn_io(&["--config", cfg.arg()]);
     let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
     assert_eq!(st.code(), Some(2), "{}", io.stderr());
     let err = io.stderr();
     for p in &expected {
         let line = format!("motion-io: error: config: {p}");
         assert!(
-            io.lines.iter().any(|(_, l)| *l == line),
+            io.lines().iter().any(|(_, l)| *l == line),
             "missing {line:?} in\n{err}"
         );
     }
@@ -57,13 +51,13 @@ fn config_with_several_mistakes_exits_2_and_prints_every_one() {
     );
     println!("{} problems reported:\n{err}", expected.len());
     // nothing was created
-    assert_eq!(shm_entries(&prefix), Vec::<String>::new());
-    finish(None, &prefix);
+    assert_eq!(shm_leftovers(&prefix), Vec::<String>::new());
+    clean_and_assert_empty(None, &prefix);
 }
 
 #[test]
 fn unreadable_config_file_exits_2() {
-    let mut io = Io::spawn(&["--config", "/nonexistent/motion-io.toml"]);
+    let mut io = spawn_io(&["--config", "/nonexistent/motion-io.toml"]);
     let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
     assert_eq!(st.code(), Some(2));
     assert!(
@@ -87,7 +81,7 @@ fn command_line_mistakes_exit_2_with_usage() {
         (&["stray"][..], "unexpected argument 'stray'"),
         (&["--service-prefix", "../../tmp/x"][..], "service prefix"),
     ] {
-        let mut io = Io::spawn(args);
+        let mut io = spawn_io(args);
         let st = io.wait_exit(Duration::from_secs(10)).expect("no exit");
         assert_eq!(st.code(), Some(2), "{args:?}");
         let err = io.stderr();
@@ -95,10 +89,7 @@ fn command_line_mistakes_exit_2_with_usage() {
         assert!(err.contains("--help"), "{args:?}: {err}");
     }
     // --help is not a mistake
-    let st = std::process::Command::new(BIN)
-        .arg("--help")
-        .output()
-        .unwrap();
-    assert_eq!(st.status.code(), Some(0));
-    assert!(String::from_utf8_lossy(&st.stdout).contains("--exit-with-supervisor"));
+    let help = spawn_io(&["--help"]).finish();
+    help.expect_code(0);
+    assert!(help.stdout.contains("--exit-with-supervisor"));
 }

@@ -2,18 +2,14 @@
 //! counts, the marker latch arms and latches exactly, sequence numbers and
 //! timestamps are right; bad frames are ignored without a crash.
 
-mod common;
-
-use std::sync::Mutex;
 use std::time::Duration;
 
-use common::*;
 use motion_frames::{AxisCommand, CW_ENABLE, SW_ENABLED};
+use motion_harness::peer::{
+    enabled, io_on_own_prefix, io_with_peer, one_axis, pace_like_the_supervisor, quantile, Pacer,
+};
+use motion_harness::*;
 use nix::sys::signal::Signal;
-
-/// The timing tests run one at a time (2 vCPUs: a spinning peer next to
-/// another test would distort both).
-static SERIAL: Mutex<()> = Mutex::new(());
 
 const ANSWER_TIMEOUT: Duration = Duration::from_secs(2);
 /// Counts per cycle while moving (30 units/s at 1000 counts/unit, 1 kHz).
@@ -28,20 +24,19 @@ fn target(k: i64) -> i64 {
 }
 
 fn round_trip(spin: bool) {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let prefix = unique_prefix();
-    let _guard = DomainGuard(prefix.clone());
+    // The timing tests run one at a time (2 vCPUs: a spinning peer next to
+    // another test would distort both), paced like the supervisor.
+    let _serial = serial();
+    pace_like_the_supervisor();
     // the prefix comes from the TOML here (no --service-prefix)
-    let cfg = TempConfig::new("rt", &one_axis_toml(&prefix, 50));
-    let mut args = vec!["--config".to_string(), cfg.arg()];
+    let cfg = Machine::fixture("io_marker").write("iotest_rt");
+    let prefix = cfg.prefix.clone();
+    let _guard = DomainGuard(prefix.clone());
+    let mut args = vec!["--config", cfg.arg()];
     if spin {
-        args.push("--spin".into());
+        args.push("--spin");
     }
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let mut io = Io::spawn(&args);
-    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
-        .expect("waiting line");
-    let mut sup = Sup::new(&prefix);
+    let (mut io, mut sup) = io_with_peer(&args, &prefix);
     let start = io
         .wait_line("backend sim", Duration::from_secs(10))
         .expect("start line");
@@ -64,18 +59,10 @@ fn round_trip(spin: bool) {
         let pos = target(k);
         let a = sup
             .exchange(
-                |f| {
-                    f.header.axis_count = 1;
-                    f.axes[0] = AxisCommand {
-                        target_position: pos,
-                        target_velocity: if k >= HOLD { (STEP * 1000) as f64 } else { 0.0 },
-                        torque_limit_positive: 100.0,
-                        torque_limit_negative: 100.0,
-                        control_word: CW_ENABLE,
-                        marker_arm_id: if k >= 5 { 1 } else { 0 },
-                        ..AxisCommand::ZERO
-                    };
-                },
+                one_axis(AxisCommand {
+                    marker_arm_id: if k >= 5 { 1 } else { 0 },
+                    ..enabled(pos, if k >= HOLD { (STEP * 1000) as f64 } else { 0.0 })
+                }),
                 ANSWER_TIMEOUT,
             )
             .unwrap_or_else(|| panic!("no answer to command {k}"));
@@ -148,7 +135,7 @@ fn round_trip(spin: bool) {
     io.signal(Signal::SIGTERM);
     let st = io.wait_exit(Duration::from_secs(5)).expect("exit");
     assert_eq!(st.code(), Some(0), "{}", io.stderr());
-    finish(Some(sup), &prefix);
+    sup.finish();
 }
 
 #[test]
@@ -163,13 +150,7 @@ fn round_trip_spin_mode() {
 
 #[test]
 fn wrong_axis_count_and_bad_frames_are_ignored() {
-    let prefix = unique_prefix();
-    let _guard = DomainGuard(prefix.clone());
-    let cfg = TempConfig::new("bad", &one_axis_toml("iotest_unused", 50));
-    let mut io = Io::spawn(&["--config", &cfg.arg(), "--service-prefix", &prefix]);
-    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
-        .expect("start line");
-    let mut sup = Sup::new(&prefix);
+    let (_cfg, _guard, mut io, mut sup) = io_on_own_prefix(&Machine::fixture("io_marker"));
     sup.connect(1);
 
     // two axes for a one-axis config: answered with our one axis, not applied
@@ -234,5 +215,5 @@ fn wrong_axis_count_and_bad_frames_are_ignored() {
     io.signal(Signal::SIGTERM);
     let st = io.wait_exit(Duration::from_secs(5)).expect("exit");
     assert_eq!(st.code(), Some(0), "{}", io.stderr());
-    finish(Some(sup), &prefix);
+    sup.finish();
 }

@@ -1,12 +1,14 @@
 //! SIGTERM/SIGINT: every axis stopped, exit 0, nothing left in /dev/shm.
 //! SIGKILL: the stale resources are removed by the cleanup helper.
 
-mod common;
-
 use std::time::{Duration, Instant};
 
-use common::*;
-use motion_frames::{AxisCommand, CW_ENABLE, SW_ENABLED};
+use motion_frames::SW_ENABLED;
+use motion_harness::peer::{
+    enabled, io_on_own_prefix, io_with_peer, one_axis, pace_like_the_supervisor, Pacer,
+    SupervisorPeer,
+};
+use motion_harness::*;
 use motion_ipc::cleanup_domain;
 use nix::sys::signal::Signal;
 
@@ -14,13 +16,9 @@ const STOP_LINE: &str = "motion-io: signal: every axis stopped";
 
 #[test]
 fn sigterm_while_moving_stops_every_axis_and_exits_0() {
-    let prefix = unique_prefix();
-    let _guard = DomainGuard(prefix.clone());
-    let cfg = TempConfig::new("term", &one_axis_toml("iotest_unused", 50));
-    let mut io = Io::spawn(&["--config", &cfg.arg(), "--service-prefix", &prefix]);
-    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
-        .expect("start line");
-    let mut sup = Sup::new(&prefix);
+    // 50 ms of silence would trip motion-io's watchdog mid-move
+    pace_like_the_supervisor();
+    let (_cfg, _guard, mut io, mut sup) = io_on_own_prefix(&Machine::fixture("io_marker"));
     sup.connect(1);
     let mut pacer = Pacer::new(Duration::from_millis(1));
     let mut pos = 0;
@@ -28,20 +26,7 @@ fn sigterm_while_moving_stops_every_axis_and_exits_0() {
         pacer.wait();
         pos += 30;
         let a = sup
-            .exchange(
-                |f| {
-                    f.header.axis_count = 1;
-                    f.axes[0] = AxisCommand {
-                        target_position: pos,
-                        target_velocity: 30_000.0,
-                        torque_limit_positive: 100.0,
-                        torque_limit_negative: 100.0,
-                        control_word: CW_ENABLE,
-                        ..AxisCommand::ZERO
-                    };
-                },
-                Duration::from_secs(2),
-            )
+            .exchange(one_axis(enabled(pos, 30_000.0)), Duration::from_secs(2))
             .expect("answer");
         if k >= 2 {
             assert_eq!(a.fb.axes[0].status_word, SW_ENABLED);
@@ -65,30 +50,30 @@ fn sigterm_while_moving_stops_every_axis_and_exits_0() {
         assert_eq!(f.axes[0].velocity, 0.0);
         assert_eq!(f.axes[0].status_word & SW_ENABLED, 0);
     }
-    finish(Some(sup), &prefix);
+    sup.finish();
 }
 
 #[test]
 fn sigint_while_waiting_for_a_supervisor_exits_0_and_creates_nothing() {
-    let prefix = unique_prefix();
+    let prefix = unique_prefix("iotest");
     let _guard = DomainGuard(prefix.clone());
-    let mut io = Io::spawn(&["--service-prefix", &prefix]);
+    let mut io = spawn_io(&["--service-prefix", &prefix]);
     io.wait_line("waiting for the supervisor", Duration::from_secs(10))
         .expect("waiting line");
-    assert_eq!(shm_entries(&prefix), Vec::<String>::new());
+    assert_eq!(shm_leftovers(&prefix), Vec::<String>::new());
     io.signal(Signal::SIGINT);
     let st = io.wait_exit(Duration::from_secs(2)).expect("no exit");
     assert_eq!(st.code(), Some(0), "{}", io.stderr());
-    assert_eq!(shm_entries(&prefix), Vec::<String>::new());
+    assert_eq!(shm_leftovers(&prefix), Vec::<String>::new());
 }
 
 #[test]
 fn sigint_before_any_command_exits_0_and_leaves_nothing() {
-    let prefix = unique_prefix();
+    let prefix = unique_prefix("iotest");
     let _guard = DomainGuard(prefix.clone());
     // built-in demo machine, prefix overridden
-    let mut io = Io::spawn(&["--service-prefix", &prefix]);
-    let sup = Sup::new(&prefix);
+    let mut io = spawn_io(&["--service-prefix", &prefix]);
+    let sup = SupervisorPeer::new(&prefix);
     let start = io
         .wait_line("backend sim", Duration::from_secs(10))
         .expect("start line");
@@ -102,7 +87,7 @@ fn sigint_before_any_command_exits_0_and_leaves_nothing() {
         start.1
     );
     assert!(
-        !shm_entries(&prefix).is_empty(),
+        !shm_leftovers(&prefix).is_empty(),
         "no iceoryx2 files while running?"
     );
     let t0 = Instant::now();
@@ -112,24 +97,21 @@ fn sigint_before_any_command_exits_0_and_leaves_nothing() {
     assert_eq!(st.code(), Some(0), "{}", io.stderr());
     assert!(io.find(STOP_LINE).is_some());
     // with the supervisor side gone too, nothing of the domain is left
-    finish(Some(sup), &prefix);
+    sup.finish();
 }
 
 #[test]
 fn sigkilled_peer_is_cleaned_up_by_the_helper() {
-    let prefix = unique_prefix();
+    let prefix = unique_prefix("iotest");
     let _guard = DomainGuard(prefix.clone());
-    let mut io = Io::spawn(&["--service-prefix", &prefix]);
-    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
-        .expect("start line");
-    let mut sup = Sup::new(&prefix);
+    let (mut io, mut sup) = io_with_peer(&["--service-prefix", &prefix], &prefix);
     sup.connect(4);
     let domain = sup.domain.clone();
     drop(sup);
     let killed = Instant::now();
-    io.kill9();
+    io.kill();
     assert!(
-        !shm_entries(&prefix).is_empty(),
+        !shm_leftovers(&prefix).is_empty(),
         "a killed process leaves files"
     );
 
@@ -152,5 +134,5 @@ fn sigkilled_peer_is_cleaned_up_by_the_helper() {
         std::thread::sleep(Duration::from_millis(20));
     }
     assert_eq!(cleaned, 1);
-    assert_eq!(shm_entries(&prefix), Vec::<String>::new());
+    assert_eq!(shm_leftovers(&prefix), Vec::<String>::new());
 }

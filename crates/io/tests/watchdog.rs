@@ -2,12 +2,14 @@
 //! axis, disables it with a fault, and (with `--exit-with-supervisor`) exits;
 //! without the flag it serves a new supervisor when commands resume.
 
-mod common;
-
 use std::time::{Duration, Instant};
 
-use common::*;
 use motion_frames::{AxisCommand, FeedbackFrame, CW_ENABLE, SW_ENABLED, SW_FAULT};
+use motion_harness::leftovers::clean_and_assert_empty;
+use motion_harness::peer::{
+    enabled, io_on_own_prefix, one_axis, pace_like_the_supervisor, Pacer, SupervisorPeer,
+};
+use motion_harness::*;
 use nix::sys::signal::Signal;
 
 const WATCHDOG_CYCLES: u32 = 20;
@@ -15,23 +17,18 @@ const STEP: i64 = 30; // counts per cycle = 30 units/s
 const WATCHDOG_LINE: &str = "motion-io: warning: watchdog: no command for ";
 const STOPPED_LINE: &str = "motion-io: warning: watchdog: every axis stopped and disabled";
 
+/// `tests/machines/io_marker.toml` with a watchdog of [`WATCHDOG_CYCLES`].
+fn machine() -> Machine {
+    Machine::fixture("io_marker").set("supervisor.io_watchdog_cycles", i64::from(WATCHDOG_CYCLES))
+}
+
 fn moving(pos: i64) -> impl FnOnce(&mut motion_frames::CommandFrame) {
-    move |f| {
-        f.header.axis_count = 1;
-        f.axes[0] = AxisCommand {
-            target_position: pos,
-            target_velocity: (STEP * 1000) as f64,
-            torque_limit_positive: 100.0,
-            torque_limit_negative: 100.0,
-            control_word: CW_ENABLE,
-            ..AxisCommand::ZERO
-        };
-    }
+    one_axis(enabled(pos, (STEP * 1000) as f64))
 }
 
 /// 100 commands, enabled and moving; returns the last commanded position
 /// and when its answer arrived.
-fn drive_100(sup: &mut Sup) -> (i64, Instant) {
+fn drive_100(sup: &mut SupervisorPeer) -> (i64, Instant) {
     let mut pacer = Pacer::new(Duration::from_millis(1));
     let mut pos = 0;
     let mut last = None;
@@ -54,10 +51,10 @@ fn drive_100(sup: &mut Sup) -> (i64, Instant) {
 
 /// Keeps receiving feedback until `until` holds or `timeout` passes.
 fn collect_until(
-    sup: &mut Sup,
-    io: &mut Io,
+    sup: &mut SupervisorPeer,
+    io: &Running,
     timeout: Duration,
-    mut until: impl FnMut(&mut Io) -> bool,
+    mut until: impl FnMut(&Running) -> bool,
 ) -> Vec<FeedbackFrame> {
     let deadline = Instant::now() + timeout;
     let mut frames = Vec::new();
@@ -117,15 +114,19 @@ fn parse_watchdog_line(line: &str) -> (u64, f64) {
 }
 
 fn watchdog_stop_and_exit(spin: bool) {
-    let prefix = unique_prefix();
+    // A 20 ms silence is the watchdog's trigger: the tests take turns (a
+    // spinning motion-io of another test next to this one, on 2 vCPUs, can
+    // starve this test's commands that long) and pace like the supervisor.
+    let _serial = serial();
+    pace_like_the_supervisor();
+    let cfg = machine().write("iotest_unused");
+    let prefix = unique_prefix("iotest");
     let _guard = DomainGuard(prefix.clone());
-    let cfg = TempConfig::new("wd", &one_axis_toml("iotest_unused", WATCHDOG_CYCLES));
     // --quiet: no start line to wait for, so the supervisor side comes first
-    let mut sup = Sup::new(&prefix);
-    let cfg_arg = cfg.arg();
+    let mut sup = SupervisorPeer::new(&prefix);
     let mut args = vec![
         "--config",
-        &cfg_arg,
+        cfg.arg(),
         "--service-prefix",
         &prefix,
         "--exit-with-supervisor",
@@ -134,19 +135,19 @@ fn watchdog_stop_and_exit(spin: bool) {
     if spin {
         args.push("--spin");
     }
-    let mut io = Io::spawn(&args);
+    let mut io = spawn_io(&args);
     sup.connect(1);
     let (last_pos, last_at) = drive_100(&mut sup);
 
     // silence: keep receiving feedback as a live supervisor would
-    let frames = collect_until(&mut sup, &mut io, Duration::from_secs(10), |io| {
+    let frames = collect_until(&mut sup, &io, Duration::from_secs(10), |io| {
         io.find(STOPPED_LINE).is_some()
     });
     let w = io.find(WATCHDOG_LINE).expect("watchdog line");
     let s = io.find(STOPPED_LINE).expect("stopped line");
     assert!(w < s);
     assert_eq!(io.count(WATCHDOG_LINE), 1, "one watchdog line");
-    let (wd_at, wd_line) = io.lines[w].clone();
+    let (wd_at, wd_line) = io.lines()[w].clone();
     let (cycles, ms) = parse_watchdog_line(&wd_line);
     let after = wd_at.duration_since(last_at);
     println!("watchdog line {after:?} after the last answer: {cycles} cycles, {ms} ms");
@@ -161,7 +162,7 @@ fn watchdog_stop_and_exit(spin: bool) {
     assert!(io.find("first command").is_none(), "{}", io.stderr());
 
     // gone supervisor: exit 0 about 1 s after the stop
-    let stopped_at = io.lines[s].0;
+    let stopped_at = io.lines()[s].0;
     let st = io
         .wait_exit(Duration::from_secs(10))
         .expect("motion-io did not exit");
@@ -169,7 +170,7 @@ fn watchdog_stop_and_exit(spin: bool) {
     println!("exited {exit_after:?} after the stopped line: {st:?}");
     assert_eq!(st.code(), Some(0), "{}", io.stderr());
     assert!(exit_after >= Duration::from_millis(900), "{exit_after:?}");
-    finish(Some(sup), &prefix);
+    sup.finish();
 }
 
 #[test]
@@ -184,16 +185,12 @@ fn watchdog_in_spin_mode() {
 
 #[test]
 fn watchdog_then_commands_resume_with_the_fault_handshake() {
-    let prefix = unique_prefix();
-    let _guard = DomainGuard(prefix.clone());
-    let cfg = TempConfig::new("wdr", &one_axis_toml("iotest_unused", WATCHDOG_CYCLES));
-    let mut io = Io::spawn(&["--config", &cfg.arg(), "--service-prefix", &prefix]);
-    io.wait_line("waiting for the supervisor", Duration::from_secs(10))
-        .expect("start line");
-    let mut sup = Sup::new(&prefix);
+    let _serial = serial();
+    pace_like_the_supervisor();
+    let (_cfg, _guard, mut io, mut sup) = io_on_own_prefix(&machine());
     sup.connect(1);
     let (last_pos, _) = drive_100(&mut sup);
-    let frames = collect_until(&mut sup, &mut io, Duration::from_secs(10), |io| {
+    let frames = collect_until(&mut sup, &io, Duration::from_secs(10), |io| {
         io.find(STOPPED_LINE).is_some()
     });
     let stopped = check_stop(&frames, last_pos);
@@ -201,7 +198,7 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
     assert!(io.find("commands resumed").is_none());
 
     // without --exit-with-supervisor it keeps waiting (well past 1 s)
-    let frames = collect_until(&mut sup, &mut io, Duration::from_millis(1500), |_| false);
+    let frames = collect_until(&mut sup, &io, Duration::from_millis(1500), |_| false);
     assert!(io.wait_exit(Duration::ZERO).is_none(), "exited");
     // status heartbeat while stopped
     assert!(
@@ -212,16 +209,10 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
     );
 
     let hold = |enable: bool| {
-        move |f: &mut motion_frames::CommandFrame| {
-            f.header.axis_count = 1;
-            f.axes[0] = AxisCommand {
-                target_position: at,
-                torque_limit_positive: 100.0,
-                torque_limit_negative: 100.0,
-                control_word: if enable { CW_ENABLE } else { 0 },
-                ..AxisCommand::ZERO
-            };
-        }
+        one_axis(AxisCommand {
+            control_word: if enable { CW_ENABLE } else { 0 },
+            ..enabled(at, 0.0)
+        })
     };
     let t = Duration::from_secs(2);
     // enable still requested: no edge, the fault stays
@@ -251,18 +242,18 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
     io.signal(Signal::SIGTERM);
     let st = io.wait_exit(Duration::from_secs(5)).expect("exit");
     assert_eq!(st.code(), Some(0), "{}", io.stderr());
-    finish(Some(sup), &prefix);
+    sup.finish();
 }
 
 #[test]
 fn exit_with_supervisor_but_no_supervisor_exits_1_after_10_s() {
-    let prefix = unique_prefix();
+    let cfg = machine().write("iotest_unused");
+    let prefix = unique_prefix("iotest");
     let _guard = DomainGuard(prefix.clone());
-    let cfg = TempConfig::new("nosup", &one_axis_toml("iotest_unused", WATCHDOG_CYCLES));
     let t0 = Instant::now();
-    let mut io = Io::spawn(&[
+    let mut io = spawn_io(&[
         "--config",
-        &cfg.arg(),
+        cfg.arg(),
         "--service-prefix",
         &prefix,
         "--exit-with-supervisor",
@@ -277,5 +268,5 @@ fn exit_with_supervisor_but_no_supervisor_exits_1_after_10_s() {
         "{}",
         io.stderr()
     );
-    finish(None, &prefix);
+    clean_and_assert_empty(None, &prefix);
 }

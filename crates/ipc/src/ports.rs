@@ -119,6 +119,16 @@ fn topic<T: ShmFrame>(
     }
 }
 
+/// Opens the frame topic `name` (`T`: [`CommandFrame`] or [`FeedbackFrame`])
+/// with the settings it was created with, for an observer (a topic admits
+/// the peer plus one): the benches' frame spy subscribes through it.
+pub fn open_topic<T: ShmFrame>(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> Result<TopicFactory<T>, IpcError> {
+    topic(node, &named(name)?, Access::Open)
+}
+
 fn event(
     node: &Node<ipc::Service>,
     name: &Named,

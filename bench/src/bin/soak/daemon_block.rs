@@ -61,16 +61,15 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
             // still homed since the last homing?
             match drive::status(&ctx.b.motionctl, &prefix) {
                 Some(v) => {
-                    let homed = v["axes"][0]["homed"].as_bool().unwrap_or(false);
-                    if !homed && part.tally.details.len() < 1000 {
+                    let a = v.axes.first().cloned().unwrap_or_default();
+                    if !a.homed && part.tally.details.len() < 1000 {
                         part.tally.lost_between += 1;
-                        let a = &v["axes"][0];
                         part.tally.note(format!(
                             "{prefix} before homing {}: X not homed any more (err {}/{}, {})",
                             i + 1,
-                            a["err"],
-                            a["exerr"],
-                            a["error"].as_str().unwrap_or("")
+                            a.err,
+                            a.exerr,
+                            a.error.as_deref().unwrap_or("")
                         ));
                     }
                 }

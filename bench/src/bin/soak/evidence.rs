@@ -38,17 +38,17 @@ pub fn traced_home(
         Duration::from_secs_f64(timeout + 30.0),
     )?;
     let status = drive::status(motionctl, prefix);
-    let a = status.as_ref().map(|v| &v["axes"][0]);
+    let a = status.as_ref().and_then(|v| v.axes.first());
     run.rows = match a {
-        Some(a) if a.is_object() => vec![AxisResult {
-            name: a["name"].as_str().unwrap_or("X").into(),
-            pc: a["pc"].as_bool().unwrap_or(false),
-            er: a["er"].as_bool().unwrap_or(false),
-            err: a["err"].as_u64().unwrap_or(0) as u16,
-            exerr: a["exerr"].as_u64().unwrap_or(0) as u16,
-            homed: a["homed"].as_bool().unwrap_or(false),
-            error: a["error"].as_str().map(str::to_string),
-            duration_s: a["elapsed_s"].as_f64(),
+        Some(a) => vec![AxisResult {
+            name: a.name.clone(),
+            pc: a.pc,
+            er: a.er,
+            err: a.err,
+            exerr: a.exerr,
+            homed: a.homed,
+            error: a.error.clone(),
+            duration_s: Some(a.elapsed_s),
             ..AxisResult::default()
         }],
         _ => Vec::new(),

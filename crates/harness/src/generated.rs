@@ -1,6 +1,8 @@
-//! Temporary machine configs: the demo machine's axes with another
+//! The machines the benches generate: the demo machine's axes with another
 //! `[supervisor]` section (period, CPU, priority, service prefix), and the
-//! generated machines of the soak, dead-peer and 64-axis benches.
+//! machines of the soak, dead-peer and 64-axis benches. Written by code, not
+//! kept as fixtures: their size and timing are the benches' parameters, and
+//! `soak --print-config` shows the text as generated here.
 
 use motion_config::{MachineConfig, DEMO_TOML};
 use std::fmt::Write as _;
@@ -70,7 +72,8 @@ fn default_section(s: &Supervisor, state_dir: Option<&str>) -> String {
     t
 }
 
-fn checked(text: String) -> Result<(String, MachineConfig), String> {
+/// `text` with the machine it parses to, or every problem in one line.
+pub(crate) fn checked(text: String) -> Result<(String, MachineConfig), String> {
     match motion_config::parse(&text) {
         Ok(m) => Ok((text, m)),
         Err(problems) => Err(problems
@@ -228,20 +231,12 @@ pub fn demo_with(s: &Supervisor) -> Result<(String, MachineConfig), String> {
          cpu_dma_latency_us = 0\n\n",
         s.cycle_us, s.cpu, s.priority, s.service_prefix
     );
-    let text = format!(
+    checked(format!(
         "# Written by motion-bench: deploy/demo.toml's axes, [supervisor] changed.\n{}{}{}",
         &DEMO_TOML[..start],
         section,
         &DEMO_TOML[end..]
-    );
-    match motion_config::parse(&text) {
-        Ok(m) => Ok((text, m)),
-        Err(problems) => Err(problems
-            .iter()
-            .map(|p| p.to_string())
-            .collect::<Vec<_>>()
-            .join("; ")),
-    }
+    ))
 }
 
 #[cfg(test)]

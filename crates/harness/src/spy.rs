@@ -5,10 +5,11 @@
 //! it shows does not depend on when the spy itself ran; frames it missed
 //! show as gaps in the sequence numbers.
 
-use crate::sys;
-use iceoryx2::prelude::ServiceName;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::{ipc, ServiceName, ZeroCopySend};
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
 use motion_frames::{CommandFrame, FeedbackFrame};
-use motion_ipc::ports::{MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED};
+use motion_ipc::ports::{open_topic, SUBSCRIBER_BUFFER};
 use motion_ipc::wait::ppoll_until;
 use motion_ipc::{monotonic_ns, Domain, IoServiceNames};
 use std::io::Write;
@@ -85,6 +86,8 @@ impl Recording {
     }
 }
 
+type PubSub<T> = PortFactory<ipc::Service, T, ()>;
+
 /// A running spy thread.
 pub struct Spy {
     stop: Arc<AtomicBool>,
@@ -93,6 +96,17 @@ pub struct Spy {
 
 fn service(name: &str) -> Result<ServiceName, String> {
     ServiceName::new(name).map_err(|e| format!("service name {name:?}: {e:?}"))
+}
+
+fn subscribe<T: std::fmt::Debug + ZeroCopySend>(
+    topic: &PubSub<T>,
+    what: &str,
+) -> Result<Subscriber<ipc::Service, T, ()>, String> {
+    topic
+        .subscriber_builder()
+        .buffer_size(SUBSCRIBER_BUFFER)
+        .create()
+        .map_err(|e| format!("{what} subscriber: {e:?}"))
 }
 
 impl Spy {
@@ -173,50 +187,23 @@ fn run<F: FnMut(&Cmd)>(
         fbs: Vec::with_capacity(capacity),
         error: None,
     };
-    for w in sys::enter_rt(Some(cpu), (priority > 0).then_some(priority)) {
+    for w in crate::placement::enter(cpu, (priority > 0).then_some(priority)) {
         eprintln!("spy: warning: {w}");
     }
     let setup = || -> Result<_, String> {
         let domain = Domain::join(prefix, None).map_err(|e| e.to_string())?;
         let node = domain.create_node("mb-spy").map_err(|e| e.to_string())?;
         let n = IoServiceNames::new(prefix, io);
-        let cmd_topic = node
-            .service_builder(&service(&n.command)?)
-            .publish_subscribe::<CommandFrame>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(0)
-            .max_publishers(1)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open()
-            .map_err(|e| format!("open {}: {e:?}", n.command))?;
-        let fb_topic = node
-            .service_builder(&service(&n.feedback)?)
-            .publish_subscribe::<FeedbackFrame>()
-            .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-            .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
-            .history_size(0)
-            .max_publishers(1)
-            .max_subscribers(MAX_SUBSCRIBERS)
-            .open()
-            .map_err(|e| format!("open {}: {e:?}", n.feedback))?;
+        let cmd_topic = open_topic::<CommandFrame>(&node, &n.command).map_err(|e| e.to_string())?;
+        let fb_topic =
+            open_topic::<FeedbackFrame>(&node, &n.feedback).map_err(|e| e.to_string())?;
         let event = node
             .service_builder(&service(&n.command_ready)?)
             .event()
             .open()
             .map_err(|e| format!("open {}: {e:?}", n.command_ready))?;
-        let cmd_sub = cmd_topic
-            .subscriber_builder()
-            .buffer_size(SUBSCRIBER_BUFFER)
-            .create()
-            .map_err(|e| format!("command subscriber: {e:?}"))?;
-        let fb_sub = fb_topic
-            .subscriber_builder()
-            .buffer_size(SUBSCRIBER_BUFFER)
-            .create()
-            .map_err(|e| format!("feedback subscriber: {e:?}"))?;
+        let cmd_sub = subscribe(&cmd_topic, "command")?;
+        let fb_sub = subscribe(&fb_topic, "feedback")?;
         let listener = event
             .listener_builder()
             .create()
