@@ -15,7 +15,7 @@
 //! command-line or config mistake.
 
 mod backend;
-mod cli;
+use motion_io::cli;
 mod ethercat;
 mod run;
 mod say;
