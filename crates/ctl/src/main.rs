@@ -2,7 +2,7 @@
 //! `motionctl --help`). It joins the supervisor through its session file
 //! and talks to it over the control and status services.
 
-mod cli;
+use motionctl::cli;
 mod commands;
 mod plot;
 

@@ -14,7 +14,7 @@
 //! state) or no supervisor within 10 s (`--exit-with-supervisor`); 2 on a
 //! command-line or config mistake.
 
-mod cli;
+use motion_io::cli;
 mod ethercat;
 mod run;
 mod say;

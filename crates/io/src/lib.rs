@@ -1,0 +1,5 @@
+//! The library side of `motion-io`: only its command line, so that the man
+//! page and shell completions are generated from the clap definition the
+//! binary parses with (`crates/docgen`). Everything else lives in the binary.
+
+pub mod cli;
