@@ -2,8 +2,8 @@
 //! its session, homing through `motionctl`, tallying homing results,
 //! finding the `motion-io` it spawned, stress-ng, shared memory left over.
 
+use crate::host;
 use crate::proc::{self, Ended, Running};
-use crate::sys;
 use motion_report::AxisResult;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -22,7 +22,7 @@ impl Binaries {
     pub fn find(supervisor: Option<&Path>) -> Result<Self, String> {
         let supervisor = match supervisor {
             Some(p) => p.to_path_buf(),
-            None => sys::sibling_exe("motion-supervisor").ok_or_else(|| {
+            None => host::sibling_exe("motion-supervisor").ok_or_else(|| {
                 "motion-supervisor not found next to this binary; build it first: \
                  `cargo build --release --workspace --bins` (with the same CARGO_TARGET_DIR), \
                  or pass --supervisor PATH"
@@ -34,7 +34,7 @@ impl Binaries {
             .unwrap_or_else(|| supervisor.with_file_name("motion-io"));
         let motionctl = supervisor.with_file_name("motionctl");
         for p in [&supervisor, &io, &motionctl] {
-            if !sys::is_executable(p) {
+            if !host::is_executable(p) {
                 return Err(format!(
                     "{} is not an executable file (build the workspace's binaries: \
                      `cargo build --release --workspace --bins`)",
@@ -304,7 +304,7 @@ pub fn io_children(parent: u32) -> Vec<u32> {
 /// `stress-ng --cpu 1 --taskset CPU --timeout BOUND` in its own process
 /// group (ended with the returned handle, or by its own timeout).
 pub fn stress(cpu: usize, bound: Duration) -> Result<Running, String> {
-    let bin = sys::find_in_path("stress-ng")
+    let bin = host::find_in_path("stress-ng")
         .ok_or("stress-ng not found (apt-get install -y stress-ng)".to_string())?;
     let mut c = Command::new(bin);
     c.args([

@@ -47,7 +47,7 @@ impl EcatRig {
         // the emulator's thread inherits the affinity of the thread that
         // starts it
         let emu = std::thread::spawn(move || {
-            crate::sys::enter_rt(Some(cpu), None);
+            crate::host::enter_rt(Some(cpu), None);
             Emulator::start(cfg)
         })
         .join()

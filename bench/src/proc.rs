@@ -4,40 +4,26 @@
 use std::io::Read;
 use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-static STOP: AtomicBool = AtomicBool::new(false);
-static SIGNAL: AtomicI32 = AtomicI32::new(0);
-
-extern "C" fn on_signal(sig: libc::c_int) {
-    SIGNAL.store(sig, Ordering::SeqCst);
-    STOP.store(true, Ordering::SeqCst);
-}
-
-/// SIGINT and SIGTERM set a flag (no SA_RESTART: blocking calls return EINTR).
+/// SIGINT and SIGTERM set a flag: `motion_rt::termination`'s handler, the
+/// one every binary of the workspace installs (blocking calls resume; the
+/// waits here poll the flag).
 pub fn install_stop_handler() {
-    for sig in [libc::SIGINT, libc::SIGTERM] {
-        // SAFETY: a zeroed sigaction with a valid handler; the handler only
-        // stores atomics, which is async-signal-safe.
-        unsafe {
-            let mut sa: libc::sigaction = std::mem::zeroed();
-            sa.sa_sigaction = on_signal as *const () as usize;
-            libc::sigemptyset(&mut sa.sa_mask);
-            libc::sigaction(sig, &sa, std::ptr::null_mut());
-        }
+    if let Err(e) = motion_rt::termination::install() {
+        eprintln!("warning: {e}");
     }
 }
 
 /// A SIGINT or SIGTERM arrived.
 pub fn stop_requested() -> bool {
-    STOP.load(Ordering::SeqCst)
+    motion_rt::termination::received().is_some()
 }
 
 /// The signal that set the flag (0: none).
 pub fn stop_signal() -> i32 {
-    SIGNAL.load(Ordering::SeqCst)
+    motion_rt::termination::received().unwrap_or(0)
 }
 
 /// How a child ended.

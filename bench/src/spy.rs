@@ -5,7 +5,7 @@
 //! it shows does not depend on when the spy itself ran; frames it missed
 //! show as gaps in the sequence numbers.
 
-use crate::sys;
+use crate::host;
 use iceoryx2::prelude::ServiceName;
 use motion_frames::ports::{MAX_SUBSCRIBERS, SUBSCRIBER_BUFFER, SUBSCRIBER_MAX_BORROWED};
 use motion_frames::wait::ppoll_until;
@@ -172,7 +172,7 @@ fn run<F: FnMut(&Cmd)>(
         fbs: Vec::with_capacity(capacity),
         error: None,
     };
-    for w in sys::enter_rt(Some(cpu), (priority > 0).then_some(priority)) {
+    for w in host::enter_rt(Some(cpu), (priority > 0).then_some(priority)) {
         eprintln!("spy: warning: {w}");
     }
     let setup = || -> Result<_, String> {
