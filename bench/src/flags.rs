@@ -61,8 +61,35 @@ impl Files {
     }
 }
 
-/// `--slice S`: a number of seconds of at least `min`.
-pub fn seconds_at_least(min: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
+/// `--duration`, `--slice`: the variants of a slice bench run in
+/// alternating slices (so that all meet the same host noise) until each has
+/// run its duration. `SLICE_MS` is the default slice, `MIN_MS` the shortest.
+#[derive(Clone, Debug, Args)]
+pub struct Slicing<const SLICE_MS: u32, const MIN_MS: u32> {
+    /// Seconds each variant runs.
+    #[arg(long, value_name = "S", default_value_t = 60.0, allow_negative_numbers = true,
+          value_parser = motion_config::args::seconds)]
+    pub duration: f64,
+    /// Seconds per slice (the last one shorter).
+    #[arg(long, value_name = "S", default_value_t = f64::from(SLICE_MS) / 1e3,
+          allow_negative_numbers = true, value_parser = seconds_at_least(f64::from(MIN_MS) / 1e3))]
+    pub slice: f64,
+}
+
+impl<const SLICE_MS: u32, const MIN_MS: u32> Slicing<SLICE_MS, MIN_MS> {
+    /// Slices of `--slice` s that make up `--duration`.
+    pub fn count(&self) -> usize {
+        (self.duration / self.slice - 1e-9).ceil().max(1.0) as usize
+    }
+
+    /// Seconds of slice `i`.
+    pub fn len(&self, i: usize) -> f64 {
+        (self.duration - i as f64 * self.slice).min(self.slice)
+    }
+}
+
+/// A number of seconds of at least `min`.
+fn seconds_at_least(min: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
     move |s| match s.parse::<f64>() {
         Ok(v) if v >= min && v.is_finite() => Ok(v),
         _ => Err(format!("must be a number of seconds, at least {min}")),
@@ -80,6 +107,8 @@ mod tests {
         c: Cycle,
         #[command(flatten)]
         f: Files,
+        #[command(flatten)]
+        s: Slicing<5000, 500>,
     }
 
     fn parse(args: &[&str]) -> Result<T, clap::Error> {
@@ -124,7 +153,17 @@ mod tests {
             assert!(e.to_string().contains(flag), "{args:?}: {e}");
         }
         assert!(parse(&["--cpu", "0", "--cpu", "0"]).is_err() && parse(&["stray"]).is_err());
-        assert_eq!(seconds_at_least(0.5)("0.5"), Ok(0.5));
-        assert!(seconds_at_least(0.5)("0.4").is_err() && seconds_at_least(2.0)("inf").is_err());
+        let s = parse(&["--cpu=0", "--duration", "12", "--slice=5"])
+            .unwrap()
+            .s;
+        assert_eq!((s.count(), s.len(0), s.len(2)), (3, 5.0, 2.0));
+        assert_eq!((t.s.duration, t.s.slice), (60.0, 5.0));
+        for bad in [
+            &["--slice", "0.4"][..],
+            &["--duration", "0"],
+            &["--duration", "-1"],
+        ] {
+            assert!(parse(&[bad, &["--cpu=0"]].concat()).is_err(), "{bad:?}");
+        }
     }
 }

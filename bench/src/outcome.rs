@@ -7,6 +7,7 @@
 
 use crate::host::{Env, OtherRt};
 use crate::proc;
+use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -49,6 +50,19 @@ impl Bench {
             let (name, p) = (self.name, &self.env.preemption);
             eprintln!("{name}: kernel is not PREEMPT_RT ({p}): the numbers are upper bounds");
         }
+    }
+
+    /// The `environment` object of a report's JSON.
+    pub fn environment(&self) -> Value {
+        let e = &self.env;
+        json!({
+            "kernel": e.kernel,
+            "preemption": e.preemption,
+            "preempt_rt": e.is_rt,
+            "cpus": e.cpus,
+            "rt_throttling": e.throttling,
+            "other_rt_threads": self.other_rt.list(),
+        })
     }
 
     /// Nothing was measured: the failures on stderr, then 130 if
@@ -114,8 +128,16 @@ pub fn tmp_dir(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("motion-bench-{name}-{}", std::process::id()))
 }
 
+/// The object `v` with the members of `more` added.
+pub fn with(mut v: Value, more: Value) -> Value {
+    if let (Some(v), Value::Object(more)) = (v.as_object_mut(), more) {
+        v.extend(more);
+    }
+    v
+}
+
 /// Writes `v` to `path` as pretty JSON.
-pub fn write_json(path: &Path, v: &serde_json::Value) -> Result<(), String> {
+pub fn write_json(path: &Path, v: &Value) -> Result<(), String> {
     let text = serde_json::to_string_pretty(v).unwrap_or_default() + "\n";
     std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }

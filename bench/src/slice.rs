@@ -8,6 +8,7 @@ use crate::hist::{self, new_hist, pct_of, Pct};
 use crate::proc::Ended;
 use hdrhistogram::Histogram;
 use motion_report::Latency;
+use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -168,6 +169,21 @@ impl Group {
         }
     }
 
+    /// Its figures in a report's JSON.
+    pub fn json(&self) -> Value {
+        json!({
+            "seconds": self.secs,
+            "slices": self.slices,
+            "cycles": self.cycles,
+            "deadline_misses": self.misses,
+            "deadline_miss_ratio": self.miss_ratio,
+            "late_replies": self.late,
+            "wakeup_us": self.w,
+            "compute_us": self.c,
+            "io_roundtrip_us": self.r,
+        })
+    }
+
     /// It produced at least one slice.
     pub fn ran(&self) -> bool {
         self.slices > 0
@@ -190,4 +206,17 @@ impl Group {
             false => self.wake.count_between(ns, self.wake.max()),
         }
     }
+}
+
+/// `a / b` per column of [`Pct::values`] in a report's JSON, two decimals;
+/// null where `b` is 0.
+pub fn ratio_json(a: &Pct, b: &Pct) -> Value {
+    let keys = ["min", "p50", "p99", "p999", "p9999", "max"];
+    let r = a.ratio(b).map(|x| x.map(|x| motion_report::round(x, 2)));
+    Value::Object(
+        keys.iter()
+            .zip(r)
+            .map(|(k, v)| (k.to_string(), json!(v)))
+            .collect(),
+    )
 }

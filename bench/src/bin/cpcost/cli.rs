@@ -3,7 +3,7 @@
 //! results go; the shared groups come from `motion_bench::flags`.
 
 use clap::Parser;
-use motion_bench::flags::{seconds_at_least, Cycle, Files};
+use motion_bench::flags::{Cycle, Files, Slicing};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -26,15 +26,10 @@ use motion_bench::flags::{seconds_at_least, Cycle, Files};
                   still printed and written). Percentiles never fail the run."
 )]
 pub struct Opts {
-    /// Seconds per variant.
-    #[arg(long, value_name = "S", default_value_t = 60.0, allow_negative_numbers = true,
-          value_parser = motion_config::args::seconds)]
-    pub duration: f64,
-    /// Seconds per slice (at least 2: the clients attach once the daemon
-    /// answers).
-    #[arg(long, value_name = "S", default_value_t = 10.0, allow_negative_numbers = true,
-          value_parser = seconds_at_least(2.0))]
-    pub slice: f64,
+    // --duration per variant, in slices of 10 s by default (at least 2: the
+    // clients attach once the daemon answers)
+    #[command(flatten)]
+    pub slicing: Slicing<10000, 2000>,
     #[command(flatten)]
     pub cycle: Cycle,
     #[command(flatten)]
@@ -54,17 +49,10 @@ pub struct Opts {
 }
 
 impl Opts {
-    /// Slices of `--slice` s that make up `--duration` (the last shorter).
-    pub fn slices(&self) -> usize {
-        (self.duration / self.slice - 1e-9).ceil().max(1.0) as usize
-    }
-
     /// Seconds of slice `i`; the last one at least 2 s (the clients must
     /// attach).
     pub fn slice_len(&self, i: usize) -> f64 {
-        (self.duration - i as f64 * self.slice)
-            .min(self.slice)
-            .max(2.0)
+        self.slicing.len(i).max(2.0)
     }
 }
 
@@ -85,7 +73,12 @@ mod tests {
         Opts::command().debug_assert();
         let o = parse(&[]).unwrap();
         assert_eq!(
-            (o.duration, o.slice, o.slices(), o.slice_len(5)),
+            (
+                o.slicing.duration,
+                o.slicing.slice,
+                o.slicing.count(),
+                o.slice_len(5)
+            ),
             (60.0, 10.0, 6, 10.0)
         );
         assert_eq!(
@@ -93,7 +86,10 @@ mod tests {
             (100, 1000, false)
         );
         let o = parse(&["--duration=25", "--homing", "--status-every-ms", "50"]).unwrap();
-        assert_eq!((o.slices(), o.slice_len(1), o.slice_len(2)), (3, 10.0, 5.0));
+        assert_eq!(
+            (o.slicing.count(), o.slice_len(1), o.slice_len(2)),
+            (3, 10.0, 5.0)
+        );
         assert!(o.homing && o.status_every_ms == 50);
         for (args, flag) in [
             (&["--slice", "1.5"][..], "--slice"),

@@ -42,11 +42,11 @@ fn run(o: &Opts) -> Result<i32, String> {
     let letters: Vec<String> = variants.iter().map(|v| v.letter().to_string()).collect();
     eprintln!(
         "cpcost: {} s per variant ({}) at {} µs, {} slice(s) of ≤ {} s, SCHED_FIFO {} on CPU {}",
-        o.duration,
+        o.slicing.duration,
         letters.join(", "),
         cy.period_us,
-        o.slices(),
-        o.slice,
+        o.slicing.count(),
+        o.slicing.slice,
         cy.priority,
         cy.cpu
     );
@@ -110,7 +110,7 @@ fn slices(o: &Opts, bins: &Binaries, b: &mut Bench, variants: &[Variant]) -> Res
         leftovers: (0, 0),
         interrupted: false,
     };
-    let n = o.slices();
+    let n = o.slicing.count();
     'slices: for i in 0..n {
         let mut order = variants.to_vec();
         if i % 2 == 1 {

@@ -9,8 +9,8 @@ use crate::clients::{Clients, Count};
 use crate::slice::Done;
 use crate::variant::Variant;
 use motion_bench::hist::Pct;
-use motion_bench::outcome::Bench;
-use motion_bench::slice::{Group, MAX_MISS_RATIO};
+use motion_bench::outcome::{with, Bench};
+use motion_bench::slice::{ratio_json, Group, MAX_MISS_RATIO};
 use motion_bench::table::{ratio, ratio_cells, ratio_of, row, thousands, us_cells, Text, COLUMNS};
 use serde_json::{json, Value};
 
@@ -93,7 +93,7 @@ pub fn text(
     t.line(format!(
         "== cpcost: what the control plane costs the cycle — period {} µs ({:.0} Hz), SCHED_FIFO {} on CPU {}, \
          demo machine (4 axes) idle, {:.0} s per variant in {} slice(s) of ≤ {} s, variants alternating",
-        cy.period_us, 1e6 / f64::from(cy.period_us), cy.priority, cy.cpu, a.secs, a.slices, o.slice
+        cy.period_us, 1e6 / f64::from(cy.period_us), cy.priority, cy.cpu, a.secs, a.slices, o.slicing.slice
     ));
     let (throttling, before, after) = (
         &env.throttling,
@@ -247,51 +247,34 @@ fn round2(x: f64) -> f64 {
     motion_report::round(x, 2)
 }
 
-/// `a / b` per column, two decimals; null where `b` is 0.
-fn ratio_json(a: &Pct, b: &Pct) -> Value {
-    let keys = ["min", "p50", "p99", "p999", "p9999", "max"];
-    Value::Object(
-        keys.iter()
-            .zip(a.ratio(b))
-            .map(|(k, v)| (k.to_string(), json!(v.map(round2))))
-            .collect(),
-    )
-}
-
 fn group_json(o: &Opts, m: &Merged) -> Value {
     let (g, c) = (&m.g, &m.clients);
     if !g.ran() {
         return json!({ "ran": false });
     }
-    json!({
-        "ran": true,
-        "what": m.variant.describe(o),
-        "seconds": g.secs,
-        "slices": g.slices,
-        "cycles": g.cycles,
-        "deadline_misses": g.misses,
-        "deadline_miss_ratio": g.miss_ratio,
-        "late_replies": g.late,
-        "hlog_samples": g.wake.len(),
-        "wakeup_us": g.w,
-        "compute_us": g.c,
-        "io_roundtrip_us": g.r,
-        "supervisor_cpu_share": g.cpu,
-        "motion_io_cpu_share": g.io_cpu,
-        "clients_attached_after_s": m.attach_s,
-        "clients": if m.variant.serves() { json!({
-            "made": c.made(),
-            "failed": c.failed(),
-            "cut_off": c.cut_off(),
-            "watch": c.watch,
-            "status": c.status,
-            "status_request_ms_p50_max": c.status.ms_p50_max(),
-            "stats": c.stats,
-            "stats_request_ms_p50_max": c.stats.ms_p50_max(),
-            "home": c.home,
-            "home_request_ms_p50_max": c.home.ms_p50_max(),
-        }) } else { Value::Null },
-    })
+    with(
+        g.json(),
+        json!({
+            "ran": true,
+            "what": m.variant.describe(o),
+            "hlog_samples": g.wake.len(),
+            "supervisor_cpu_share": g.cpu,
+            "motion_io_cpu_share": g.io_cpu,
+            "clients_attached_after_s": m.attach_s,
+            "clients": if m.variant.serves() { json!({
+                "made": c.made(),
+                "failed": c.failed(),
+                "cut_off": c.cut_off(),
+                "watch": c.watch,
+                "status": c.status,
+                "status_request_ms_p50_max": c.status.ms_p50_max(),
+                "stats": c.stats,
+                "stats_request_ms_p50_max": c.stats.ms_p50_max(),
+                "home": c.home,
+                "home_request_ms_p50_max": c.home.ms_p50_max(),
+            }) } else { Value::Null },
+        }),
+    )
 }
 
 /// cpcost.json; `status`: interrupted, and the run's failures so far.
@@ -322,28 +305,22 @@ pub fn json(
             );
         }
     }
-    let (cy, env) = (&o.cycle, &b.env);
+    let cy = &o.cycle;
     json!({
         "bench": "cpcost",
         "machine": "demo (deploy/demo.toml, 4 axes, idle)",
         "period_us": cy.period_us,
         "priority": cy.priority,
         "cpu": cy.cpu,
-        "duration_s_per_variant": o.duration,
-        "slice_s": o.slice,
+        "duration_s_per_variant": o.slicing.duration,
+        "slice_s": o.slicing.slice,
         "status_every_ms": o.status_every_ms,
         "stats_every_ms": o.stats_every_ms,
         "wall_s": wall_s,
-        "environment": {
-            "kernel": env.kernel,
-            "preemption": env.preemption,
-            "preempt_rt": env.is_rt,
-            "cpus": env.cpus,
-            "rt_throttling": env.throttling,
-            "load_before": env.load_before,
+        "environment": with(b.environment(), json!({
+            "load_before": b.env.load_before,
             "load_after": motion_bench::host::loadavg(),
-            "other_rt_threads": b.other_rt.list(),
-        },
+        })),
         "variants": variants,
         "ratios": ratios,
         "warnings": warnings,

@@ -2,7 +2,7 @@
 //! binaries; the shared groups come from `motion_bench::flags`.
 
 use clap::Parser;
-use motion_bench::flags::{seconds_at_least, Cycle, Files};
+use motion_bench::flags::{Cycle, Files, Slicing};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -20,14 +20,9 @@ use std::path::PathBuf;
                   interrupted. Percentiles never fail the run."
 )]
 pub struct Opts {
-    /// Seconds per tool.
-    #[arg(long, value_name = "S", default_value_t = 60.0, allow_negative_numbers = true,
-          value_parser = motion_config::args::seconds)]
-    pub duration: f64,
-    /// Seconds per slice (at least 0.5).
-    #[arg(long, value_name = "S", default_value_t = 5.0, allow_negative_numbers = true,
-          value_parser = seconds_at_least(0.5))]
-    pub slice: f64,
+    // --duration per tool, in slices of 5 s by default (at least 0.5)
+    #[command(flatten)]
+    pub slicing: Slicing<5000, 500>,
     #[command(flatten)]
     pub cycle: Cycle,
     #[command(flatten)]
@@ -79,7 +74,10 @@ mod tests {
             "0",
         ];
         let o = parse(&[&ci[..], &["--out", "bench/out/ci", "--no-cyclictest"]].concat()).unwrap();
-        assert_eq!((o.duration, o.slice, o.cycle.period_us), (10.0, 2.5, 1000));
+        assert_eq!(
+            (o.slicing.duration, o.slicing.slice, o.cycle.period_us),
+            (10.0, 2.5, 1000)
+        );
         assert_eq!(o.files.out(""), PathBuf::from("bench/out/ci"));
         assert!(o.no_cyclictest && o.axes64 && !o.stress && !o.ethercat);
         assert_eq!((o.hist_max_us, o.cyclictest), (20_000, None));

@@ -7,10 +7,10 @@
 use crate::cli::Opts;
 use crate::report::Summary;
 use crate::slices::{Collected, Variant};
-use motion_bench::hist::{self, Pct};
-use motion_bench::outcome::{write_json, Bench};
+use motion_bench::hist;
+use motion_bench::outcome::{with, write_json, Bench};
 use motion_bench::plot::{self, Series};
-use motion_bench::slice::Group;
+use motion_bench::slice::{ratio_json, Group};
 use plotters::style::RGBColor;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -102,41 +102,6 @@ pub fn svg(path: &Path, o: &Opts, b: &Bench, m: &Summary) -> Result<(), String> 
     )
 }
 
-/// A variant's figures in the JSON report.
-fn group_json(g: &Group) -> Value {
-    json!({
-        "seconds": g.secs,
-        "slices": g.slices,
-        "cycles": g.cycles,
-        "deadline_misses": g.misses,
-        "deadline_miss_ratio": g.miss_ratio,
-        "late_replies": g.late,
-        "wakeup_us": g.w,
-        "compute_us": g.c,
-        "io_roundtrip_us": g.r,
-    })
-}
-
-/// `v` with `more` added (`v` an object).
-fn with(mut v: Value, more: Value) -> Value {
-    if let (Some(v), Value::Object(more)) = (v.as_object_mut(), more) {
-        v.extend(more);
-    }
-    v
-}
-
-/// `a / b` per column, two decimals; null where `b` is 0.
-fn ratio_json(a: &Pct, b: &Pct) -> Value {
-    let keys = ["min", "p50", "p99", "p999", "p9999", "max"];
-    let r = a.ratio(b).map(|x| x.map(|x| motion_report::round(x, 2)));
-    Value::Object(
-        keys.iter()
-            .zip(r)
-            .map(|(k, v)| (k.to_string(), json!(v)))
-            .collect(),
-    )
-}
-
 /// The JSON report in `path`; `files` are the other two, `failures` the
 /// run's so far (its status).
 pub fn json(
@@ -153,7 +118,6 @@ pub fn json(
         m.group(Variant::Ethercat),
     );
     let ct_ran = m.ct.ran();
-    let env = &b.env;
     let bus: Vec<Value> = (c.bus_runs.iter())
         .map(|b| json!({"cycles": b.cycles, "min": b.min, "p50": b.p50, "p99": b.p99, "p999": b.p999, "max": b.max, "lost_frames": b.lost}))
         .collect();
@@ -161,30 +125,23 @@ pub fn json(
         "period_us": o.cycle.period_us,
         "priority": o.cycle.priority,
         "cpu": o.cycle.cpu,
-        "duration_s_per_tool": o.duration,
-        "slice_s": o.slice,
+        "duration_s_per_tool": o.slicing.duration,
+        "slice_s": o.slicing.slice,
         "stress": o.stress,
         "wall_s": wall_s,
-        "environment": {
-            "kernel": env.kernel,
-            "preemption": env.preemption,
-            "preempt_rt": env.is_rt,
-            "cpus": env.cpus,
-            "rt_throttling": env.throttling,
-            "other_rt_threads": b.other_rt.list(),
-        },
-        "ours": with(group_json(demo), json!({
+        "environment": b.environment(),
+        "ours": with(Group::json(demo), json!({
             "machine": "demo (deploy/demo.toml, 4 axes, idle)",
             "hlog_samples": demo.wake.len(),
             "warnings": c.warnings,
         })),
-        "ours_axes64": if a64.ran() { with(group_json(a64), json!({
+        "ours_axes64": if a64.ran() { with(Group::json(a64), json!({
             "machine": "64 axes (motion_bench::machine::axes64_with), motionctl home --parallel again and again",
             "hlog_samples": a64.wake.len(),
             "homing": c.homing64.json(),
         })) } else { skipped() },
         "ours_ethercat": if ecat.ran() {
-            with(group_json(ecat), json!({ "bus_roundtrip_us_per_slice": bus }))
+            with(Group::json(ecat), json!({ "bus_roundtrip_us_per_slice": bus }))
         } else { skipped() },
         "cyclictest": if ct_ran { json!({
             "command": c.ct_command,

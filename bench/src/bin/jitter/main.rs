@@ -39,14 +39,14 @@ fn run(o: &Opts) -> Result<i32, String> {
     }
     let out = o.files.out("");
     let mut b = Bench::start("jitter", Some(&out))?;
-    let (cy, slices) = (&o.cycle, slices::count(o));
+    let (cy, slices) = (&o.cycle, o.slicing.count());
     let on = match o.stress {
         true => format!(", stress-ng on CPU {}", cy.other_cpu()),
         false => String::new(),
     };
     eprintln!(
         "jitter: {} s per tool at {} µs, {slices} slice(s) of ≤ {} s, SCHED_FIFO {} on CPU {}{on}",
-        o.duration, cy.period_us, o.slice, cy.priority, cy.cpu
+        o.slicing.duration, cy.period_us, o.slicing.slice, cy.priority, cy.cpu
     );
     eprintln!("jitter: supervisor {}", bins.supervisor.display());
     if let Some(c) = &cyclictest {
@@ -123,7 +123,7 @@ fn cyclictest(o: &Opts) -> Option<PathBuf> {
 /// by its own timeout well beyond the bench's expected length (so it cannot
 /// outlive a bench that dies) and killed as a group at the end.
 fn start_stress(o: &Opts, slices: usize) -> Result<Running, String> {
-    let bound = (3.0 * o.duration + 20.0 * slices as f64 + 60.0).ceil() as u64;
+    let bound = (3.0 * o.slicing.duration + 20.0 * slices as f64 + 60.0).ceil() as u64;
     let cpu = o.cycle.other_cpu();
     let r = drive::stress(cpu, Duration::from_secs(bound)).map_err(|e| format!("--stress: {e}"))?;
     eprintln!(

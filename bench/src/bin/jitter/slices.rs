@@ -49,11 +49,6 @@ impl Variant {
     }
 }
 
-/// Slices of `--slice` s that make up `--duration` (the last one shorter).
-pub fn count(o: &Opts) -> usize {
-    (o.duration / o.slice - 1e-9).ceil().max(1.0) as usize
-}
-
 /// What the slices run with.
 pub struct Plan<'a> {
     pub o: &'a Opts,
@@ -102,7 +97,7 @@ pub fn run(p: &Plan, other_rt: &mut OtherRt) -> Result<Collected, String> {
     let on = [true, p.o.axes64, p.rig.is_some()];
     let variants = [Variant::Demo, Variant::Axes64, Variant::Ethercat];
     'slices: for i in 0..p.slices {
-        let len = (p.o.duration - i as f64 * p.o.slice).min(p.o.slice);
+        let len = p.o.slicing.len(i);
         for v in variants.into_iter().filter(|&v| on[v as usize]) {
             if !our_slice(p, v, i, len, &mut c)? {
                 break 'slices;
