@@ -42,7 +42,8 @@ impl Cycle {
 /// `--out`, `--supervisor`: where the results go, which binaries run.
 #[derive(Clone, Debug, Args)]
 pub struct Files {
-    /// Output directory (default: bench/out of the source tree).
+    /// Output directory (default: bench/out of the source tree; for cpcost
+    /// bench/out/cpcost).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
     /// motion-supervisor binary (default: next to this binary; motion-io and
@@ -70,8 +71,8 @@ pub struct Slicing<const SLICE_MS: u32, const MIN_MS: u32> {
     #[arg(long, value_name = "S", default_value_t = 60.0, allow_negative_numbers = true,
           value_parser = motion_config::args::seconds)]
     pub duration: f64,
-    /// Seconds per slice (the last one shorter).
     #[arg(long, value_name = "S", default_value_t = f64::from(SLICE_MS) / 1e3,
+          help = format!("Seconds per slice (at least {}; the last one shorter)", f64::from(MIN_MS) / 1e3),
           allow_negative_numbers = true, value_parser = seconds_at_least(f64::from(MIN_MS) / 1e3))]
     pub slice: f64,
 }

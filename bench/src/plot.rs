@@ -88,42 +88,32 @@ pub fn latency_plot(
     let size = (W, head + PANEL_H * (1 + u32::from(zoom.is_some())));
     let root = SVGBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(&x))?;
-    let centred = Pos::new(HPos::Center, VPos::Top);
-    let bold = ("sans-serif", 17).into_font().style(FontStyle::Bold);
+    let (centre, font) = (Pos::new(HPos::Center, VPos::Top), |n| {
+        ("sans-serif", n).into_font()
+    });
     let mut texts = vec![(
         title.to_string(),
         (W as i32 / 2, 10),
-        bold.color(&BLACK).pos(centred),
+        font(17).style(FontStyle::Bold).color(&BLACK).pos(centre),
     )];
     for (i, s) in subtitle.iter().enumerate() {
-        let style = ("sans-serif", 13)
-            .into_font()
-            .color(&RGBColor(68, 68, 68))
-            .pos(centred);
+        let style = font(13).color(&RGBColor(68, 68, 68)).pos(centre);
         texts.push((s.to_string(), (W as i32 / 2, 34 + 20 * i as i32), style));
     }
     for (i, s) in series.iter().enumerate() {
-        let y = 44 + 20 * (subtitle.len() + i) as i32;
+        let (y, h) = (44 + 20 * (subtitle.len() + i) as i32, s.hist);
         let line = PathElement::new([(80, y + 7), (102, y + 7)], s.colour.stroke_width(3));
         root.draw(&line).map_err(|x| e(&x))?;
-        let h = s.hist;
+        let (n, max) = (thousands(h.len()), h.max() as f64 / 1000.0);
+        let [p50, p99, p999] = [0.5, 0.99, 0.999].map(|x| q(h, x));
         let label = match h.is_empty() {
             true => format!("{} (no samples)", s.name),
             false => format!(
-                "{}: {} samples, p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs",
-                s.name,
-                thousands(h.len()),
-                q(h, 0.5),
-                q(h, 0.99),
-                q(h, 0.999),
-                h.max() as f64 / 1000.0
+                "{}: {n} samples, p50 {p50:.1} µs, p99 {p99:.1} µs, p99.9 {p999:.1} µs, max {max:.1} µs",
+                s.name
             ),
         };
-        texts.push((
-            label,
-            (108, y),
-            ("sans-serif", 13).into_font().color(&BLACK),
-        ));
+        texts.push((label, (108, y), font(13).color(&BLACK)));
     }
     for (text, at, style) in texts {
         root.draw(&Text::new(text, at, style)).map_err(|x| e(&x))?;
@@ -131,11 +121,7 @@ pub fn latency_plot(
     let (_, body) = root.split_vertically(head);
     let full = Bins::new(max_us);
     let panels = body.split_evenly((1 + usize::from(zoom.is_some()), 1));
-    let heading = if zoom.is_some() {
-        "full range (every sample)"
-    } else {
-        "every sample"
-    };
+    let heading = ["every sample", "full range (every sample)"][usize::from(zoom.is_some())];
     panel(&panels[0], &full, series, marker_us, heading).map_err(|x| e(&x))?;
     if let Some(z) = &zoom {
         let beyond: Vec<String> = (series.iter())
