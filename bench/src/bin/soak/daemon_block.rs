@@ -13,7 +13,7 @@ use crate::Ctx;
 use motion_bench::drive::{self, HomeRun};
 use motion_bench::spy::Spy;
 use motion_bench::{host, machine, proc};
-use motion_report::AxisResult;
+use motion_report::{AxisResult, AxisStatus, StatusReport};
 use serde_json::{json, Value};
 use std::path::Path;
 use std::process::Command;
@@ -107,20 +107,25 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
     Ok(interrupted)
 }
 
+/// `motionctl status` of `prefix`, typed.
+fn status(motionctl: &Path, prefix: &str) -> Option<StatusReport> {
+    drive::status(motionctl, prefix).and_then(|v| serde_json::from_value(v).ok())
+}
+
 /// Before homing `i`: is X still homed since the last one?
 fn still_homed(ctx: &Ctx, prefix: &str, i: u32, part: &mut Part) {
-    let Some(v) = drive::status(&ctx.b.motionctl, prefix) else {
+    let Some(st) = status(&ctx.b.motionctl, prefix) else {
         return part
             .tally
             .note(format!("{prefix} before homing {i}: no status"));
     };
-    let a = &v["axes"][0];
-    if !a["homed"].as_bool().unwrap_or(false) && part.tally.details.len() < 1000 {
+    let a = st.axes.first().cloned().unwrap_or_default();
+    if !a.homed && part.tally.details.len() < 1000 {
         part.tally.lost_between += 1;
-        let error = a["error"].as_str().unwrap_or("");
+        let error = a.error.as_deref().unwrap_or("");
         part.tally.note(format!(
             "{prefix} before homing {i}: X not homed any more (err {}/{}, {error})",
-            a["err"], a["exerr"]
+            a.err, a.exerr
         ));
     }
 }
@@ -147,21 +152,23 @@ fn traced_home(
     cmd.args(["--timeout", &timeout.to_string()]);
     let limit = Duration::from_secs_f64(timeout + 30.0);
     let mut run = drive::home_run(&mut cmd, "motionctl trace", limit)?;
-    let status = drive::status(motionctl, prefix);
-    run.rows = match status.as_ref().map(|v| &v["axes"][0]) {
-        Some(a) if a.is_object() => vec![AxisResult {
-            name: a["name"].as_str().unwrap_or("X").into(),
-            pc: a["pc"].as_bool().unwrap_or(false),
-            er: a["er"].as_bool().unwrap_or(false),
-            err: a["err"].as_u64().unwrap_or(0) as u16,
-            exerr: a["exerr"].as_u64().unwrap_or(0) as u16,
-            homed: a["homed"].as_bool().unwrap_or(false),
-            error: a["error"].as_str().map(str::to_string),
-            duration_s: a["elapsed_s"].as_f64(),
-            ..AxisResult::default()
-        }],
-        _ => Vec::new(),
+    let status = status(motionctl, prefix);
+    let row = |a: &AxisStatus| AxisResult {
+        name: a.name.clone(),
+        pc: a.pc,
+        er: a.er,
+        err: a.err,
+        exerr: a.exerr,
+        homed: a.homed,
+        error: a.error.clone(),
+        duration_s: Some(a.elapsed_s),
+        ..AxisResult::default()
     };
+    run.rows = status
+        .iter()
+        .flat_map(|s| s.axes.first())
+        .map(row)
+        .collect();
     if let Some(st) = status {
         run.json = Some(json!({"trace": run.json.take(), "status": st}));
     }
@@ -197,7 +204,7 @@ fn keep_evidence(
         "output": run.json,
         "ended": run.ended.describe(),
         "stderr_tail": drive::tail(&run.ended.stderr, 20),
-        "status_after": drive::status(&ctx.b.motionctl, prefix),
+        "status_after": status(&ctx.b.motionctl, prefix),
         "stats_after": stats,
         "loadavg": host::loadavg(),
     });
