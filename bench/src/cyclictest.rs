@@ -4,7 +4,9 @@
 //! at or above MAXUS, not in any bin).
 
 use crate::hist::new_hist;
+use crate::proc::Ended;
 use hdrhistogram::Histogram;
+use std::path::Path;
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CtHistogram {
@@ -63,6 +65,26 @@ pub fn parse(text: &str) -> Result<CtHistogram, String> {
         return Err("no '# Total:' line (cyclictest did not finish its histogram)".into());
     }
     Ok(h)
+}
+
+/// Reads one finished run: its exit and its histogram file; errors carry
+/// the end of its output.
+pub fn read_run(ended: &Ended, hist_path: &Path) -> Result<CtHistogram, String> {
+    let out = format!("{}\n{}", ended.stdout.trim(), ended.stderr.trim());
+    let out = match out.trim() {
+        "" => String::new(),
+        e => format!("; its output: {}", crate::drive::tail(e, 8)),
+    };
+    if !ended.success() {
+        return Err(format!("{}{out}", ended.describe()));
+    }
+    let text = std::fs::read_to_string(hist_path)
+        .map_err(|e| format!("no histogram file {} ({e}){out}", hist_path.display()))?;
+    let hist = parse(&text)?;
+    match hist.samples() {
+        0 => Err(format!("an empty histogram{out}")),
+        _ => Ok(hist),
+    }
 }
 
 impl CtHistogram {

@@ -1,10 +1,10 @@
-//! What the machine a bench runs on is like — kernel, preemption model,
-//! CPUs, RT throttling, load — and other real-time threads seen during the
-//! bench (another benchmark, say): printed and recorded with the numbers
-//! because they decide what the numbers mean. Shared by the benches.
+//! The machine a bench runs on as its reports show it (the facts come from
+//! `motion_rt::host`), other real-time threads seen while it runs, the
+//! bench's own threads set up like the cycle's, and the programs it starts.
 
-use crate::sys;
+pub use motion_rt::host::{cpus, kernel, loadavg, other_rt_tasks, preemption, RtTask};
 use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
 
 /// The kernel and its real-time settings, read once at the start.
 pub struct Env {
@@ -19,15 +19,27 @@ pub struct Env {
 
 impl Env {
     pub fn probe() -> Self {
-        let (preemption, is_rt) = sys::preemption();
+        let (preemption, is_rt) = preemption();
         Env {
-            kernel: sys::kernel(),
+            kernel: kernel(),
             preemption,
             is_rt,
-            cpus: sys::cpus(),
-            throttling: sys::rt_throttling(),
-            load_before: sys::loadavg(),
+            cpus: cpus(),
+            throttling: motion_rt::host::rt_throttling(),
+            load_before: loadavg(),
         }
+    }
+
+    /// `kernel K | preemption: P | N CPUs`: how every report's second line
+    /// starts.
+    pub fn head(&self) -> String {
+        let Env {
+            kernel,
+            preemption,
+            cpus,
+            ..
+        } = self;
+        format!("kernel {kernel} | preemption: {preemption} | {cpus} CPUs")
     }
 }
 
@@ -42,16 +54,14 @@ pub struct OtherRt {
 
 impl OtherRt {
     pub fn new(bench: &'static str) -> Self {
-        Self {
-            bench,
-            seen: BTreeSet::new(),
-        }
+        let seen = BTreeSet::new();
+        Self { bench, seen }
     }
 
     /// Looks for other real-time threads now (`when` says when, for the
     /// warning).
     pub fn note(&mut self, when: &str) {
-        for t in sys::other_rt_tasks() {
+        for t in other_rt_tasks() {
             if self.seen.insert(t.to_string()) {
                 eprintln!(
                     "{}: WARNING: another real-time thread is running ({when}): {t} — \
@@ -69,4 +79,63 @@ impl OtherRt {
     pub fn list(&self) -> Vec<String> {
         self.seen.iter().cloned().collect()
     }
+}
+
+/// Pins the calling thread to `cpu` (if given), SCHED_FIFO at `priority`
+/// (if given), memory locked — with the runtime the supervisor uses, so a
+/// bench thread is set up exactly like the cycle. Returns what the OS
+/// refused, as warnings.
+pub fn enter_rt(cpu: Option<usize>, priority: Option<i32>) -> Vec<String> {
+    if let Some(priority) = priority {
+        let cfg = motion_rt::RtConfig {
+            cpu,
+            priority,
+            ..motion_rt::RtConfig::default()
+        };
+        return motion_rt::enter_realtime(&cfg).warnings;
+    }
+    let pinned = cpu.map(motion_rt::pin_to_cpu).and_then(Result::err);
+    use nix::sys::mman::{mlockall, MlockAllFlags as F};
+    let locked = mlockall(F::MCL_CURRENT | F::MCL_FUTURE).err();
+    let locked = locked.map(|e| format!("mlockall: {e}"));
+    pinned.into_iter().chain(locked).collect()
+}
+
+/// Whether this process may run a thread SCHED_FIFO at `priority` (tried
+/// on a throw-away thread).
+pub fn can_use_fifo(priority: i32) -> Result<(), String> {
+    std::thread::spawn(move || {
+        let cfg = motion_rt::RtConfig {
+            priority,
+            lock_memory: false,
+            prefault_stack: 0,
+            ..motion_rt::RtConfig::default()
+        };
+        let r = motion_rt::enter_realtime(&cfg);
+        match r.policy {
+            motion_rt::SchedPolicy::Fifo => Ok(()),
+            _ => Err(r.warnings.join("; ")),
+        }
+    })
+    .join()
+    .unwrap_or_else(|_| Err("probe thread panicked".into()))
+}
+
+/// `name` in `$PATH`.
+pub fn find_in_path(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|d| d.join(name))
+        .find(|p| is_executable(p))
+}
+
+pub fn is_executable(p: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+}
+
+/// `name` in the directory of this executable (`target/release/`).
+pub fn sibling_exe(name: &str) -> Option<PathBuf> {
+    let p = std::env::current_exe().ok()?.parent()?.join(name);
+    is_executable(&p).then_some(p)
 }

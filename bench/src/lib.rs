@@ -1,24 +1,22 @@
-//! Shared pieces of the benchmarks (see `bench/README.md`):
+//! The benchmarks' shared pieces (see `bench/README.md`). The binaries —
+//! `jitter`, `cpcost`, `ipc`, `soak`, `deadpeer` — are thin sequences of
+//! these: [`flags`] their common command-line groups, [`outcome`] how a run
+//! starts and ends, [`host`] the machine, [`slice`] a supervisor run read
+//! back, [`hist`], [`table`] and [`plot`] the figures, [`cyclictest`] the
+//! reference tool; [`drive`], [`proc`], [`machine`], [`spy`] and [`ecat`]
+//! start, drive and observe the supervisor.
 //!
-//! * `jitter` — the supervisor's real cycle side by side with cyclictest
-//!   (and, with `--ethercat`, with the EtherCAT backend over a veth pair to
-//!   emulated drives, `motion_harness::ecat`);
-//! * `ipc` — the command/feedback round trip through iceoryx2, next to a bare
-//!   iceoryx2 ping-pong;
-//! * `benches/engine.rs` — criterion benches of one engine step and one
-//!   whole cycle's compute.
-//!
-//! Nothing here runs in a real-time loop except [`sys::sleep_until`] and the
-//! IPC bench's measuring thread; the rest is orchestration, parsing and
-//! reporting.
+//! Nothing here runs in a real-time loop except the IPC bench's measuring
+//! thread; the rest is orchestration, parsing and reporting.
 
-pub mod cli;
 pub mod cyclictest;
+pub mod flags;
 pub mod hist;
 pub mod host;
-pub mod run_report;
-pub mod svg;
-pub mod sys;
+pub mod outcome;
+pub mod plot;
+pub mod slice;
+pub mod table;
 
 // The harness's pieces, under the names the bench binaries use: children
 // and the stop flag, driving a running supervisor, its machines, the frame

@@ -20,6 +20,8 @@
 //!   unlike a relative sleep). Overruns that swallow whole periods are
 //!   counted as missed and skipped while keeping the phase — cyclictest
 //!   skips them silently; a servo loop must know.
+//! - [`host`] — the host in words for a report: kernel, preemption model,
+//!   RT throttling, load, other programs' real-time threads.
 //! - [`clock`] — [`now_ns`]: `CLOCK_MONOTONIC` in `u64` nanoseconds.
 //! - [`rt_pool`] + [`RtAllocator`] + [`counting`] — no system-allocator
 //!   calls in the cycle. glibc `malloc` can take a lock, `mmap`/`brk` and
@@ -62,6 +64,7 @@ mod allocator;
 pub mod clock;
 pub mod counting;
 pub mod environment;
+pub mod host;
 pub mod logging;
 pub mod pm_qos;
 mod pool;
@@ -75,7 +78,7 @@ pub use allocator::RtAllocator;
 pub use clock::now_ns;
 pub use environment::check_environment;
 pub use pm_qos::{hold_cpu_dma_latency, DmaLatencyGuard};
-pub use thread::{enter_realtime, keep_off_cpu, RtConfig, RtReport, SchedPolicy};
+pub use thread::{enter_realtime, keep_off_cpu, pin_to_cpu, RtConfig, RtReport, SchedPolicy};
 pub use timer::{PeriodicTimer, Wakeup};
 
 /// Per-thread real-time memory pools (see [`RtAllocator`]).

@@ -213,7 +213,9 @@ pub fn enter_realtime(cfg: &RtConfig) -> RtReport {
     }
 }
 
-fn pin_to_cpu(cpu: usize) -> Result<(), String> {
+/// Pins the calling thread to `cpu` (no other setting changed); the error
+/// names the CPUs there are or the allowed set, as a warning to print.
+pub fn pin_to_cpu(cpu: usize) -> Result<(), String> {
     let online = online_cpus();
     let exists = match &online {
         Some(list) => list.contains(&cpu),

@@ -7,9 +7,9 @@
 //! slice's end (failed after the supervisor's `--duration` ran out: it was
 //! stopping), with how long it took from start to exit.
 //!
-//! The periodic clients run on threads of the bench (a request ends when
-//! its `motionctl` exits; they wait for it in 5 ms steps); every `motionctl`
-//! started is ended before [`Attached::detach`] returns.
+//! The periodic clients run on threads of the bench (waiting for their
+//! `motionctl` in 5 ms steps); every `motionctl` started is ended before
+//! [`Attached::detach`] returns.
 
 use motion_bench::drive::{self, last_json};
 use motion_bench::proc::{self, Running};
@@ -51,9 +51,7 @@ impl Count {
         self.failed += o.failed;
         self.cut_off += o.cut_off;
         self.ms.extend_from_slice(&o.ms);
-        for d in &o.details {
-            self.note(d.clone());
-        }
+        o.details.iter().for_each(|d| self.note(d.clone()));
     }
 
     fn note(&mut self, s: String) {
@@ -64,12 +62,9 @@ impl Count {
 
     /// Median and maximum of [`Count::ms`].
     pub fn ms_p50_max(&self) -> Option<(f64, f64)> {
-        if self.ms.is_empty() {
-            return None;
-        }
         let mut v = self.ms.clone();
         v.sort_by(f64::total_cmp);
-        Some((v[v.len() / 2], v[v.len() - 1]))
+        Some((*v.get(v.len() / 2)?, *v.last()?))
     }
 
     /// Counts one request's outcome: `end`ed means the supervisor is gone
@@ -103,6 +98,10 @@ pub struct Clients {
 }
 
 impl Clients {
+    fn all(&self) -> [&Count; 4] {
+        [&self.watch, &self.status, &self.stats, &self.home]
+    }
+
     pub fn merge(&mut self, o: &Clients) {
         self.watch.merge(&o.watch);
         self.status.merge(&o.status);
@@ -112,15 +111,20 @@ impl Clients {
 
     /// Requests made by every client (a watch counts once).
     pub fn made(&self) -> u64 {
-        self.watch.made + self.status.made + self.stats.made + self.home.made
+        self.all().iter().map(|c| c.made).sum()
     }
 
     pub fn failed(&self) -> u64 {
-        self.watch.failed + self.status.failed + self.stats.failed + self.home.failed
+        self.all().iter().map(|c| c.failed).sum()
     }
 
     pub fn cut_off(&self) -> u64 {
-        self.watch.cut_off + self.status.cut_off + self.stats.cut_off + self.home.cut_off
+        self.all().iter().map(|c| c.cut_off).sum()
+    }
+
+    /// The first problems of every kind of request.
+    pub fn details(&self) -> impl Iterator<Item = &String> {
+        self.all().into_iter().flat_map(|c| c.details.iter())
     }
 }
 
@@ -138,9 +142,8 @@ pub struct Attached {
     watch: Option<Running>,
     /// When the watch was seen to have ended by itself.
     watch_ended: Option<Instant>,
-    status: Option<JoinHandle<Count>>,
-    stats: Option<JoinHandle<Count>>,
-    home: Option<JoinHandle<Count>>,
+    /// The status and stats pollers and the homing client.
+    threads: [Option<JoinHandle<Count>>; 3],
 }
 
 /// Attaches every client to the supervisor of `prefix`, whose `--duration`
@@ -148,39 +151,27 @@ pub struct Attached {
 pub fn attach(motionctl: &Path, prefix: &str, p: &Plan, cut: Instant) -> Result<Attached, String> {
     let end = Arc::new(AtomicBool::new(false));
     let mut cmd = Command::new(motionctl);
-    cmd.args(["--service-prefix", prefix, "status", "--watch"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped());
+    cmd.args(["--service-prefix", prefix, "status", "--watch"]);
     // not captured: stdout stays /dev/null, stderr is still read
+    cmd.stdout(Stdio::null()).stderr(Stdio::piped());
     let watch = Running::spawn(&mut cmd, "motionctl status --watch", false, false)?;
-    let poller = |args: &'static [&'static str], every: Duration| {
-        let (m, pf, e) = (motionctl.to_path_buf(), prefix.to_string(), end.clone());
-        std::thread::Builder::new()
-            .name("cpcost-client".into())
-            .spawn(move || periodic(&m, &pf, args, every, cut, &e))
-            .map_err(|e| format!("cannot start a client thread: {e}"))
-    };
-    let status = poller(&["status", "--json"], p.status_every)?;
-    let stats = poller(&["stats", "--json"], p.stats_every)?;
-    let home = if p.homing {
-        let (m, pf, e) = (motionctl.to_path_buf(), prefix.to_string(), end.clone());
-        Some(
-            std::thread::Builder::new()
-                .name("cpcost-home".into())
-                .spawn(move || homing(&m, &pf, cut, &e))
-                .map_err(|e| format!("cannot start a client thread: {e}"))?,
-        )
-    } else {
-        None
-    };
+    let ctx = || (motionctl.to_path_buf(), prefix.to_string(), end.clone());
+    let (every, (m, pf, e)) = (p.status_every, ctx());
+    let status = client(move || periodic(&m, &pf, &["status", "--json"], every, cut, &e))?;
+    let (every, (m, pf, e)) = (p.stats_every, ctx());
+    let stats = client(move || periodic(&m, &pf, &["stats", "--json"], every, cut, &e))?;
+    let (m, pf, e) = ctx();
+    let home = p
+        .homing
+        .then(|| client(move || homing(&m, &pf, cut, &e)))
+        .transpose()?;
+    let threads = [Some(status), Some(stats), home];
     Ok(Attached {
         end,
         cut,
         watch: Some(watch),
         watch_ended: None,
-        status: Some(status),
-        stats: Some(stats),
-        home,
+        threads,
     })
 }
 
@@ -215,20 +206,22 @@ impl Attached {
                 }
             }
         }
-        let join = |h: Option<JoinHandle<Count>>| {
-            h.map(|h| {
-                h.join().unwrap_or_else(|_| Count {
-                    details: vec!["client thread panicked".into()],
-                    failed: 1,
-                    ..Count::default()
-                })
-            })
-            .unwrap_or_default()
-        };
-        c.status = join(self.status.take());
-        c.stats = join(self.stats.take());
-        c.home = join(self.home.take());
-        c
+        let [status, stats, home] = self.threads.each_mut().map(|h| {
+            let panicked = || Count {
+                details: vec!["client thread panicked".into()],
+                failed: 1,
+                ..Count::default()
+            };
+            h.take()
+                .map(|h| h.join().unwrap_or_else(|_| panicked()))
+                .unwrap_or_default()
+        });
+        Clients {
+            status,
+            stats,
+            home,
+            ..c
+        }
     }
 }
 
@@ -240,10 +233,22 @@ impl Drop for Attached {
     }
 }
 
+/// Runs a client on a thread of its own.
+fn client(f: impl FnOnce() -> Count + Send + 'static) -> Result<JoinHandle<Count>, String> {
+    let b = std::thread::Builder::new().name("cpcost-client".into());
+    b.spawn(f)
+        .map_err(|e| format!("cannot start a client thread: {e}"))
+}
+
+/// Whether a client goes on: not ended, not interrupted.
+fn going(end: &AtomicBool) -> bool {
+    !end.load(Ordering::Acquire) && !proc::stop_requested()
+}
+
 /// `motionctl --service-prefix P ARGS...` every `every` (a request that
 /// takes longer delays the next one: no burst to catch up) until `end`.
 fn periodic(
-    motionctl: &Path,
+    m: &Path,
     prefix: &str,
     args: &[&str],
     every: Duration,
@@ -252,31 +257,16 @@ fn periodic(
 ) -> Count {
     let mut c = Count::default();
     let mut next = Instant::now();
-    while !end.load(Ordering::Acquire) && !proc::stop_requested() {
+    while going(end) {
         let started = Instant::now();
-        let r = request(motionctl, prefix, args);
-        c.add(r, started, cut, end);
-        next += every;
-        let now = Instant::now();
-        if next <= now {
-            next = now;
-        } else {
-            sleep_until(next, end);
+        c.add(request(m, prefix, args), started, cut, end);
+        next = (next + every).max(Instant::now());
+        // in steps of at most 20 ms, to see `end` and a stop request
+        while Instant::now() < next && going(end) {
+            std::thread::sleep((next - Instant::now()).min(Duration::from_millis(20)));
         }
     }
     c
-}
-
-/// Sleeps until `t` in steps of at most 20 ms, returning early on `end` or
-/// a stop request.
-fn sleep_until(t: Instant, end: &AtomicBool) {
-    loop {
-        let now = Instant::now();
-        if now >= t || end.load(Ordering::Acquire) || proc::stop_requested() {
-            return;
-        }
-        std::thread::sleep((t - now).min(Duration::from_millis(20)));
-    }
 }
 
 /// One `motionctl --service-prefix P ARGS... --json` to its end: Ok if it
@@ -293,18 +283,15 @@ fn request(motionctl: &Path, prefix: &str, args: &[&str]) -> Result<(), String> 
     // ended: collects its output; still running: terminated (timed out)
     let ended = r.wait(Duration::ZERO, Duration::from_secs(1));
     let json = last_json(&ended.stdout);
-    if !ended.success() {
-        let said = json
-            .as_ref()
-            .and_then(|j| j.get("errors"))
-            .map(|e| e.to_string())
-            .unwrap_or_else(|| drive::tail(&ended.stderr, 2));
-        return Err(format!("{what}: {}; {said}", ended.describe()));
-    }
-    match json {
-        Some(j) if j.get("errors").is_none() => Ok(()),
-        Some(j) => Err(format!("{what}: errors {}", j["errors"])),
-        None => Err(format!("{what}: no JSON object on its stdout")),
+    let errors = json.as_ref().and_then(|j| j.get("errors"));
+    match (ended.success(), &json, errors) {
+        (false, _, _) => {
+            let said = errors.map_or_else(|| drive::tail(&ended.stderr, 2), |e| e.to_string());
+            Err(format!("{what}: {}; {said}", ended.describe()))
+        }
+        (true, Some(_), None) => Ok(()),
+        (true, Some(_), Some(e)) => Err(format!("{what}: errors {e}")),
+        (true, None, _) => Err(format!("{what}: no JSON object on its stdout")),
     }
 }
 
@@ -312,25 +299,24 @@ fn request(motionctl: &Path, prefix: &str, args: &[&str]) -> Result<(), String> 
 /// `cut` (it would only be cut off: X takes ~3 s to home).
 fn homing(motionctl: &Path, prefix: &str, cut: Instant, end: &AtomicBool) -> Count {
     let mut c = Count::default();
-    while !end.load(Ordering::Acquire) && !proc::stop_requested() && Instant::now() < cut {
+    while going(end) && Instant::now() < cut {
         let started = Instant::now();
-        let r = drive::ctl_home(motionctl, prefix, &["X"], false, HOME_TIMEOUT_S).and_then(|run| {
-            if !run.rows.is_empty() && run.rows.iter().all(|x| x.succeeded()) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "home X: {}; rows {}; {}",
-                    run.ended.describe(),
-                    run.rows
-                        .iter()
-                        .map(|x| format!(
-                            "{} pc {} er {} homed {} err {}/{}",
-                            x.name, x.pc, x.er, x.homed, x.err, x.exerr
-                        ))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    drive::tail(&run.ended.stderr, 2)
-                ))
+        let run = drive::ctl_home(motionctl, prefix, &["X"], false, HOME_TIMEOUT_S);
+        let r = run.and_then(|run| {
+            match !run.rows.is_empty() && run.rows.iter().all(|x| x.succeeded()) {
+                true => Ok(()),
+                false => {
+                    let rows: Vec<String> = (run.rows.iter())
+                        .map(|x| {
+                            format!(
+                                "{} pc {} er {} homed {} err {}/{}",
+                                x.name, x.pc, x.er, x.homed, x.err, x.exerr
+                            )
+                        })
+                        .collect();
+                    let (how, tail) = (run.ended.describe(), drive::tail(&run.ended.stderr, 2));
+                    Err(format!("home X: {how}; rows {}; {tail}", rows.join(", ")))
+                }
             }
         });
         c.add(r, started, cut, end);

@@ -3,7 +3,8 @@
 //! usage error (exit 2), not a half-run bench.
 
 use crate::mode::{self, Mode};
-use clap::Parser;
+use clap::{CommandFactory, Parser};
+use motion_bench::flags::Cycle;
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -12,8 +13,11 @@ use std::path::PathBuf;
     about = "Round trip command → feedback through iceoryx2, one message per period, with \
              (a) motion-io waiting on the event, (b) motion-io --spin, and (c) a bare \
              iceoryx2 echo of the same payload sizes (event-waiting and spinning).",
-    after_help = "The bare echo peer is this binary re-run as `ipc --role echo --prefix P \
-                  [--cpu N] [--priority P | --spin]` (see `ipc --role echo --help`).\n\n\
+    after_help = "The measuring thread plays the cycle: --cpu, --priority, --period-us (one \
+                  message per period, 20..=100000 µs); event-waiting peers run at priority \
+                  P-10 (so P is within 11..=99), spinning peers SCHED_OTHER. The bare echo peer \
+                  is this binary re-run as `ipc --role echo --prefix P [--cpu N] [--priority P \
+                  | --spin]` (see `ipc --role echo --help`).\n\n\
                   Exit status: 0, or 1 if a mode failed or motion-io was not found; 2 on a \
                   command-line mistake; 130 if interrupted."
 )]
@@ -22,21 +26,11 @@ pub struct Opts {
     #[arg(long, value_name = "N", default_value_t = 10_000,
           value_parser = clap::value_parser!(u64).range(1..))]
     pub count: u64,
-    /// One message per period, µs.
-    #[arg(long, value_name = "N", default_value_t = 1000,
-          value_parser = clap::value_parser!(u32).range(20..=100_000))]
-    pub period_us: u32,
-    /// CPU of the measuring thread, SCHED_FIFO.
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = motion_bench::cli::cpu)]
-    pub cpu: usize,
+    #[command(flatten)]
+    pub cycle: Cycle,
     /// CPU of the peer (default: the other one, 0; 1 with --cpu 0).
-    #[arg(long = "peer-cpu", value_name = "N", value_parser = motion_bench::cli::cpu)]
+    #[arg(long = "peer-cpu", value_name = "N", value_parser = motion_config::args::cpu)]
     peer_cpu_arg: Option<usize>,
-    /// SCHED_FIFO priority of the measuring thread; event-waiting peers run
-    /// at P-10, spinning peers SCHED_OTHER.
-    #[arg(long, value_name = "P", default_value_t = 80, value_parser = priority,
-          allow_negative_numbers = true)]
-    pub priority: i32,
     /// Answered messages before measuring.
     #[arg(long, value_name = "N", default_value_t = 200)]
     pub warmup: u64,
@@ -59,12 +53,11 @@ pub struct Opts {
 }
 
 impl Opts {
-    /// Parses the process's command line; also checks the default
-    /// `--peer-cpu`, which depends on `--cpu`, exiting as clap does.
+    /// Parses the process's command line with the checks that involve two
+    /// flags or the peers, exiting as clap does.
     pub fn parse_checked() -> Self {
         let o = Opts::parse();
         if let Err(e) = o.check() {
-            use clap::CommandFactory;
             Opts::command()
                 .error(clap::error::ErrorKind::ValueValidation, e)
                 .exit();
@@ -73,138 +66,77 @@ impl Opts {
     }
 
     fn check(&self) -> Result<(), String> {
+        let (p, period) = (self.cycle.priority, self.cycle.period_us);
+        if !(11..=99).contains(&p) {
+            return Err(format!(
+                "--priority {p}: must be within 11..=99 (peers run at P-10)"
+            ));
+        }
+        if !(20..=100_000).contains(&period) {
+            return Err(format!("--period-us {period}: must be within 20..=100000"));
+        }
         if self.peer_cpu_arg.is_none() {
-            let n = motion_bench::sys::cpus();
-            if self.peer_cpu() >= n {
-                return Err(format!(
-                    "--peer-cpu {} (its default with --cpu {}): this machine has {n} CPUs",
-                    self.peer_cpu(),
-                    self.cpu
-                ));
-            }
+            motion_config::args::cpu(&self.peer_cpu().to_string()).map_err(|e| {
+                format!(
+                    "--peer-cpu (its default with --cpu {}): {e}",
+                    self.cycle.cpu
+                )
+            })?;
         }
         Ok(())
     }
 
     /// The peer's CPU: `--peer-cpu`, else another one than `--cpu`.
     pub fn peer_cpu(&self) -> usize {
-        self.peer_cpu_arg
-            .unwrap_or(if self.cpu == 0 { 1 } else { 0 })
-    }
-}
-
-/// `--priority`: 11..=99, since event-waiting peers run at P-10.
-fn priority(s: &str) -> Result<i32, String> {
-    let p: i32 = s.parse().map_err(|_| "not a valid number".to_string())?;
-    if (11..=99).contains(&p) {
-        Ok(p)
-    } else {
-        Err("must be within 11..=99 (peers run at P-10)".into())
+        self.peer_cpu_arg.unwrap_or(self.cycle.other_cpu())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::CommandFactory;
 
     fn parse(args: &[&str]) -> Result<Opts, clap::Error> {
         Opts::try_parse_from(std::iter::once("ipc").chain(args.iter().copied()))
     }
 
-    /// The default `--cpu 1` exists; on one CPU only `--cpu 0` parses.
-    fn two_cpus() -> bool {
-        motion_bench::sys::cpus() >= 2
-    }
-
     #[test]
-    fn the_command_is_well_formed() {
+    fn flags_and_checks() {
         Opts::command().debug_assert();
-    }
-
-    #[test]
-    fn defaults() {
-        if !two_cpus() {
-            return;
-        }
-        let o = parse(&[]).unwrap();
+        let o = parse(&["--cpu", "0"]).unwrap();
         assert_eq!(
-            (o.count, o.period_us, o.cpu, o.priority),
-            (10_000, 1000, 1, 80)
+            (o.count, o.warmup, o.peer_cpu(), o.cpu_dma_latency),
+            (10_000, 200, 1, 0)
         );
-        assert_eq!(o.peer_cpu(), 0);
-        assert_eq!(o.warmup, 200);
-        assert_eq!(o.modes, Mode::ALL.to_vec());
-        assert_eq!(o.io, None);
-        assert_eq!(o.cpu_dma_latency, 0);
-        assert!(o.check().is_ok());
-    }
-
-    #[test]
-    fn every_flag() {
-        if !two_cpus() {
-            return;
-        }
+        assert_eq!((o.modes, o.io), (Mode::ALL.to_vec(), None));
         let o = parse(&[
+            "--cpu=0",
             "--count=5",
-            "--period-us",
-            "250",
-            "--cpu",
-            "0",
-            "--priority",
-            "11",
-            "--warmup",
-            "0",
             "--modes",
             "bare-spin, io-event",
             "--io",
-            "/x/motion-io",
-            "--cpu-dma-latency",
-            "-1",
+            "/x",
         ])
         .unwrap();
-        assert_eq!((o.count, o.period_us, o.cpu, o.priority), (5, 250, 0, 11));
-        assert_eq!(o.peer_cpu(), 1);
-        assert_eq!(o.warmup, 0);
-        assert_eq!(o.modes, vec![Mode::BareSpin, Mode::IoEvent]);
-        assert_eq!(o.io, Some(PathBuf::from("/x/motion-io")));
-        assert_eq!(o.cpu_dma_latency, -1);
-        assert_eq!(parse(&["--peer-cpu", "1"]).unwrap().peer_cpu(), 1);
-    }
-
-    #[test]
-    fn out_of_range_values_name_their_flag() {
-        if !two_cpus() {
-            return;
-        }
-        for (args, flag) in [
-            (&["--count", "0"][..], "--count"),
-            (&["--period-us", "19"], "--period-us"),
-            (&["--period-us", "100001"], "--period-us"),
-            (&["--priority", "10"], "--priority"),
-            (&["--priority", "100"], "--priority"),
-            (&["--modes", "io-event,nope"], "--modes"),
-            (&["--modes", ""], "--modes"),
+        assert_eq!((o.count, o.modes), (5, vec![Mode::BareSpin, Mode::IoEvent]));
+        assert!(parse(&["--cpu=0", "--peer-cpu", "0", "--cpu-dma-latency", "-1"]).is_ok());
+        for args in [
+            &["--priority", "10"][..],
+            &["--period-us", "19"],
+            &["--period-us", "100001"],
         ] {
-            let e = parse(args).unwrap_err();
-            assert_eq!(
-                e.kind(),
-                clap::error::ErrorKind::ValueValidation,
-                "{args:?}"
-            );
-            assert!(e.to_string().contains(flag), "{args:?}: {e}");
+            let o = parse(&[args, &["--cpu", "0"]].concat()).unwrap();
+            assert!(o.check().unwrap_err().contains(args[0]), "{args:?}");
         }
-        let beyond = motion_bench::sys::cpus().to_string();
-        for flag in ["--cpu", "--peer-cpu"] {
-            let e = parse(&[flag, &beyond]).unwrap_err();
-            assert!(e.to_string().contains(flag), "{e}");
+        for args in [
+            &["--count", "0"][..],
+            &["--modes", "io-event,nope"],
+            &["--modes", ""],
+        ] {
+            let e = parse(&[args, &["--cpu", "0"]].concat()).unwrap_err();
+            assert!(e.to_string().contains(args[0]), "{args:?}: {e}");
         }
-    }
-
-    #[test]
-    fn unknown_and_repeated_flags_are_errors() {
-        assert!(parse(&["--role", "echo"]).is_err());
-        assert!(parse(&["--count", "1", "--count", "2"]).is_err());
-        assert!(parse(&["--modes", "io-event", "--modes", "bare-spin"]).is_err());
+        assert!(parse(&["--cpu=0", "--role", "echo"]).is_err());
+        assert!(parse(&["--cpu=0", "--modes", "io-event", "--modes", "bare-spin"]).is_err());
     }
 }

@@ -10,9 +10,10 @@
 
 use crate::bare::{BareSide, PING, PONG};
 use clap::{Parser, ValueEnum};
+use motion_bench::host;
 use motion_bench::proc;
-use motion_bench::sys::{self, now_ns};
 use motion_ipc::{cleanup_domain, Domain};
+use motion_rt::now_ns;
 use std::time::Duration;
 
 /// The peer's role (`echo`, the only one).
@@ -49,11 +50,10 @@ pub struct EchoOpts {
 /// The echo's arguments as the bench spawns it: under `prefix` on `cpu`,
 /// SCHED_FIFO at `priority`, or spinning if None.
 pub fn args(prefix: &str, cpu: usize, priority: Option<i32>) -> Vec<String> {
-    let mut a: Vec<String> = ["--role", "echo", "--prefix", prefix, "--cpu"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    a.push(cpu.to_string());
+    let cpu = cpu.to_string();
+    let mut a: Vec<String> = ["--role", "echo", "--prefix", prefix, "--cpu", &cpu]
+        .map(String::from)
+        .to_vec();
     match priority {
         None => a.push("--spin".into()),
         Some(p) => a.extend(["--priority".into(), p.to_string()]),
@@ -76,17 +76,16 @@ pub fn main() -> i32 {
         libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
     }
     proc::install_stop_handler();
-    for w in sys::enter_rt(Some(cpu), prio) {
+    for w in host::enter_rt(Some(cpu), prio) {
         eprintln!("ipc echo: warning: {w}");
     }
-    let code = match echo(&prefix, spin) {
+    match echo(&prefix, spin) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("ipc echo: {e}");
             1
         }
-    };
-    code
+    }
 }
 
 /// Answers every ping with a pong carrying its sequence number, until
@@ -140,59 +139,33 @@ mod tests {
     use super::*;
     use clap::CommandFactory;
 
-    fn argv(args: Vec<String>) -> Vec<String> {
-        std::iter::once("ipc".to_string()).chain(args).collect()
-    }
-
-    #[test]
-    fn the_command_is_well_formed() {
-        EchoOpts::command().debug_assert();
-    }
-
     #[test]
     fn the_spawned_command_lines_are_the_echos_and_parse() {
+        EchoOpts::command().debug_assert();
+        let argv = |a: Vec<String>| {
+            std::iter::once("ipc".to_string())
+                .chain(a)
+                .collect::<Vec<_>>()
+        };
         let event = argv(args("mbi7m1", 0, Some(70)));
-        assert_eq!(
-            event[1..],
-            [
-                "--role",
-                "echo",
-                "--prefix",
-                "mbi7m1",
-                "--cpu",
-                "0",
-                "--priority",
-                "70"
-            ]
-        );
+        let shown = "--role echo --prefix mbi7m1 --cpu 0 --priority 70";
+        assert_eq!(event[1..].join(" "), shown);
         assert!(wanted(&event));
         let o = EchoOpts::try_parse_from(&event).unwrap();
         assert_eq!((o.role, o.prefix.as_str()), (Role::Echo, "mbi7m1"));
         assert_eq!((o.cpu, o.priority, o.spin), (0, Some(70), false));
-
         let spin = argv(args("mbi7m3", 1, None));
         assert_eq!(
-            spin[1..],
-            ["--role", "echo", "--prefix", "mbi7m3", "--cpu", "1", "--spin"]
+            spin[1..].join(" "),
+            "--role echo --prefix mbi7m3 --cpu 1 --spin"
         );
         let o = EchoOpts::try_parse_from(&spin).unwrap();
         assert_eq!((o.cpu, o.priority, o.spin), (1, None, true));
-    }
-
-    #[test]
-    fn only_a_leading_role_makes_an_echo() {
         let v = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
         assert!(wanted(&v(&["ipc", "--role=echo", "--prefix", "p"])));
-        assert!(!wanted(&v(&["ipc"])));
-        assert!(!wanted(&v(&["ipc", "--count", "5", "--role", "echo"])));
-    }
-
-    #[test]
-    fn the_prefix_is_required_and_the_role_checked() {
+        assert!(!wanted(&v(&["ipc"])) && !wanted(&v(&["ipc", "--count", "5", "--role", "echo"])));
         let parse = |a: &[&str]| EchoOpts::try_parse_from(a.iter().copied());
         assert!(parse(&["ipc", "--role", "echo"]).is_err());
         assert!(parse(&["ipc", "--role", "ping", "--prefix", "p"]).is_err());
-        let o = parse(&["ipc", "--role", "echo", "--prefix", "p"]).unwrap();
-        assert_eq!((o.cpu, o.priority, o.spin), (0, None, false));
     }
 }

@@ -7,7 +7,7 @@ use crate::exchange::Exchange;
 use hdrhistogram::Histogram;
 use motion_bench::hist::new_hist;
 use motion_bench::proc;
-use motion_bench::sys::{self, now_ns};
+use motion_rt::{now_ns, PeriodicTimer};
 use std::time::{Duration, Instant};
 
 /// Result of one mode.
@@ -25,9 +25,8 @@ fn cycle<X: Exchange>(x: &mut X, deadline: u64, period_ns: u64) -> Result<Option
     x.clear();
     let t_send = now_ns();
     let seq = x.send()?;
-    let budget_end = deadline + period_ns / 2;
     for _ in 0..4 {
-        if !x.wait_until(budget_end) {
+        if !x.wait_until(deadline + period_ns / 2) {
             break;
         }
         if x.answer() == Some(seq) {
@@ -37,26 +36,18 @@ fn cycle<X: Exchange>(x: &mut X, deadline: u64, period_ns: u64) -> Result<Option
     Ok(None)
 }
 
-/// `count` messages, one per period of `period_ns`, after `warmup` answers
-/// in a row.
+/// `count` messages, one per period of `period_ns` (the cycle's timer:
+/// absolute deadlines, whole periods that passed skipped with the phase
+/// kept), after `warmup` answers in a row.
 pub fn measure<X: Exchange>(
     x: &mut X,
     count: u64,
     period_ns: u64,
     warmup: u64,
 ) -> Result<Measured, String> {
-    let mut deadline = now_ns() + period_ns;
-    let next = |deadline: &mut u64| {
-        *deadline += period_ns;
-        // keep the phase; skip whole periods that already passed
-        let now = now_ns();
-        if now > *deadline {
-            *deadline += (now - *deadline) / period_ns * period_ns + period_ns;
-        }
-    };
+    let mut timer = PeriodicTimer::new(period_ns);
     // warm-up: until `warmup` answers in a row (peer started, connected)
-    let started = Instant::now();
-    let mut in_row = 0;
+    let (started, mut in_row) = (Instant::now(), 0);
     while in_row < warmup {
         if started.elapsed() > Duration::from_secs(15) {
             return Err(format!(
@@ -66,13 +57,12 @@ pub fn measure<X: Exchange>(
         if proc::stop_requested() {
             return Err("interrupted".into());
         }
-        sys::sleep_until(deadline);
+        let deadline = timer.wait().deadline_ns;
         in_row = if cycle(x, deadline, period_ns)?.is_some() {
             in_row + 1
         } else {
             0
         };
-        next(&mut deadline);
     }
     let mut m = Measured {
         hist: new_hist(),
@@ -83,13 +73,12 @@ pub fn measure<X: Exchange>(
         if m.sent % 1000 == 0 && proc::stop_requested() {
             return Err("interrupted".into());
         }
-        sys::sleep_until(deadline);
+        let deadline = timer.wait().deadline_ns;
         m.sent += 1;
         match cycle(x, deadline, period_ns)? {
             Some(rt) => m.hist.saturating_record(rt.max(1)),
             None => m.late += 1,
         }
-        next(&mut deadline);
     }
     Ok(m)
 }

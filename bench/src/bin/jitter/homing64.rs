@@ -4,7 +4,6 @@
 //! machine. The homings themselves are counted too (all homed, a failed
 //! axis, cut off by the slice's end).
 
-use crate::supervisor;
 use motion_bench::drive::{self, Tally};
 use motion_bench::proc::{self, Running};
 use serde_json::{json, Value};
@@ -39,27 +38,41 @@ impl Homing64 {
         self.durations.extend(h.durations);
     }
 
+    fn mean_s(&self) -> f64 {
+        let n = self.durations.len().max(1) as f64;
+        self.durations.iter().sum::<f64>() / n
+    }
+
+    /// The progress line's part.
+    pub fn progress(&self) -> String {
+        let Homing64 {
+            started,
+            ok,
+            failed,
+            cut_off,
+            ..
+        } = self;
+        format!(
+            "; {started} homing(s) of 64 axes: {ok} ok, {failed} failed, {cut_off} cut off by the slice's end"
+        )
+    }
+
     /// The report's line for `secs` s of 64-axis slices.
     pub fn line(&self, secs: f64) -> String {
-        let mean = if self.durations.is_empty() {
-            0.0
-        } else {
-            self.durations.iter().sum::<f64>() / self.durations.len() as f64
-        };
+        let (
+            Homing64 {
+                started,
+                ok,
+                failed,
+                cut_off,
+                ..
+            },
+            t,
+        ) = (self, &self.tally);
         format!(
-            "64 axes: {} parallel homing(s) in {:.0} s ({:.1} s each): {} all homed, {} with a failed axis, {} cut off by a slice's end; \
+            "64 axes: {started} parallel homing(s) in {secs:.0} s ({:.1} s each): {ok} all homed, {failed} with a failed axis, {cut_off} cut off by a slice's end; \
              axis homings {}: {} ok, {} ERR 12/40 (feedback lost), {} other error(s), {} not homed",
-            self.started,
-            secs,
-            mean,
-            self.ok,
-            self.failed,
-            self.cut_off,
-            self.tally.axis_homings,
-            self.tally.ok,
-            self.tally.feedback_lost,
-            self.tally.other_errors,
-            self.tally.not_homed
+            self.mean_s(), t.axis_homings, t.ok, t.feedback_lost, t.other_errors, t.not_homed
         )
     }
 
@@ -71,54 +84,47 @@ impl Homing64 {
             "with_failed_axis": self.failed,
             "cut_off_by_slice_end": self.cut_off,
             "axes": self.tally,
-            "mean_duration_s": if self.durations.is_empty() { 0.0 }
-                else { self.durations.iter().sum::<f64>() / self.durations.len() as f64 },
+            "mean_duration_s": self.mean_s(),
         })
     }
 }
 
-/// Runs `motion-supervisor run` on the 64-axis `toml` for `len` s (as
-/// [`supervisor::run`]) and, while it runs, homes every axis in parallel
-/// with `motionctl home --parallel`, one homing after the other.
-#[allow(clippy::too_many_arguments)]
-pub fn run(
-    supervisor: &Path,
+/// While `sup` (started at `t0` for `len` s, prefix `prefix`) runs, homes
+/// every axis in parallel with `motionctl home --parallel`, one homing
+/// after the other.
+pub fn home_while(
     motionctl: &Path,
-    tmp: &Path,
-    tag: &str,
-    toml: &str,
     prefix: &str,
+    sup: &mut Running,
+    t0: Instant,
     len: f64,
-    hlog: &Path,
-) -> Result<(proc::Ended, Homing64), String> {
-    let mut cmd = supervisor::run_command(supervisor, tmp, tag, toml, prefix, len, hlog)?;
-    let t0 = Instant::now();
-    let mut r = Running::spawn(&mut cmd, "motion-supervisor", true, false)?;
+) -> Result<Homing64, String> {
     let mut h = Homing64::default();
-    if drive::wait_until_ready(motionctl, prefix, &mut r, Duration::from_secs_f64(len)).is_ok() {
-        while r.running() && !proc::stop_requested() && t0.elapsed().as_secs_f64() < len {
-            let started = Instant::now();
-            h.started += 1;
-            let run = drive::ctl_home(motionctl, prefix, &[], true, len + 10.0)?;
-            let all_ok = !run.rows.is_empty() && run.rows.iter().all(|x| x.succeeded());
-            if all_ok {
-                h.ok += 1;
-                h.tally.add(&format!("{prefix} homing {}", h.started), &run);
-                h.durations.push(started.elapsed().as_secs_f64());
-            } else if (!r.running() || t0.elapsed().as_secs_f64() >= len - 0.5)
-                && run.rows.iter().all(|x| {
-                    x.succeeded() || (x.er && x.err == 12 && x.exerr == 1) || (!x.er && !x.homed)
-                })
-            {
-                // the supervisor's --duration ended it: every axis stopped
-                // (ERR 12/1), the homed ones unhomed; any other code counts
-                h.cut_off += 1;
-            } else {
-                h.failed += 1;
-                h.tally.add(&format!("{prefix} homing {}", h.started), &run);
-            }
+    if drive::wait_until_ready(motionctl, prefix, sup, Duration::from_secs_f64(len)).is_err() {
+        return Ok(h);
+    }
+    let running = |sup: &mut Running| sup.running() && t0.elapsed().as_secs_f64() < len;
+    while running(sup) && !proc::stop_requested() {
+        let started = Instant::now();
+        h.started += 1;
+        let run = drive::ctl_home(motionctl, prefix, &[], true, len + 10.0)?;
+        let what = format!("{prefix} homing {}", h.started);
+        if !run.rows.is_empty() && run.rows.iter().all(|x| x.succeeded()) {
+            h.ok += 1;
+            h.tally.add(&what, &run);
+            h.durations.push(started.elapsed().as_secs_f64());
+        } else if (!sup.running() || t0.elapsed().as_secs_f64() >= len - 0.5)
+            && (run.rows.iter()).all(|x| {
+                x.succeeded() || (x.er && x.err == 12 && x.exerr == 1) || (!x.er && !x.homed)
+            })
+        {
+            // the supervisor's --duration ended it: every axis stopped
+            // (ERR 12/1), the homed ones unhomed; any other code counts
+            h.cut_off += 1;
+        } else {
+            h.failed += 1;
+            h.tally.add(&what, &run);
         }
     }
-    let left = Duration::from_secs_f64(len + 60.0).saturating_sub(t0.elapsed());
-    Ok((r.wait(left, Duration::from_secs(10)), h))
+    Ok(h)
 }

@@ -4,218 +4,161 @@
 //! supervisor with the EtherCAT backend (over a veth pair to emulated
 //! drives) in the same slices. See `bench/README.md`.
 //!
-//! This file is the sequence — find the tools, set the stage (temporary
-//! directory, EtherCAT rig, stress-ng), run the slices, merge, judge,
-//! report — and the modules are its steps:
-//!
-//! * [`cli`] the command line; [`tools`] the programs it runs; [`host`] the
-//!   machine it runs on; [`stress`] the `--stress` load;
-//! * [`slices`] the alternating slices, running [`supervisor`] (with
-//!   [`homing64`] for the 64-axis machine) and [`cyclictest_slice`];
-//! * [`summary`] the slices merged and the verdict;
-//! * [`table`] the printed report, [`hlog`], [`plot`] and [`json`] the files.
+//! This file is the sequence — find the tools, set the stage (EtherCAT rig,
+//! stress-ng), run the slices, merge, judge, report — and the modules are
+//! its steps: [`cli`] the command line, [`slices`] the alternating slices
+//! (with [`homing64`] for the 64-axis machine), [`report`] the merge, the
+//! verdict and the printed report, [`files`] the files written.
 
 mod cli;
-mod cyclictest_slice;
-mod hlog;
+mod files;
 mod homing64;
-mod json;
-mod plot;
+mod report;
 mod slices;
-mod stress;
-mod summary;
-mod supervisor;
-mod table;
-mod tools;
 
 use clap::Parser;
 use cli::Opts;
+use motion_bench::drive::{self, Binaries};
 use motion_bench::ecat::EcatRig;
-use motion_bench::host::{Env, OtherRt};
-use motion_bench::proc;
+use motion_bench::host;
+use motion_bench::outcome::{self, Bench};
+use motion_bench::proc::Running;
 use std::path::PathBuf;
-use std::time::{Instant, SystemTime};
+use std::time::{Duration, Instant, SystemTime};
 
 fn main() {
     let o = Opts::parse();
-    proc::install_stop_handler();
-    std::process::exit(match run(&o) {
-        Ok(code) => code,
-        Err(e) => {
-            eprintln!("jitter: FAILED: {e}");
-            1
-        }
-    });
+    outcome::main("jitter", || run(&o))
 }
 
 fn run(o: &Opts) -> Result<i32, String> {
-    let supervisor = tools::supervisor(o)?;
-    let cyclictest = tools::cyclictest(o);
-    let other_cpu = if o.cpu == 0 { 1 } else { 0 };
-    let stress_ng = tools::stress_ng(o)?;
-
-    let env = Env::probe();
-    let pid = std::process::id();
-    let tmp = std::env::temp_dir().join(format!("motion-bench-jitter-{pid}"));
-    std::fs::create_dir_all(&tmp).map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
-    let _tmp_guard = RemoveDir(tmp.clone());
-    std::fs::create_dir_all(&o.out)
-        .map_err(|e| format!("cannot create {}: {e}", o.out.display()))?;
-
-    let slices = slices::count(o);
+    let bins = Binaries::find(o.files.supervisor.as_deref())?;
+    let cyclictest = cyclictest(o);
+    if o.stress && host::cpus() < 2 {
+        return Err("--stress needs a second CPU".into());
+    }
+    let out = o.files.out("");
+    let mut b = Bench::start("jitter", Some(&out))?;
+    let (cy, slices) = (&o.cycle, o.slicing.count());
+    let on = match o.stress {
+        true => format!(", stress-ng on CPU {}", cy.other_cpu()),
+        false => String::new(),
+    };
     eprintln!(
-        "jitter: {} s per tool at {} µs, {} slice(s) of ≤ {} s, SCHED_FIFO {} on CPU {}{}",
-        o.duration,
-        o.period_us,
-        slices,
-        o.slice,
-        o.priority,
-        o.cpu,
-        if o.stress {
-            format!(", stress-ng on CPU {other_cpu}")
-        } else {
-            String::new()
-        }
+        "jitter: {} s per tool at {} µs, {slices} slice(s) of ≤ {} s, SCHED_FIFO {} on CPU {}{on}",
+        o.slicing.duration, cy.period_us, o.slicing.slice, cy.priority, cy.cpu
     );
-    eprintln!("jitter: supervisor {}", supervisor.display());
+    eprintln!("jitter: supervisor {}", bins.supervisor.display());
     if let Some(c) = &cyclictest {
         eprintln!("jitter: cyclictest {}", c.display());
     }
-    if !env.is_rt {
-        eprintln!(
-            "jitter: kernel is not PREEMPT_RT ({}): the numbers are upper bounds",
-            env.preemption
-        );
-    }
-    let mut other_rt = OtherRt::new("jitter");
-    other_rt.note("before the bench");
-
-    let rig = if o.ethercat {
-        Some(ethercat_rig(o, other_cpu)?)
-    } else {
-        None
-    };
-
-    let t0 = Instant::now();
-    let t0_wall = SystemTime::now();
-    let stress = match &stress_ng {
-        None => None,
-        Some(bin) => Some(stress::start(bin, other_cpu, o.duration, slices)?),
-    };
-    let motionctl = tools::motionctl(o, &supervisor)?;
-
-    let mut c = slices::run(
-        &slices::Plan {
-            o,
-            slices,
-            pid,
-            tmp: &tmp,
-            t0,
-            supervisor: &supervisor,
-            motionctl: &motionctl,
-            rig: rig.as_ref(),
-            cyclictest: cyclictest.as_deref(),
-        },
-        &mut other_rt,
-    )?;
-    let mut failures = std::mem::take(&mut c.failures);
-    stress::stop(stress, c.interrupted, &mut failures);
-    let wall = t0.elapsed();
-
-    if c.ours.is_empty() {
-        for f in &failures {
-            eprintln!("jitter: FAILED: {f}");
-        }
-        if c.interrupted {
-            eprintln!("jitter: interrupted (signal {})", proc::stop_signal());
-            return Ok(130);
-        }
-        return Err(failures.join("; "));
-    }
-
-    let m = summary::Summary::of(&c, o.period_us);
-    m.judge(
-        o.axes64,
-        o.ethercat,
-        cyclictest.is_some(),
-        c.interrupted,
-        &mut failures,
-    );
-    print!("{}", table::text(o, &env, other_cpu, &m, &c, &other_rt));
-
-    let base = o.out.join(format!("jitter-{}us", o.period_us));
-    let hlog_path = base.with_extension("hlog");
-    let svg_path = base.with_extension("svg");
-    let json_path = base.with_extension("json");
-    if let Err(e) = hlog::write(&hlog_path, o, &env, t0_wall, &c) {
-        failures.push(e);
-    }
-    if let Err(e) = plot::write(&svg_path, o, &env, &m) {
-        failures.push(e);
-    }
-    if let Err(e) = json::write(
-        &json_path,
+    b.warn_not_rt();
+    let rig = o.ethercat.then(|| ethercat_rig(o)).transpose()?;
+    let (t0, t0_wall) = (Instant::now(), SystemTime::now());
+    let stress = o.stress.then(|| start_stress(o, slices)).transpose()?;
+    let plan = slices::Plan {
         o,
-        &env,
-        wall,
-        &m,
-        &c,
-        &other_rt,
-        (&hlog_path, &svg_path),
-        &failures,
-    ) {
+        slices,
+        tmp: &b.tmp,
+        t0,
+        supervisor: &bins.supervisor,
+        motionctl: &bins.motionctl,
+        rig: rig.as_ref(),
+        cyclictest: cyclictest.as_deref(),
+    };
+    let mut c = slices::run(&plan, &mut b.other_rt)?;
+    let mut failures = std::mem::take(&mut c.failures);
+    stop_stress(stress, c.interrupted, &mut failures);
+    let wall = t0.elapsed().as_secs_f64();
+    if c.ours[0].is_empty() {
+        return b.nothing_measured(c.interrupted, &failures);
+    }
+    let m = report::Summary::of(&c, cy.period_us);
+    m.judge(o, cyclictest.is_some(), c.interrupted, &mut failures);
+    print!("{}", report::text(o, &b, &m, &c));
+    let base = out.join(format!("jitter-{}us", cy.period_us));
+    let [hlog, svg, json] = ["hlog", "svg", "json"].map(|e| base.with_extension(e));
+    let written = [
+        files::hlog(&hlog, o, &b, t0_wall, &c),
+        files::svg(&svg, o, &b, &m),
+    ];
+    failures.extend(written.into_iter().filter_map(Result::err));
+    let ctx = (o, &b, &m, &c);
+    if let Err(e) = files::json(&json, ctx, wall, [&hlog, &svg], &failures) {
         failures.push(e);
     }
-    println!(
-        "files: {}, {}, {}",
-        hlog_path.display(),
-        svg_path.display(),
-        json_path.display()
-    );
+    Ok(b.end(&[&hlog, &svg, &json], c.interrupted, &failures, true))
+}
 
-    if c.interrupted {
-        eprintln!(
-            "jitter: interrupted (signal {}): results above are partial",
-            proc::stop_signal()
-        );
-        return Ok(130);
+/// cyclictest, or None (with a warning saying why) when its half is
+/// skipped: `--no-cyclictest`, not installed, or no SCHED_FIFO for this
+/// user (cyclictest refuses to run without it).
+fn cyclictest(o: &Opts) -> Option<PathBuf> {
+    if o.no_cyclictest {
+        eprintln!("jitter: --no-cyclictest: running the supervisor half only");
+        return None;
     }
-    if failures.is_empty() {
-        println!("jitter: OK");
-        Ok(0)
-    } else {
-        for f in &failures {
-            println!("jitter: FAILED: {f}");
+    let Some(bin) = o
+        .cyclictest
+        .clone()
+        .or_else(|| host::find_in_path("cyclictest"))
+    else {
+        eprintln!(
+            "jitter: WARNING: cyclictest not found (install rt-tests: `apt-get install -y \
+             rt-tests`); SKIPPING the cyclictest half, the supervisor is measured alone"
+        );
+        return None;
+    };
+    if let Err(e) = host::can_use_fifo(o.cycle.priority) {
+        eprintln!(
+            "jitter: WARNING: no real-time scheduling for this user ({e}); cyclictest cannot run \
+             like that: SKIPPING the cyclictest half (the supervisor warns and runs SCHED_OTHER)"
+        );
+        return None;
+    }
+    Some(bin)
+}
+
+/// `--stress`: stress-ng loading the other CPU for the whole bench, bounded
+/// by its own timeout well beyond the bench's expected length (so it cannot
+/// outlive a bench that dies) and killed as a group at the end.
+fn start_stress(o: &Opts, slices: usize) -> Result<Running, String> {
+    let bound = (3.0 * o.slicing.duration + 20.0 * slices as f64 + 60.0).ceil() as u64;
+    let cpu = o.cycle.other_cpu();
+    let r = drive::stress(cpu, Duration::from_secs(bound)).map_err(|e| format!("--stress: {e}"))?;
+    eprintln!(
+        "jitter: stress-ng --cpu 1 --taskset {cpu} --timeout {bound}s (pid {})",
+        r.pid()
+    );
+    Ok(r)
+}
+
+/// Ends stress-ng, whatever happened; a failure if it had ended by itself
+/// (the bench did not run under the load it claims), unless interrupted.
+fn stop_stress(stress: Option<Running>, interrupted: bool, failures: &mut Vec<String>) {
+    if let Some(mut s) = stress {
+        let still = s.running();
+        s.terminate(Duration::from_secs(3));
+        if !still && !interrupted {
+            failures.push("stress-ng ended before the bench did (see its output)".into());
         }
-        Ok(1)
     }
 }
 
 /// `--ethercat`: the veth pair and the emulated drives, for the whole bench.
-fn ethercat_rig(o: &Opts, other_cpu: usize) -> Result<EcatRig, String> {
+fn ethercat_rig(o: &Opts) -> Result<EcatRig, String> {
     let demo = motion_config::parse(motion_config::DEMO_TOML)
         .map_err(|p| format!("deploy/demo.toml: {p:?}"))?;
-    // below motion-io (priority − 10), whose answer to the supervisor
-    // is what the cycle measures; the emulator plays hardware that
-    // would take no CPU at all
-    let emu_priority = (o.priority - 15).clamp(1, 99);
-    let rig =
-        EcatRig::start(&demo, other_cpu, emu_priority).map_err(|e| format!("--ethercat: {e}"))?;
+    // below motion-io (priority − 10), whose answer to the supervisor is
+    // what the cycle measures; the emulator plays hardware that would take
+    // no CPU at all
+    let (cpu, priority) = (o.cycle.other_cpu(), (o.cycle.priority - 15).clamp(1, 99));
+    let rig = EcatRig::start(&demo, cpu, priority).map_err(|e| format!("--ethercat: {e}"))?;
     eprintln!(
         "jitter: EtherCAT: motion-io --backend ethercat on {} ↔ veth ↔ ecat-emu ({} drives, \
-         SCHED_FIFO {emu_priority} on CPU {other_cpu})",
+         SCHED_FIFO {priority} on CPU {cpu})",
         rig.interface(),
         rig.drives
     );
     Ok(rig)
-}
-
-/// Removes a directory on drop: the bench's temporary configs, logs and
-/// histograms go whichever way `run` returns.
-struct RemoveDir(PathBuf);
-
-impl Drop for RemoveDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }

@@ -8,36 +8,51 @@
 //! reported); so does SIGINT/SIGTERM.
 
 use crate::cli::Opts;
-use crate::cyclictest_slice::{self, CtSlice};
 use crate::homing64::{self, Homing64};
-use crate::supervisor::{self, leftover_shm, our_slice, OurSlice};
+use motion_bench::cyclictest::{self, CtHistogram};
 use motion_bench::ecat::{self, BusRun, EcatRig};
-use motion_bench::hist::us;
 use motion_bench::host::OtherRt;
-use motion_bench::machine::{self, Machine, Supervisor};
+use motion_bench::machine::{self, Machine};
 use motion_bench::proc::{self, Running};
+use motion_bench::slice::{self, Slice};
+use motion_bench::table::us;
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-/// Slices of `--slice` s that make up `--duration` (the last one shorter).
-pub fn count(o: &Opts) -> usize {
-    (o.duration / o.slice - 1e-9).ceil().max(1.0) as usize
+/// A supervisor variant measured in every slice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// The demo machine, idle.
+    Demo,
+    /// The 64-axis machine, homing in parallel again and again.
+    Axes64,
+    /// The demo machine on the EtherCAT backend.
+    Ethercat,
 }
 
-/// Seconds of slice `i`.
-fn len(o: &Opts, i: usize) -> f64 {
-    (o.duration - i as f64 * o.slice).min(o.slice)
+impl Variant {
+    /// Letter of its service prefixes and temporary files.
+    fn letter(self) -> char {
+        ['s', 'a', 'e'][self as usize]
+    }
+
+    /// Its name in the progress lines and failures.
+    fn label(self) -> &'static str {
+        ["ours", "64 axes", "EtherCAT"][self as usize]
+    }
+
+    /// Its tag in the interval log.
+    pub fn tag(self) -> &'static str {
+        ["ours", "ours_axes64", "ours_ethercat"][self as usize]
+    }
 }
 
 /// What the slices run with.
 pub struct Plan<'a> {
     pub o: &'a Opts,
-    /// Number of slices ([`count`]).
     pub slices: usize,
-    /// Makes the service prefixes unique to this bench.
-    pub pid: u32,
     /// Configs and interval logs of the runs.
     pub tmp: &'a Path,
     /// Start of the bench: slices are timed from here.
@@ -50,15 +65,19 @@ pub struct Plan<'a> {
     pub cyclictest: Option<&'a Path>,
 }
 
+/// One cyclictest slice.
+pub struct CtSlice {
+    pub start: Duration,
+    pub len: Duration,
+    pub hist: CtHistogram,
+    pub hdr: hdrhistogram::Histogram<u64>,
+}
+
 /// Everything the slices measured, and how they ended.
 #[derive(Default)]
 pub struct Collected {
-    /// The demo machine, idle.
-    pub ours: Vec<OurSlice>,
-    /// The 64-axis machine, homing.
-    pub ours64: Vec<OurSlice>,
-    /// The demo machine on the EtherCAT backend.
-    pub ours_ecat: Vec<OurSlice>,
+    /// Per variant (`Variant as usize`), its slices.
+    pub ours: [Vec<Slice>; 3],
     pub homing64: Homing64,
     /// motion-io's bus round trips, one per EtherCAT slice that reported it.
     pub bus_runs: Vec<BusRun>,
@@ -71,291 +90,179 @@ pub struct Collected {
     pub interrupted: bool,
 }
 
-/// Whether the slices go on after one tool's run.
-#[derive(PartialEq)]
-enum Flow {
-    Go,
-    /// Interrupted, or a tool failed (recorded in [`Collected`]).
-    Stop,
-}
-
 /// Runs the slices. An `Err` is a bench that could not go on (a config or
 /// a process that could not be made), not a tool that failed.
 pub fn run(p: &Plan, other_rt: &mut OtherRt) -> Result<Collected, String> {
     let mut c = Collected::default();
-    for i in 0..p.slices {
-        let len = len(p.o, i);
-        if ours_demo(p, i, len, &mut c)? == Flow::Stop {
-            break;
-        }
-        if p.o.axes64 && ours_axes64(p, i, len, &mut c)? == Flow::Stop {
-            break;
-        }
-        if let Some(rig) = p.rig {
-            if ours_ethercat(p, rig, i, len, &mut c)? == Flow::Stop {
-                break;
+    let on = [true, p.o.axes64, p.rig.is_some()];
+    let variants = [Variant::Demo, Variant::Axes64, Variant::Ethercat];
+    'slices: for i in 0..p.slices {
+        let len = p.o.slicing.len(i);
+        for v in variants.into_iter().filter(|&v| on[v as usize]) {
+            if !our_slice(p, v, i, len, &mut c)? {
+                break 'slices;
             }
         }
-        if let Some(ct_bin) = p.cyclictest {
-            if cyclictest(p, ct_bin, i, len, &mut c)? == Flow::Stop {
+        if let Some(bin) = p.cyclictest {
+            if !cyclictest(p, bin, i, len, &mut c)? {
                 break;
             }
         }
         other_rt.note("during the bench");
     }
-    if proc::stop_requested() {
-        c.interrupted = true;
-    }
+    c.interrupted |= proc::stop_requested();
     Ok(c)
 }
 
-/// The `[supervisor]` section of every run: the bench's period, CPU and
-/// priority, and a prefix of its own.
-fn sup(o: &Opts, prefix: &str) -> Supervisor {
-    Supervisor {
-        cycle_us: o.period_us,
-        cpu: o.cpu,
-        priority: o.priority,
-        service_prefix: prefix.to_string(),
-    }
-}
-
-/// One series of supervisor slices: the letter of its service prefixes,
-/// its name in the progress lines and failures.
-struct Series {
-    letter: char,
-    label: &'static str,
-}
-
-/// One supervisor slice of a series: `launch` runs it under `prefix` with
-/// its interval log at `hlog` and returns how it ended with whatever else
-/// it measured; `keep` files the slice (and that) and returns what to add
-/// to the progress line. The stop request, the report, the progress line,
-/// the failure and the clean-up are the same for every series.
-fn our_slice_of<X>(
-    p: &Plan,
-    i: usize,
-    len: f64,
-    c: &mut Collected,
-    series: Series,
-    launch: impl FnOnce(&str, &Path) -> Result<(proc::Ended, X), String>,
-    keep: impl FnOnce(&mut Collected, OurSlice, Vec<String>, X, &proc::Ended) -> String,
-) -> Result<Flow, String> {
+/// One supervisor slice of `v`; false: the slices end (interrupted, or the
+/// run failed, recorded in `c`).
+fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Result<bool, String> {
     if proc::stop_requested() {
         c.interrupted = true;
-        return Ok(Flow::Stop);
+        return Ok(false);
     }
-    let prefix = format!("mbj{}{}{i}", p.pid, series.letter);
-    let hlog_path = p.tmp.join(format!("{}{i}.hlog", series.letter));
-    let start = p.t0.elapsed();
-    let (ended, extra) = launch(&prefix, &hlog_path)?;
+    let prefix = format!("mbj{}{}{i}", std::process::id(), v.letter());
+    let sup = p.o.cycle.supervisor(&prefix);
+    let (toml, _) = match v {
+        Variant::Axes64 => Machine::Axes64.with(&sup)?,
+        _ => machine::demo_with(&sup)?,
+    };
+    let toml = match (v, p.rig) {
+        (Variant::Ethercat, Some(rig)) => ecat::on_ethercat(&toml, rig.interface())?.0,
+        _ => toml,
+    };
+    let tag = format!("{}{i}", v.letter());
+    let (mut cmd, hlog) = slice::command(p.supervisor, p.tmp, &tag, &toml, &prefix, len)?;
+    let (start, t) = (p.t0.elapsed(), Instant::now());
+    let mut run = Running::spawn(&mut cmd, "motion-supervisor", true, false)?;
+    let homing = match v {
+        Variant::Axes64 => Some(homing64::home_while(
+            p.motionctl,
+            &prefix,
+            &mut run,
+            t,
+            len,
+        )?),
+        _ => None,
+    };
+    let left = Duration::from_secs_f64(len + 60.0).saturating_sub(t.elapsed());
+    let ended = run.wait(left, Duration::from_secs(10));
     if ended.interrupted {
         c.interrupted = true;
-        return Ok(Flow::Stop);
+        return Ok(false);
     }
-    match our_slice(&ended, &hlog_path, start, len) {
-        Ok((s, w)) => {
-            let line = format!(
-                "jitter: slice {}/{} {:<11} {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies)",
-                i + 1,
-                p.slices,
-                format!("{}:", series.label),
-                s.cycles,
-                us(s.json_wakeup.p99),
-                us(s.json_wakeup.max),
-                s.misses,
-                s.late
-            );
-            let more = keep(c, s, w, extra, &ended);
-            eprintln!("{line}{more}");
-        }
+    let (s, warnings) = match slice::read(&ended, &hlog, start, len) {
+        Ok(x) => x,
         Err(e) => {
-            c.failures.push(format!(
-                "slice {}: motion-supervisor ({}): {e}",
-                i + 1,
-                series.label
-            ));
-            return Ok(Flow::Stop);
+            let (n, label) = (i + 1, v.label());
+            c.failures
+                .push(format!("slice {n}: motion-supervisor ({label}): {e}"));
+            return Ok(false);
         }
+    };
+    let (l, w) = (&s.lat, &s.lat.wakeup_us);
+    let mut line = format!(
+        "jitter: slice {}/{} {:<11} {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies)",
+        i + 1, p.slices, format!("{}:", v.label()), l.cycles, us(w.p99), us(w.max), l.deadline_misses, l.late_replies
+    );
+    if let Some(h) = homing {
+        line += &h.progress();
+        c.homing64.merge(h);
     }
-    leftover_shm(&prefix, &mut c.warnings);
-    Ok(Flow::Go)
-}
-
-/// The supervisor on the demo machine, idle.
-fn ours_demo(p: &Plan, i: usize, len: f64, c: &mut Collected) -> Result<Flow, String> {
-    let series = Series {
-        letter: 's',
-        label: "ours",
-    };
-    our_slice_of(
-        p,
-        i,
-        len,
-        c,
-        series,
-        |prefix, hlog| {
-            let (toml, _) = machine::demo_with(&sup(p.o, prefix))?;
-            let ended = supervisor::run(
-                p.supervisor,
-                p.tmp,
-                &format!("slice{i}"),
-                &toml,
-                prefix,
-                len,
-                hlog,
-            )?;
-            Ok((ended, ()))
-        },
-        |c, s, w, (), _| {
-            c.warnings.extend(w);
-            c.ours.push(s);
-            String::new()
-        },
-    )
-}
-
-/// The supervisor with 64 axes, homing in parallel again and again.
-fn ours_axes64(p: &Plan, i: usize, len: f64, c: &mut Collected) -> Result<Flow, String> {
-    let series = Series {
-        letter: 'a',
-        label: "64 axes",
-    };
-    our_slice_of(
-        p,
-        i,
-        len,
-        c,
-        series,
-        |prefix, hlog| {
-            let (toml, _) = Machine::Axes64.with(&sup(p.o, prefix))?;
-            homing64::run(
-                p.supervisor,
-                p.motionctl,
-                p.tmp,
-                &format!("axes64_{i}"),
-                &toml,
-                prefix,
-                len,
-                hlog,
-            )
-        },
-        |c, s, w, h: Homing64, _| {
-            let more = format!(
-                "; {} homing(s) of 64 axes: {} ok, {} failed, {} cut off by the slice's end",
-                h.started, h.ok, h.failed, h.cut_off
-            );
-            c.warnings
-                .extend(w.into_iter().map(|w| format!("64 axes: {w}")));
-            c.ours64.push(s);
-            c.homing64.merge(h);
-            more
-        },
-    )
-}
-
-/// The supervisor on the demo machine with the EtherCAT backend.
-fn ours_ethercat(
-    p: &Plan,
-    rig: &EcatRig,
-    i: usize,
-    len: f64,
-    c: &mut Collected,
-) -> Result<Flow, String> {
-    let series = Series {
-        letter: 'e',
-        label: "EtherCAT",
-    };
-    our_slice_of(
-        p,
-        i,
-        len,
-        c,
-        series,
-        |prefix, hlog| {
-            let (toml, _) = machine::demo_with(&sup(p.o, prefix))?;
-            let (toml, _) = ecat::on_ethercat(&toml, rig.interface())?;
-            let ended = supervisor::run(
-                p.supervisor,
-                p.tmp,
-                &format!("ecat{i}"),
-                &toml,
-                prefix,
-                len,
-                hlog,
-            )?;
-            Ok((ended, ()))
-        },
-        |c, s, w, (), ended| {
-            let bus = ecat::bus_run(&ended.stderr);
-            let more = format!(
-                "; bus round trip {}",
-                bus.map_or("not reported".to_string(), |b| format!(
+    if v == Variant::Ethercat {
+        let bus = ecat::bus_run(&ended.stderr);
+        line += &format!(
+            "; bus round trip {}",
+            match bus {
+                Some(b) => format!(
                     "p50 {} / p99 {} / max {} µs, {} lost frame(s)",
                     us(b.p50),
                     us(b.p99),
                     us(b.max),
                     b.lost
-                ))
-            );
-            c.warnings
-                .extend(w.into_iter().map(|w| format!("EtherCAT: {w}")));
-            c.ours_ecat.push(s);
-            match bus {
-                Some(b) => c.bus_runs.push(b),
-                None => {
-                    c.warnings
-                        .insert("EtherCAT: motion-io reported no bus summary in a slice".into());
-                }
+                ),
+                None => "not reported".into(),
             }
-            more
-        },
-    )
+        );
+        match bus {
+            Some(b) => c.bus_runs.push(b),
+            None => {
+                c.warnings
+                    .insert("EtherCAT: motion-io reported no bus summary in a slice".into());
+            }
+        }
+    }
+    eprintln!("{line}");
+    let shown = ["", "64 axes: ", "EtherCAT: "][v as usize];
+    c.warnings
+        .extend(warnings.into_iter().map(|w| format!("{shown}{w}")));
+    c.ours[v as usize].push(s);
+    let (found, remaining) = motion_bench::drive::clean_leftovers(&prefix);
+    if !found.is_empty() {
+        let all = if remaining.is_empty() {
+            ""
+        } else {
+            ", NOT all"
+        };
+        c.warnings.insert(format!(
+            "left in /dev/shm after a run (then cleaned by the bench{all}): {}",
+            found.join(", ")
+        ));
+    }
+    Ok(true)
 }
 
-/// cyclictest, as many periods as fit in the slice.
-fn cyclictest(
-    p: &Plan,
-    ct_bin: &Path,
-    i: usize,
-    len: f64,
-    c: &mut Collected,
-) -> Result<Flow, String> {
+/// cyclictest for as many periods as fit in the slice (`-l`, since `-D`
+/// takes whole seconds only), its histogram written to a file and read
+/// back; false: the slices end.
+fn cyclictest(p: &Plan, bin: &Path, i: usize, len: f64, c: &mut Collected) -> Result<bool, String> {
     if proc::stop_requested() {
         c.interrupted = true;
-        return Ok(Flow::Stop);
+        return Ok(false);
     }
-    let o = p.o;
-    let period_s = f64::from(o.period_us) * 1e-6;
+    let cy = &p.o.cycle;
+    let period_s = f64::from(cy.period_us) * 1e-6;
     let loops = ((len / period_s).round() as u64).max(1);
     let hist_path = p.tmp.join(format!("ct{i}.hist"));
-    let mut cmd = Command::new(ct_bin);
-    let (args, shown) = cyclictest_slice::command(o, loops, &hist_path);
-    c.ct_command = shown;
-    cmd.args(&args);
+    let args = format!(
+        "-m -p {} -t 1 -a {} -i {} -l {loops} -q -h {}",
+        cy.priority, cy.cpu, cy.period_us, p.o.hist_max_us
+    );
+    // the file's name left out: it is a temporary one
+    c.ct_command = format!("cyclictest {args} --histfile=FILE");
+    let mut cmd = Command::new(bin);
+    cmd.args(args.split(' '))
+        .arg(format!("--histfile={}", hist_path.display()));
     let start = p.t0.elapsed();
     let ended = Running::spawn(&mut cmd, "cyclictest", true, false)?
         .wait(Duration::from_secs_f64(len + 30.0), Duration::from_secs(3));
     if ended.interrupted {
         c.interrupted = true;
-        return Ok(Flow::Stop);
+        return Ok(false);
     }
-    match cyclictest_slice::ct_slice(&ended, &hist_path, start, loops as f64 * period_s) {
-        Ok(s) => {
+    match cyclictest::read_run(&ended, &hist_path) {
+        Ok(hist) => {
+            let hdr = hist.to_hdr();
             eprintln!(
                 "jitter: slice {}/{} cyclictest: {:>6} samples, wake-up p99 {:>7} µs, max {:>7} µs",
                 i + 1,
                 p.slices,
-                s.hist.samples(),
-                us(s.hdr.value_at_quantile(0.99) as f64 / 1000.0),
-                us(s.hist.max_us as f64)
+                hist.samples(),
+                us(hdr.value_at_quantile(0.99) as f64 / 1000.0),
+                us(hist.max_us as f64)
             );
-            c.ct.push(s);
+            let len = Duration::from_secs_f64(loops as f64 * period_s);
+            c.ct.push(CtSlice {
+                start,
+                len,
+                hist,
+                hdr,
+            });
+            Ok(true)
         }
         Err(e) => {
             c.failures.push(format!("slice {}: cyclictest: {e}", i + 1));
-            return Ok(Flow::Stop);
+            Ok(false)
         }
     }
-    Ok(Flow::Go)
 }

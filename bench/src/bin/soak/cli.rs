@@ -1,13 +1,9 @@
 //! The command line: how many homings, how (daemon or one `home` each),
-//! under which load, and what to record. The checks of `--cpu`,
-//! `--stress-share` and `--block` are made in `main`, before anything
-//! starts.
+//! under which load, and what to record; the shared groups come from
+//! `motion_bench::flags`.
 
 use clap::{Parser, ValueEnum};
-use std::path::PathBuf;
-
-/// `bench/out` of the source tree, wherever the bench is started from.
-const DEFAULT_OUT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/out");
+use motion_bench::flags::{Cycle, Files};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Via {
@@ -60,25 +56,13 @@ pub struct Opts {
     /// Run the 64-axis homings with stress-ng on the other CPU too.
     #[arg(long)]
     pub stress64: bool,
-    /// Cycle period, µs.
-    #[arg(long, default_value_t = 1000)]
-    pub period_us: u32,
-    /// CPU of the cycle (motion-io runs there too, the supervisor's
-    /// default); stress-ng goes on another one.
-    #[arg(long, default_value_t = 1)]
-    pub cpu: usize,
-    /// SCHED_FIFO priority of the cycle.
-    #[arg(long, default_value_t = 80)]
-    pub priority: i32,
+    #[command(flatten)]
+    pub cycle: Cycle,
     /// Seconds one homing may take before it counts as failed.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = motion_config::args::seconds)]
     pub timeout: f64,
-    /// Output directory (soak.json).
-    #[arg(long, default_value = DEFAULT_OUT)]
-    pub out: PathBuf,
-    /// motion-supervisor binary (motion-io and motionctl next to it).
-    #[arg(long)]
-    pub supervisor: Option<PathBuf>,
+    #[command(flatten)]
+    pub files: Files,
     /// With --via daemon: record every one-axis homing with `motionctl trace
     /// X --home` (every cycle: phase, commanded and actual motion, fresh
     /// feedback or not) instead of `motionctl home X`, the result read from
@@ -103,17 +87,11 @@ mod tests {
     use clap::CommandFactory;
 
     #[test]
-    fn the_command_is_well_formed() {
-        Opts::command().debug_assert();
-    }
-
-    #[test]
     fn defaults() {
-        let o = Opts::try_parse_from(["soak"]).unwrap();
+        Opts::command().debug_assert();
+        let o = Opts::try_parse_from(["soak", "--cpu", "0"]).unwrap();
         assert_eq!((o.homings, o.block, o.runs64), (500, 50, 20));
         assert_eq!((o.via, o.stress_share, o.timeout), (Via::Daemon, 0.5, 60.0));
-        assert_eq!((o.period_us, o.cpu, o.priority), (1000, 1, 80));
-        assert!(!o.stress64 && !o.trace && !o.spy);
-        assert_eq!(o.print_config, None);
+        assert!(!o.stress64 && !o.trace && !o.spy && o.print_config.is_none());
     }
 }

@@ -2,32 +2,36 @@
 //! `motion-supervisor run`, then `--block` homings of X through motionctl
 //! (or `motionctl trace` with `--trace`), each after the first preceded by
 //! a status check that X is still homed (counted as "lost between"). With
-//! `--spy` a spy records the block's frames; a block with a failure keeps
-//! them, and the daemon's output, as evidence.
+//! `--spy` a spy records the block's frames. A failed homing keeps, in
+//! OUT/soak-evidence/, what tells why: its row, timing, `motionctl status`
+//! and `stats` right after, its trace; the block's frames and the daemon's
+//! output.
 
 use crate::cli::Opts;
-use crate::ctx::{sup, Ctx};
-use crate::evidence::{keep_evidence, traced_home};
-use crate::figures::Part;
-use motion_bench::drive;
-use motion_bench::machine;
-use motion_bench::proc;
+use crate::report::Part;
+use crate::Ctx;
+use motion_bench::drive::{self, HomeRun};
 use motion_bench::spy::Spy;
+use motion_bench::{host, machine, proc};
+use motion_report::{AxisResult, AxisStatus};
+use serde_json::{json, Value};
+use std::path::Path;
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// `n` homings of X through one daemon. Ok(true): interrupted.
 pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, String> {
     let prefix = ctx.prefix("d");
-    let (text, _) = machine::one_switch_axis_with(&sup(o, &prefix), ctx.tmp.to_str())?;
-    let cfg = ctx.tmp.join(format!("{prefix}.toml"));
-    std::fs::write(&cfg, text).map_err(|e| format!("{}: {e}", cfg.display()))?;
+    let (text, _) = machine::one_switch_axis_with(&o.cycle.supervisor(&prefix), ctx.tmp.to_str())?;
+    let cfg = ctx.config(&prefix, &text)?;
     let mut daemon = drive::spawn_run(&ctx.b, &cfg, &prefix, None, None)?;
-    if let Err(e) = drive::wait_until_ready(
+    let ready = drive::wait_until_ready(
         &ctx.b.motionctl,
         &prefix,
         &mut daemon,
         Duration::from_secs(20),
-    ) {
+    );
+    if let Err(e) = ready {
         let ended = drive::stop_run(daemon, Duration::from_secs(20));
         if ended.interrupted || proc::stop_requested() {
             return Ok(true);
@@ -38,60 +42,37 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
             drive::tail(&ended.stderr, 5)
         ));
     }
-    let mut spy = if o.spy {
-        match Spy::start(&prefix, "io", ctx.other_cpu, 70, 400_000, |_| {}) {
-            Ok(s) => Some(s),
-            Err(e) => {
-                part.tally.note(format!("{prefix}: {e}"));
-                None
-            }
+    let mut spy = match o
+        .spy
+        .then(|| Spy::start(&prefix, "io", ctx.other_cpu, 70, 400_000, |_| {}))
+    {
+        Some(Err(e)) => {
+            part.tally.note(format!("{prefix}: {e}"));
+            None
         }
-    } else {
-        None
+        s => s.and_then(Result::ok),
     };
-    let mut interrupted = false;
-    let mut failed_in_block = false;
-    let t_block = Instant::now();
-    for i in 0..n {
+    let (mut interrupted, mut failed_in_block, t_block) = (false, false, Instant::now());
+    for i in 1..=n {
         if proc::stop_requested() {
             interrupted = true;
             break;
         }
-        if i > 0 {
-            // still homed since the last homing?
-            match drive::status(&ctx.b.motionctl, &prefix) {
-                Some(v) => {
-                    let a = v.axes.first().cloned().unwrap_or_default();
-                    if !a.homed && part.tally.details.len() < 1000 {
-                        part.tally.lost_between += 1;
-                        part.tally.note(format!(
-                            "{prefix} before homing {}: X not homed any more (err {}/{}, {})",
-                            i + 1,
-                            a.err,
-                            a.exerr,
-                            a.error.as_deref().unwrap_or("")
-                        ));
-                    }
-                }
-                None => part
-                    .tally
-                    .note(format!("{prefix} before homing {}: no status", i + 1)),
-            }
+        if i > 1 {
+            still_homed(ctx, &prefix, i, part);
         }
-        let csv = ctx.tmp.join(format!("{prefix}-{}.csv", i + 1));
-        let run = if o.trace {
-            traced_home(&ctx.b.motionctl, &prefix, &csv, o.timeout)?
-        } else {
-            drive::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?
+        let csv = ctx.tmp.join(format!("{prefix}-{i}.csv"));
+        let run = match o.trace {
+            true => traced_home(&ctx.b.motionctl, &prefix, &csv, o.timeout)?,
+            false => drive::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?,
         };
         if run.ended.interrupted {
             interrupted = true;
             break;
         }
-        let what = format!("{prefix} homing {}", i + 1);
-        if !part.tally.add(&what, &run) {
+        if !part.tally.add(&format!("{prefix} homing {i}"), &run) {
             failed_in_block = true;
-            keep_evidence(o, ctx, &prefix, i + 1, t_block, &run, &csv);
+            keep_evidence(o, ctx, &prefix, i, t_block, &run, &csv);
             if !daemon.running() {
                 part.tally.note(format!("{prefix}: the daemon ended"));
                 break;
@@ -103,7 +84,7 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
     drop(spy);
     let ended = drive::stop_run(daemon, Duration::from_secs(30));
     if failed_in_block {
-        let dir = o.out.join("soak-evidence");
+        let dir = o.files.out("").join("soak-evidence");
         if let Some(r) = &frames {
             let _ = std::fs::create_dir_all(&dir);
             if let Err(e) = r.write_csv(&dir.join(format!("{prefix}.frames.csv"))) {
@@ -114,16 +95,7 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
         let _ = std::fs::write(dir.join(format!("{prefix}.run.json")), &ended.stdout);
     }
     match drive::last_json(&ended.stdout) {
-        Some(v) => {
-            part.figures.add(&v);
-            for w in v["warnings"].as_array().into_iter().flatten() {
-                if let Some(w) = w.as_str() {
-                    if !part.figures.warnings.iter().any(|x| x == w) {
-                        part.figures.warnings.push(w.to_string());
-                    }
-                }
-            }
-        }
+        Some(v) => part.figures.add(&v, true),
         None => part.tally.note(format!(
             "{prefix}: the daemon printed no report ({}; {})",
             ended.describe(),
@@ -133,4 +105,106 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
     ctx.check_leftovers(&prefix);
     let _ = std::fs::remove_file(&cfg);
     Ok(interrupted)
+}
+
+/// Before homing `i`: is X still homed since the last one?
+fn still_homed(ctx: &Ctx, prefix: &str, i: u32, part: &mut Part) {
+    let Some(st) = drive::status(&ctx.b.motionctl, prefix) else {
+        return part
+            .tally
+            .note(format!("{prefix} before homing {i}: no status"));
+    };
+    let a = st.axes.first().cloned().unwrap_or_default();
+    if !a.homed && part.tally.details.len() < 1000 {
+        part.tally.lost_between += 1;
+        let error = a.error.as_deref().unwrap_or("");
+        part.tally.note(format!(
+            "{prefix} before homing {i}: X not homed any more (err {}/{}, {error})",
+            a.err, a.exerr
+        ));
+    }
+}
+
+/// One homing of X recorded by `motionctl trace X --home --out CSV`; its
+/// result row from `motionctl status` once the trace has ended.
+fn traced_home(
+    motionctl: &Path,
+    prefix: &str,
+    csv: &Path,
+    timeout: f64,
+) -> Result<HomeRun, String> {
+    let mut cmd = Command::new(motionctl);
+    cmd.args([
+        "--service-prefix",
+        prefix,
+        "trace",
+        "X",
+        "--home",
+        "--json",
+        "--out",
+    ])
+    .arg(csv);
+    cmd.args(["--timeout", &timeout.to_string()]);
+    let limit = Duration::from_secs_f64(timeout + 30.0);
+    let mut run = drive::home_run(&mut cmd, "motionctl trace", limit)?;
+    let status = drive::status(motionctl, prefix);
+    let row = |a: &AxisStatus| AxisResult {
+        name: a.name.clone(),
+        pc: a.pc,
+        er: a.er,
+        err: a.err,
+        exerr: a.exerr,
+        homed: a.homed,
+        error: a.error.clone(),
+        duration_s: Some(a.elapsed_s),
+        ..AxisResult::default()
+    };
+    run.rows = status
+        .iter()
+        .flat_map(|s| s.axes.first())
+        .map(row)
+        .collect();
+    if let Some(st) = status {
+        run.json = Some(json!({"trace": run.json.take(), "status": st}));
+    }
+    Ok(run)
+}
+
+/// Keeps what tells why homing `i` of `prefix` failed: its row, when it
+/// happened, `motionctl status` and `stats` right after, and its trace.
+fn keep_evidence(
+    o: &Opts,
+    ctx: &Ctx,
+    prefix: &str,
+    i: u32,
+    t_block: Instant,
+    run: &HomeRun,
+    csv: &Path,
+) {
+    let dir = o.files.out("").join("soak-evidence");
+    if std::fs::create_dir_all(&dir).is_err() {
+        return;
+    }
+    let stats = Command::new(&ctx.b.motionctl)
+        .args(["--service-prefix", prefix, "stats", "--json"])
+        .output()
+        .ok()
+        .and_then(|x| serde_json::from_slice::<Value>(&x.stdout).ok());
+    let v = json!({
+        "prefix": prefix,
+        "homing": i,
+        "seconds_into_block": t_block.elapsed().as_secs_f64(),
+        "seconds_this_homing": run.seconds,
+        "rows": run.rows,
+        "output": run.json,
+        "ended": run.ended.describe(),
+        "stderr_tail": drive::tail(&run.ended.stderr, 20),
+        "status_after": drive::status(&ctx.b.motionctl, prefix),
+        "stats_after": stats,
+        "loadavg": host::loadavg(),
+    });
+    let _ = motion_bench::outcome::write_json(&dir.join(format!("{prefix}-h{i}.json")), &v);
+    if csv.exists() {
+        let _ = std::fs::copy(csv, dir.join(format!("{prefix}-h{i}.csv")));
+    }
 }
