@@ -15,13 +15,26 @@ pub(crate) fn euid() -> u32 {
     nix::unistd::geteuid().as_raw()
 }
 
-/// The default runtime directory: `/run/motion` for root (systemd's
-/// `RuntimeDirectory=motion`), else `/tmp/motion-<uid>`.
+/// The system runtime directory: the package's tmpfiles entry creates it at
+/// boot, owned by the daemon's user `motion`.
+const SYSTEM_RUNTIME_DIR: &str = "/run/motion";
+
+/// The default runtime directory: `/run/motion` for root, and for the user
+/// that owns it (the packaged daemon's user `motion`: so that
+/// `sudo -u motion motionctl status` finds the daemon the units started
+/// without a `--runtime-dir`); else `/tmp/motion-<uid>`.
 pub fn default_runtime_dir() -> PathBuf {
     match euid() {
-        0 => PathBuf::from("/run/motion"),
+        0 => PathBuf::from(SYSTEM_RUNTIME_DIR),
+        uid if owned_by(Path::new(SYSTEM_RUNTIME_DIR), uid) => PathBuf::from(SYSTEM_RUNTIME_DIR),
         uid => PathBuf::from(format!("/tmp/motion-{uid}")),
     }
+}
+
+/// `dir` is a real directory (not a symlink) owned by `uid`. Whether it is
+/// private enough is [`check_private_dir`]'s judgement, made before use.
+fn owned_by(dir: &Path, uid: u32) -> bool {
+    std::fs::symlink_metadata(dir).is_ok_and(|m| m.is_dir() && m.uid() == uid)
 }
 
 /// `dir`, or the default.

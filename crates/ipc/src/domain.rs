@@ -14,8 +14,9 @@
 //!   and a 128-bit session key. iceoryx2's file prefix is
 //!   `{service_prefix}.{id}.` — `.` never occurs in a service prefix, so two
 //!   prefixes never share files, and nobody can create our files before we do.
-//! * **A private runtime directory** (`/run/motion` for root, else
-//!   `/tmp/motion-<uid>`; `[supervisor] runtime_dir`) is iceoryx2's root
+//! * **A private runtime directory** (`/run/motion` for root and for the
+//!   user that owns it, else `/tmp/motion-<uid>`; `[supervisor]
+//!   runtime_dir`) is iceoryx2's root
 //!   (service and node files, event sockets). It must be a real directory
 //!   owned by us and writable by nobody else, or we refuse to start: a
 //!   directory another user created first is never used.
