@@ -4,6 +4,22 @@
 //! cycle. A summary table against the goals is printed at the end.
 //!
 //! `cargo bench -p motion-bench --bench engine` (≈ 20 s of measuring).
+//!
+//! Instructions, not time (noise-free, for a shared or virtual machine
+//! where `perf` has no counters): `-- --instructions N ID` runs the routine
+//! of benchmark `ID` exactly N times in one function, without criterion, so
+//! callgrind counts it alone:
+//!
+//! ```sh
+//! valgrind --tool=callgrind --callgrind-out-file=engine.cg \
+//!     --toggle-collect='engine::instructions::counted' \
+//!     target/release/deps/engine-<hash> --instructions 10000 cycle/64
+//! ```
+//!
+//! The total it prints (`Collected`) divided by N (and by the axis count for
+//! a cycle) is the cost of one step; `callgrind_annotate engine.cg` shows
+//! where it goes. IDs: `engine_step/seek`, `engine_step/torque_detect`,
+//! `cycle/1`, `cycle/8`, `cycle/32`, `cycle/64`.
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use motion_config::{MachineConfig, DEMO_TOML};
@@ -330,10 +346,67 @@ fn summary(dir: &Path, since: SystemTime) {
     );
 }
 
+/// `--instructions N ID`: the routine of benchmark `ID` run `N` times in
+/// [`instructions::counted`], without criterion (see the top of this file).
+mod instructions {
+    use super::*;
+
+    /// What callgrind counts (`--toggle-collect`): the states are prepared
+    /// outside it.
+    #[inline(never)]
+    pub fn counted(n: u64, routine: &mut dyn FnMut()) {
+        for _ in 0..n {
+            routine();
+        }
+    }
+
+    pub fn run(n: u64, id: &str) {
+        let step = |state: Captured, phase| {
+            check(id, &state, phase);
+            let mut axes: Vec<Axis> = (0..n).map(|_| state.axis.clone()).collect();
+            let mut next = axes.iter_mut();
+            counted(n, &mut || {
+                if let Some(a) = next.next() {
+                    black_box(a.step(
+                        black_box(state.now),
+                        Some(black_box(&state.feedback)),
+                        black_box(&state.request),
+                    ));
+                }
+            });
+        };
+        match id {
+            "engine_step/seek" => step(seek_state(), Phase::Seek),
+            "engine_step/torque_detect" => step(torque_state(), Phase::Seek),
+            _ => {
+                let k = id
+                    .strip_prefix("cycle/")
+                    .and_then(|k| k.parse().ok())
+                    .filter(|k| AXES.contains(k))
+                    .expect("ID: engine_step/seek, engine_step/torque_detect or cycle/{1,8,32,64}");
+                let (mut core, fb, mut cmd, now) = homing_core(&machine(k));
+                counted(n, &mut || {
+                    core.step(black_box(now), false, &[Some(black_box(&fb))]);
+                    core.fill(0, black_box(&mut cmd));
+                });
+            }
+        }
+        eprintln!("{id}: ran {n} times in engine::instructions::counted");
+    }
+}
+
 fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(p) = args.iter().position(|a| a == "--instructions") {
+        let n = args
+            .get(p + 1)
+            .and_then(|v| v.parse().ok())
+            .expect("--instructions N ID: a number of runs");
+        instructions::run(n, args.get(p + 2).map_or("", String::as_str));
+        return;
+    }
     let since = SystemTime::now() - Duration::from_secs(1);
     let dir = criterion_dir();
-    let args: Vec<String> = std::env::args().collect();
     let mut c = Criterion::default()
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_millis(1500))
