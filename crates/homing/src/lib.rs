@@ -17,6 +17,7 @@
 //!   coordination hooks a machine coordinator uses for gantries and home
 //!   order: barrier, timed final move, stop code).
 //! * [`status`]: the instruction's and the axis's status after a cycle.
+//! * [`time`]: ns ↔ s conversions, exact and cheap.
 
 pub mod axis;
 pub mod codes;
@@ -26,6 +27,7 @@ pub mod plan;
 pub mod position;
 pub mod profile;
 pub mod status;
+pub mod time;
 pub mod validate;
 
 pub use axis::loss::FeedbackLoss;
