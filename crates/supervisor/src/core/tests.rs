@@ -3,7 +3,7 @@
 //! place (and made to fall silent or restart at will).
 
 use super::*;
-use motion_control::REASON_IO_NOT_ATTACHED;
+use crate::shared::{AxisAck, Control, Refusal};
 
 use super::testbench::{Bench, MS};
 
@@ -15,7 +15,7 @@ fn demo_homes_through_frames_in_config_order() {
     let all = b.core.all_mask();
     assert_eq!(all, 0b1111);
     let ack = b.home(all, false);
-    assert!(ack.axes[..4].iter().all(|a| a.accepted), "{ack:?}");
+    assert!(ack.axes[..4].iter().all(|a| a.accepted()), "{ack:?}");
     let mut first_start = [None; 4];
     for _ in 0..20_000 {
         b.cycle();
@@ -93,7 +93,7 @@ fn losing_one_io_process_aborts_only_its_axes() {
     b.run(5);
     assert!(b.core.all_attached());
     let ack = b.home(0b11, true);
-    assert!(ack.axes[0].accepted && ack.axes[1].accepted);
+    assert!(ack.axes[0].accepted() && ack.axes[1].accepted());
     b.run(300); // both seeking
     b.alive[1] = false;
     b.run(3000);
@@ -109,7 +109,7 @@ fn losing_one_io_process_aborts_only_its_axes() {
     assert!(!s.ios[1].attached && s.ios[0].attached);
     // A home request on B is refused while bus1 is gone.
     let ack = b.home(0b10, false);
-    assert_eq!(ack.axes[1].reason, REASON_IO_NOT_ATTACHED);
+    assert_eq!(ack.axes[1], AxisAck::Refused(Refusal::IoNotAttached));
     // bus1 comes back as a new process: attached again, counted.
     b.origin[1] = 99;
     b.alive[1] = true;
@@ -154,7 +154,7 @@ fn stop_and_unhome() {
     b.run(4000);
     assert!(b.snap().axes[1].status.homed);
     b.control(Control::Unhome { id: 2, mask: 0b10 });
-    assert!(b.acks.pop().unwrap().axes[1].accepted);
+    assert!(b.acks.pop().unwrap().axes[1].accepted());
     b.run(1);
     assert!(!b.snap().axes[1].status.homed);
 }
@@ -166,9 +166,9 @@ fn a_second_home_request_on_a_homing_axis_is_refused() {
     b.home(0b01, false);
     b.run(3);
     let ack = b.home(0b11, false);
-    assert_eq!(ack.axes[0].reason, REASON_ALREADY_HOMING);
+    assert_eq!(ack.axes[0], AxisAck::Refused(Refusal::AlreadyHoming));
     assert!(
-        !ack.axes[1].accepted,
+        !ack.axes[1].accepted(),
         "nothing starts when one named axis is refused"
     );
 }
@@ -258,7 +258,7 @@ fn a_racked_gantry_is_squared_by_its_own_switches_and_markers() {
     let mut b = Bench::new(&gantry_toml(0.3, 1.0, false));
     b.run(5);
     let ack = b.home(b.core.all_mask(), false);
-    assert!(ack.axes[..3].iter().all(|a| a.accepted));
+    assert!(ack.axes[..3].iter().all(|a| a.accepted()));
     let mut started = [None; 3];
     for _ in 0..20_000 {
         b.cycle();
