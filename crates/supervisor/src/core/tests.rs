@@ -50,19 +50,14 @@ fn demo_homes_through_frames_in_config_order() {
     assert!(b.core.exit_done());
 }
 
-const TWO_IO: &str = r#"
-[supervisor]
-cycle_us = 1000
-cpu = 0
-
-[[io]]
-name = "bus0"
-[[io]]
-name = "bus1"
-
+/// A switch-homing axis (`extra`: its I/O process or home order): seek at
+/// 20 from -10 onto the switch [0, 5], return at 2 until it clears.
+fn switch_axis(name: &str, extra: &str) -> String {
+    format!(
+        r#"
 [[axis]]
-name = "A"
-io = "bus0"
+name = "{name}"
+{extra}
 home_sequence = "switch"
 home_speed = 20.0
 home_return_speed = 2.0
@@ -71,25 +66,24 @@ home_deceleration = 500.0
 [axis.sim]
 start = -10.0
 switch = [0.0, 5.0]
+"#
+    )
+}
 
-[[axis]]
-name = "B"
-io = "bus1"
-home_sequence = "switch"
-home_speed = 20.0
-home_return_speed = 2.0
-home_acceleration = 500.0
-home_deceleration = 500.0
-[axis.sim]
-start = -10.0
-switch = [0.0, 5.0]
-"#;
+/// Two I/O processes, one switch axis each: A on bus0, B on bus1.
+fn two_io() -> String {
+    format!(
+        "[supervisor]\ncycle_us = 1000\ncpu = 0\n\n[[io]]\nname = \"bus0\"\n[[io]]\nname = \"bus1\"\n{}{}",
+        switch_axis("A", "io = \"bus0\""),
+        switch_axis("B", "io = \"bus1\"")
+    )
+}
 
 /// Issue 7: losing one I/O process aborts homing only on its axes (12/40);
 /// the other axes carry on. Its return clears HomedStatus and is counted.
 #[test]
 fn losing_one_io_process_aborts_only_its_axes() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     assert!(b.core.all_attached());
     let ack = b.home(0b11, true);
@@ -125,7 +119,7 @@ fn losing_one_io_process_aborts_only_its_axes() {
 /// clears HomedStatus of its axes.
 #[test]
 fn a_restarted_io_process_unhomes_its_axes() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.home(0b11, true);
     b.run(4000);
@@ -142,7 +136,7 @@ fn a_restarted_io_process_unhomes_its_axes() {
 
 #[test]
 fn stop_and_unhome() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.home(0b01, false);
     b.run(100);
@@ -161,7 +155,7 @@ fn stop_and_unhome() {
 
 #[test]
 fn a_second_home_request_on_a_homing_axis_is_refused() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.home(0b01, false);
     b.run(3);
@@ -175,7 +169,7 @@ fn a_second_home_request_on_a_homing_axis_is_refused() {
 
 #[test]
 fn trace_records_one_homing() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.control(Control::Trace { id: 3, axis: 1 });
     b.home(0b10, false);
@@ -237,19 +231,7 @@ hard_stop = [-110.0, 110.0]
         "[supervisor]\ncycle_us = 1000\ncpu = 0\n{}{}{}\n[[gantry]]\nname = \"Y\"\naxes = [\"Y1\", \"Y2\"]\nmax_skew = {max_skew}\n",
         side("Y1", 1.0, 0.0),
         side("Y2", 1.5, rack),
-        r#"
-[[axis]]
-name = "X"
-home_order = 1
-home_sequence = "switch"
-home_speed = 20.0
-home_return_speed = 2.0
-home_acceleration = 500.0
-home_deceleration = 500.0
-[axis.sim]
-start = -10.0
-switch = [0.0, 5.0]
-"#
+        switch_axis("X", "home_order = 1")
     )
 }
 
