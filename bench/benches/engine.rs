@@ -1,7 +1,14 @@
 //! Engine benchmarks (criterion): one `Axis::step` in the middle of a homing
 //! leg, and one whole cycle's compute (`Core::step` + `Core::fill`) for 1, 8,
-//! 32 and 64 axes. Goals: ≤ 100 ns per axis step, ≤ 10 µs for a 64-axis
+//! 32 and 64 axes. Goals: ≤ 50 ns per axis step, ≤ 10 µs for a 64-axis
 //! cycle. A summary table against the goals is printed at the end.
+//!
+//! A step is measured on fresh copies of the captured axis, a cycle's
+//! worth (64) per timed batch, so the axis's state is in the cache as in
+//! the cycle; `engine_step/seek_cold` streams its copies from memory
+//! instead (criterion's growing `SmallInput` batches), which is what the
+//! step measurements before issue 14 did: that figure is bounded by the
+//! size of `Axis` over the memory bandwidth (≈ 1.2 KB per step).
 //!
 //! `cargo bench -p motion-bench --bench engine` (≈ 20 s of measuring).
 //!
@@ -134,6 +141,11 @@ fn check(name: &str, c: &Captured, phase: Phase) {
     );
 }
 
+/// Axes a cycle steps at most: the fresh copies of one timed batch of
+/// `engine_step/*`, so that they sit in the cache as a cycle's axes do
+/// (64 × `size_of::<Axis>()` ≈ 78 KB: in L2, between cycles too).
+const CYCLE_AXES: u64 = 64;
+
 fn engine_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("engine_step");
     for (name, state, phase) in [
@@ -143,19 +155,32 @@ fn engine_step(c: &mut Criterion) {
         check(&format!("engine_step/{name}"), &state, phase);
         // Each iteration steps a fresh copy of the captured axis (the copy
         // is made outside the timed loop), with the feedback the plant gave.
+        // The copies of a batch are as many as a cycle's axes: the step as
+        // the cycle runs it, with the axis's state in the cache.
+        let step = |axis: &mut Axis| {
+            axis.step(
+                black_box(state.now),
+                Some(black_box(&state.feedback)),
+                black_box(&state.request),
+            )
+        };
         g.bench_function(name, |b| {
             b.iter_batched_ref(
                 || state.axis.clone(),
-                |axis| {
-                    axis.step(
-                        black_box(state.now),
-                        Some(black_box(&state.feedback)),
-                        black_box(&state.request),
-                    )
-                },
-                BatchSize::SmallInput,
+                step,
+                BatchSize::NumIterations(CYCLE_AXES),
             )
         });
+        if name == "seek" {
+            // The same with criterion's `SmallInput` batches, which grow
+            // with the iteration count (to tens of MB of copies): each step
+            // then streams its copy from memory, and the figure is about
+            // `size_of::<Axis>()` / memory bandwidth, not the step. Shown,
+            // without a goal, because earlier measurements were made so.
+            g.bench_function("seek_cold", |b| {
+                b.iter_batched_ref(|| state.axis.clone(), step, BatchSize::SmallInput)
+            });
+        }
     }
     g.finish();
 }
@@ -312,8 +337,9 @@ fn summary(dir: &Path, since: SystemTime) {
         "benchmark", "time", "median", "per axis", "goal"
     );
     let mut rows: Vec<(String, usize, Option<f64>)> = vec![
-        ("engine_step/seek".into(), 1, Some(100.0)),
-        ("engine_step/torque_detect".into(), 1, Some(100.0)),
+        ("engine_step/seek".into(), 1, Some(50.0)),
+        ("engine_step/torque_detect".into(), 1, Some(50.0)),
+        ("engine_step/seek_cold".into(), 1, None),
     ];
     for n in AXES {
         rows.push((format!("cycle/{n}"), n, (n == 64).then_some(10_000.0)));
@@ -325,7 +351,7 @@ fn summary(dir: &Path, since: SystemTime) {
         };
         let (goal_txt, verdict) = match goal {
             Some(g) if n == 1 && id.starts_with("engine") => (
-                "≤ 100 ns per axis".to_string(),
+                "≤ 50 ns per axis".to_string(),
                 if t <= g { "ok" } else { "MISSED" },
             ),
             Some(g) => (
@@ -341,6 +367,10 @@ fn summary(dir: &Path, since: SystemTime) {
             fmt_ns(t / n as f64)
         );
     }
+    println!(
+        "engine_step/* = one Axis::step on a copy in the cache (64 copies per batch, as a cycle's axes); \
+         seek_cold: copies streamed from memory"
+    );
     println!(
         "cycle/N = Core::step + Core::fill for N homing axes (engine steps + counts↔units for every axis)"
     );
