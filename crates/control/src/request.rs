@@ -187,20 +187,6 @@ impl Request {
         };
         m.set_axes(names).then_some(m)
     }
-
-    /// The word logs use for it.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Request::Home { .. } => "home",
-            Request::Stop { .. } => "stop",
-            Request::Unhome { .. } => "unhome",
-            Request::Status => "status",
-            Request::Stats { .. } => "stats",
-            Request::Trace { .. } => "trace",
-            Request::TraceFetch { .. } => "trace fetch",
-            Request::Hlog { .. } => "hlog",
-        }
-    }
 }
 
 #[cfg(test)]

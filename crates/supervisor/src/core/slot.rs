@@ -16,7 +16,8 @@ use crate::shared::{AxisSnap, LostCause};
 /// The Home instruction's rung for one axis.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Rung {
-    /// What the engine is given each cycle (home, stop, the coordination).
+    /// What the engine is given each cycle (home, stop, the coordination,
+    /// and whether the cycle woke late).
     pub request: Request,
     /// Cycles until the rung goes high: 2 = drop it first (it is still
     /// high from an earlier homing), 1 = raise it now. A request is always
@@ -215,11 +216,8 @@ impl AxisSlot {
     pub(super) fn step(&mut self, now_ns: u64, stalled: bool, shutdown: bool) -> bool {
         let started = self.rung.edge(self.engine.status());
         self.rung.request.shutdown = shutdown;
-        let req = Request {
-            stalled,
-            ..self.rung.request
-        };
-        self.command = self.engine.step(now_ns, self.feedback.as_ref(), &req);
+        self.rung.request.stalled = stalled;
+        self.command = (self.engine).step(now_ns, self.feedback.as_ref(), &self.rung.request);
         // The status shows only what the engine took: a refused sample
         // (not finite, out of range, implausible) is not a reading.
         if self.feedback.is_some() && self.engine.sampled_ns() == Some(now_ns) {
