@@ -7,9 +7,9 @@
 //! preallocated vectors and bit masks.
 //!
 //! One step, in stages ([`Core::step`]): the links take the frames
-//! ([`Core::intake`]), the home sequences start and stop axes
-//! ([`Core::sequences`]), the gantries coordinate their sides
-//! ([`Core::gantries`]), every engine steps ([`Core::engines`]); then the
+//! (`Core::intake`), the home sequences start and stop axes
+//! (`Core::sequences`), the gantries coordinate their sides
+//! (`Core::gantries`), every engine steps (`Core::engines`); then the
 //! thread publishes ([`Core::fill`]). Requests come in between steps
 //! ([`Core::control`], in `control.rs`).
 //!

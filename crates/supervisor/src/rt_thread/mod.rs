@@ -1,16 +1,21 @@
 //! The real-time thread: pinned, SCHED_FIFO, its own allocation pool, one
 //! absolute deadline per cycle.
 //!
-//! One cycle:
+//! One cycle (`run` reads as this list):
 //! 1. sleep to the absolute deadline (`clock_nanosleep`, TIMER_ABSTIME);
-//! 2. take control requests (lock-free queue), answer them (lock-free queue);
+//! 2. take control requests (lock-free queue), answer them (lock-free
+//!    queue): `control_queue`;
 //! 3. take the newest feedback frame of every I/O process — the answer to
-//!    the previous cycle's command, which arrived while we slept;
-//! 4. step every axis's homing engine and the home sequences;
-//! 5. publish one command frame per I/O process and notify each;
+//!    the previous cycle's command, which arrived while we slept:
+//!    `IoPorts::receive`;
+//! 4. step every axis's homing engine and the home sequences: `Core::step`
+//!    (`IoPorts::step`);
+//! 5. publish one command frame per I/O process and notify each:
+//!    `IoPorts::publish`;
 //! 6. record wake-up latency and compute time (and the I/O round trip, from
 //!    the answer's own timestamp: command published → answer published);
-//!    now and then hand a histogram set and a status snapshot over.
+//!    now and then hand a histogram set and a status snapshot over
+//!    (`record.rs`: `Recorder`).
 //!
 //! Nothing waits for an answer: a cycle does its bounded work and goes back
 //! to sleep, so a slow I/O process can never push the next wake-up late (it
