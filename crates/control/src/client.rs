@@ -17,6 +17,7 @@ use motion_ipc::names::{control_service, status_service};
 use motion_ipc::{Domain, IpcError};
 
 use crate::message::*;
+use crate::request::Request;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ClientError {
@@ -168,6 +169,16 @@ impl Client {
         }
     }
 
+    /// Sends a typed request and waits up to `timeout` for the answer.
+    pub fn send(
+        &mut self,
+        req: &Request,
+        timeout: Duration,
+    ) -> Result<Box<ControlResponse>, ClientError> {
+        let m = req.encode().ok_or_else(too_many_names)?;
+        self.call(&m, timeout)
+    }
+
     /// A request of `kind` for `axes` (empty: every axis).
     pub fn simple(
         &mut self,
@@ -180,10 +191,7 @@ impl Client {
         req.kind = kind;
         req.flags = flags;
         if !req.set_axes(axes) {
-            return Err(ClientError::Service {
-                service: "control".into(),
-                detail: format!("at most {MAX_AXES} axis names of at most {NAME_LEN} bytes"),
-            });
+            return Err(too_many_names());
         }
         self.call(&req, timeout)
     }
@@ -249,6 +257,14 @@ impl Client {
             }
             std::thread::sleep(Duration::from_millis(2));
         }
+    }
+}
+
+/// A request naming more axes, or longer names, than a message carries.
+pub(crate) fn too_many_names() -> ClientError {
+    ClientError::Service {
+        service: "control".into(),
+        detail: format!("at most {MAX_AXES} axis names of at most {NAME_LEN} bytes"),
     }
 }
 

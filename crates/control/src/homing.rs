@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use crate::client::{Client, ClientError};
 use crate::message::*;
+use crate::request::{Axes, Request};
 use motion_report::AxisResult;
 
 /// What `home` asks for.
@@ -37,17 +38,13 @@ pub fn home_and_follow(
     mut progress: impl FnMut(&StatusFrame, &[usize]),
     interrupted: impl Fn() -> bool,
 ) -> Result<HomeOutcome, ClientError> {
-    let mut r = ControlRequest::zeroed();
-    r.kind = REQ_HOME;
-    r.flags = if req.parallel { FLAG_PARALLEL } else { 0 };
-    r.timeout_s = req.timeout_s;
-    if !r.set_axes(&req.axes) {
-        return Err(ClientError::Service {
-            service: "control".into(),
-            detail: format!("at most {MAX_AXES} axis names of at most {NAME_LEN} bytes"),
-        });
-    }
-    let resp = client.call(&r, Duration::from_secs(3))?;
+    let home = Request::Home {
+        axes: Axes::from_names(&req.axes),
+        parallel: req.parallel,
+        // As given; the supervisor takes only a finite, positive one.
+        timeout_s: (req.timeout_s > 0.0).then_some(req.timeout_s),
+    };
+    let resp = client.send(&home, Duration::from_secs(3))?;
     if resp.result != RESULT_ACCEPTED {
         return Ok(HomeOutcome::Refused(resp));
     }
@@ -91,10 +88,10 @@ pub fn home_and_follow(
         }
         if !stopped && interrupted() {
             stopped = true;
-            let mut s = ControlRequest::zeroed();
-            s.kind = REQ_STOP;
-            s.set_axes(&wanted);
-            client.call(&s, Duration::from_secs(3))?;
+            let stop = Request::Stop {
+                axes: Axes::from_names(&wanted),
+            };
+            client.send(&stop, Duration::from_secs(3))?;
         }
         if Instant::now() > until {
             return Err(ClientError::Timeout {

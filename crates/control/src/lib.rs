@@ -5,6 +5,11 @@
 //!   type names (as the frames have). Plain fixed-size data, so any iceoryx2
 //!   client can speak them — `examples/python/` does, with nothing but the
 //!   `iceoryx2` package.
+//! * [`request`] — a request as an enum ([`Request`]): decoded from the
+//!   wire once, at the daemon's edge, and encoded from it by Rust clients;
+//!   an unknown kind is an error, never another request.
+//! * [`response`] — a response built from typed outcomes ([`AxisOutcome`],
+//!   [`Reason`]); the `REASON_*`/`RESULT_*` numbers are written there.
 //! * [`client`] — what `motionctl` (and any Rust HMI) uses: join the
 //!   supervisor's domain through its session file, send requests, read status.
 //! * [`server`] — the daemon's side: serve requests and publish status, off
@@ -20,8 +25,12 @@ pub mod homing;
 pub mod message;
 pub mod progress;
 pub mod report;
+pub mod request;
+pub mod response;
 pub mod server;
 
 pub use client::{Client, ClientError};
 pub use message::*;
+pub use request::{Axes, DecodeError, Request, Since};
+pub use response::{AxisOutcome, Reason};
 pub use server::{Server, ServerError};

@@ -18,6 +18,7 @@
 //!   order: barrier, timed final move, stop code).
 //! * [`status`]: the instruction's and the axis's status after a cycle.
 //! * [`names`]: every enum's spellings, written once next to the enum.
+//! * [`time`]: ns ↔ s conversions, exact and cheap.
 
 pub mod axis;
 pub mod codes;
@@ -28,6 +29,7 @@ pub mod plan;
 pub mod position;
 pub mod profile;
 pub mod status;
+pub mod time;
 pub mod validate;
 
 pub use axis::loss::FeedbackLoss;

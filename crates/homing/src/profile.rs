@@ -244,7 +244,7 @@ impl Profile {
     }
 
     fn t(&self, now_ns: u64) -> f64 {
-        now_ns.saturating_sub(self.start_ns) as f64 * 1e-9
+        crate::time::ns_to_s(now_ns.saturating_sub(self.start_ns))
     }
 
     /// Commanded position and velocity at `now_ns`.

@@ -2,9 +2,10 @@
 //! the daemon around the cycle.
 //!
 //! * [`rt_thread`] — the pinned SCHED_FIFO thread and its cycle.
-//! * [`core`] — one cycle's work without I/O (control, I/O links, engines,
-//!   home sequences, frames).
-//! * [`shared`] — the lock-free hand-off between real-time and normal threads.
+//! * [`core`] — one cycle's work without I/O (one slot per axis, control
+//!   requests, I/O links, engines, home sequences, frames).
+//! * [`shared`] — the lock-free hand-off between real-time and normal
+//!   threads, in the domain's types (refusals, why HomedStatus was lost).
 //! * [`control_thread`] — the control and status services, off the cycle.
 //! * [`keeper`] — what outlives a run: stored references of absolute axes,
 //!   the homing record with its drift checks (files in `state_dir`).

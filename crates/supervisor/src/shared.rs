@@ -46,16 +46,42 @@ pub enum Control {
     Exit,
 }
 
+/// Why the cycle refused a request for one axis: the domain's words. The
+/// control thread turns them into the control service's reasons (the wire
+/// has numbers for them; the cycle never sees those).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Refusal {
+    /// Homing is in process on the axis (or its rising edge is pending).
+    AlreadyHoming,
+    /// Its I/O process is not attached.
+    IoNotAttached,
+    /// The Home instruction refuses, with its ERR / EXERR (an illegal
+    /// homing configuration: ERR 41).
+    Instruction { err: u16, exerr: u16 },
+    /// The supervisor is shutting down.
+    Exiting,
+    /// A home sequence runs on the axis (or no sequence can start now).
+    Busy,
+    /// Nothing was started: another axis of the request was refused.
+    NotStarted,
+    /// The stored reference was not applied (`Restore`).
+    Restore(motion_homing::RestoreRefusal),
+}
+
 /// The answer for one axis.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct AxisAck {
-    pub accepted: bool,
-    /// `motion_control::REASON_*`.
-    pub reason: u8,
-    pub err: u16,
-    pub exerr: u16,
-    /// Why a `Restore` was refused.
-    pub restore: Option<motion_homing::RestoreRefusal>,
+pub enum AxisAck {
+    /// The request did not name the axis.
+    #[default]
+    NotNamed,
+    Accepted,
+    Refused(Refusal),
+}
+
+impl AxisAck {
+    pub fn accepted(&self) -> bool {
+        *self == AxisAck::Accepted
+    }
 }
 
 /// The real-time thread's answer to a request with an id.
@@ -108,6 +134,19 @@ pub struct TraceRecord {
     pub exerr: u16,
 }
 
+/// Why HomedStatus was lost after a homing had set it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LostCause {
+    /// Another reason (invalid or implausible feedback, a shutdown), or
+    /// none known.
+    #[default]
+    Other,
+    /// The feedback-loss rule tripped (or the I/O process detached).
+    Feedback,
+    /// The I/O process reconnected (restarted or attached again).
+    Reconnect,
+}
+
 /// One axis as the reporting side sees it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AxisSnap {
@@ -142,9 +181,9 @@ pub struct AxisSnap {
     /// A trace of this axis's next homing is armed or recording.
     pub traced: bool,
     /// HomedStatus was lost after the last homing succeeded: when (ns), and
-    /// why (`motion_control::SX_LOST_*`, 0 = not known).
+    /// why.
     pub lost_homed_ns: Option<u64>,
-    pub lost_cause: u8,
+    pub lost_cause: LostCause,
     /// The raw → axis offset while homed.
     pub offset: Option<f64>,
     /// HomedStatus comes from a stored reference (absolute axis, restored

@@ -2,7 +2,7 @@
 //! publishes, and what `status --json` reports).
 
 use crate::keeper::AxisNote;
-use crate::shared::Snapshot;
+use crate::shared::{LostCause, Snapshot};
 use motion_config::MachineConfig;
 use motion_control::*;
 use motion_homing::effective_search_limit;
@@ -65,7 +65,7 @@ pub fn fill(
             })
             | (if a.in_sequence { SX_IN_SEQUENCE } else { 0 })
             | (if a.restored { SX_RESTORED } else { 0 })
-            | a.lost_cause;
+            | lost_cause_bits(a.lost_cause);
         let note = notes.get(i).copied().unwrap_or_default();
         e.warnings = note.warnings
             | if s.ambiguous_marker {
@@ -119,5 +119,14 @@ pub fn fill(
         ];
         e.longest_gap_cycles = io.gaps.longest_cycles;
         e.gap_cycles = io.gap_cycles;
+    }
+}
+
+/// Why HomedStatus was lost, as the status frame's `SX_LOST_*` bit.
+fn lost_cause_bits(c: LostCause) -> u8 {
+    match c {
+        LostCause::Other => 0,
+        LostCause::Feedback => SX_LOST_FEEDBACK,
+        LostCause::Reconnect => SX_LOST_RECONNECT,
     }
 }

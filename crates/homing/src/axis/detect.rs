@@ -58,7 +58,7 @@ impl Axis {
     /// of what was found.
     pub(super) fn detect(&mut self, now: u64, s: &Sample, search: &mut Search) -> Option<f64> {
         let (was_active, prev_pos) = match self.prev {
-            Some(p) => (p.switch_active, p.fb.position),
+            Some(p) => (p.switch_active, p.position),
             None => (s.switch_active, s.fb.position),
         };
         let detected = !was_active && s.switch_active;
@@ -93,7 +93,7 @@ impl Axis {
             Goal::Torque => {
                 if s.fb.torque * self.dir >= self.cfg.home_torque_threshold {
                     let since = *search.over_since.get_or_insert(now);
-                    if now - since >= super::secs_to_ns(self.cfg.home_torque_time) {
+                    if now - since >= self.torque_time_ns {
                         return Some(s.fb.position);
                     }
                 } else {

@@ -29,6 +29,14 @@ use crate::codes::*;
 use crate::config::AxisConfiguration;
 use crate::io::{DriveState, Feedback};
 
+/// What the detection needs of the sample before the newest (an edge is
+/// between the two).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Seen {
+    pub switch_active: bool,
+    pub position: f64,
+}
+
 /// A validated feedback sample.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Sample {
@@ -40,29 +48,26 @@ pub(super) struct Sample {
 }
 
 impl Axis {
-    /// This cycle's usable sample, if any.
-    pub(super) fn intake(
-        &mut self,
-        now: u64,
-        feedback: Option<&Feedback>,
-        stalled: bool,
-    ) -> Option<Sample> {
+    /// Takes this cycle's feedback: true when it gave a usable sample,
+    /// which is then the newest one (`self.last`).
+    pub(super) fn intake(&mut self, now: u64, feedback: Option<&Feedback>, stalled: bool) -> bool {
         let dt = self.loss.tick(now, self.cfg.cycle_ns);
-        let sample = self.sample(now, feedback);
-        match sample {
-            Some(_) => self.loss.fresh(now, dt, self.cfg.feedback_loss_drain),
-            None => self.missing(now, dt, stalled),
+        let fresh = self.sample(now, feedback);
+        if fresh {
+            self.loss.fresh(now, dt, self.cfg.feedback_loss_drain);
+        } else {
+            self.missing(now, dt, stalled);
         }
         self.status.feedback_gap_ns = self.loss.gap(now);
         self.status.feedback_loss_ns = self.loss.bucket();
-        sample
+        fresh
     }
 
-    /// The usable sample of this step's feedback, if any.
-    fn sample(&mut self, now: u64, feedback: Option<&Feedback>) -> Option<Sample> {
+    /// Takes this step's feedback as the newest sample if it is usable.
+    fn sample(&mut self, now: u64, feedback: Option<&Feedback>) -> bool {
         if self.cfg.configuration == AxisConfiguration::Virtual {
             // No hardware: the command is the position.
-            let (p, v) = self.profile.sample(now);
+            let (p, v) = self.profile.at(now);
             let fb = Feedback {
                 position: p,
                 velocity: v,
@@ -72,10 +77,11 @@ impl Axis {
                 },
                 ..Feedback::default()
             };
-            return Some(self.accept(now, fb));
+            self.accept(now, &fb);
+            return true;
         }
         match feedback {
-            None => None,
+            None => false,
             Some(fb) => match check_feedback(fb, self.cfg.max_position) {
                 Ok(()) if !self.plausible.position(fb.position, now) => {
                     // A forged or corrupt frame: never used, never an event.
@@ -90,9 +96,12 @@ impl Axis {
                             Abort::Controlled,
                         );
                     }
-                    None
+                    false
                 }
-                Ok(()) => Some(self.accept(now, *fb)),
+                Ok(()) => {
+                    self.accept(now, fb);
+                    true
+                }
                 Err(attribute) => {
                     self.status.bad_attribute = Some(attribute);
                     // Corrupt feedback: the reference can no longer be trusted.
@@ -105,24 +114,26 @@ impl Axis {
                             Abort::Controlled,
                         );
                     }
-                    None
+                    false
                 }
             },
         }
     }
 
-    fn accept(&mut self, now: u64, fb: Feedback) -> Sample {
-        let s = Sample {
-            fb,
+    /// `fb` becomes the newest sample (copied once, into `self.last`).
+    fn accept(&mut self, now: u64, fb: &Feedback) {
+        self.prev = self.last.as_ref().map(|l| Seen {
+            switch_active: l.switch_active,
+            position: l.fb.position,
+        });
+        self.last = Some(Sample {
+            fb: *fb,
             switch_active: fb.home_switch != self.cfg.home_switch_normally_closed,
             dt_ns: self.last_sample_ns.map_or(0, |t| now.saturating_sub(t)),
-        };
+        });
         self.last_sample_ns = Some(now);
         self.latches.seen_at(fb.position);
         self.status.feedback_ok = true;
-        self.prev = self.last;
-        self.last = Some(s);
-        s
     }
 
     /// A step without a usable sample, `dt` after the previous step.
@@ -143,7 +154,12 @@ impl Axis {
 
 /// Rejects feedback that must not reach the engine; names the attribute.
 fn check_feedback(fb: &Feedback, max_position: f64) -> Result<(), &'static str> {
-    let bad = |x: f64, limit: f64| !x.is_finite() || x.abs() > limit;
+    // Finite and within the limit: `|x| <= limit` with the limit cut to the
+    // largest finite number (so an infinite or NaN limit still refuses
+    // infinities; NaN compares false), one comparison where `is_finite` and
+    // the limit take two.
+    let ok = |x: f64, limit: f64| x.abs() <= limit.min(f64::MAX);
+    let bad = |x: f64, limit: f64| !ok(x, limit);
     if bad(fb.position, max_position) {
         return Err("feedback.position");
     }

@@ -23,9 +23,15 @@ impl Travel {
         Self { lo: p, hi: p }
     }
 
+    /// Compared, not `f64::min`/`max` (which also sort out NaN): positions
+    /// reach here validated, and this runs every step.
     fn extend(&mut self, p: f64) {
-        self.lo = self.lo.min(p);
-        self.hi = self.hi.max(p);
+        if p < self.lo {
+            self.lo = p;
+        }
+        if p > self.hi {
+            self.hi = p;
+        }
     }
 
     /// `x` lies on the travel, give or take `margin`.

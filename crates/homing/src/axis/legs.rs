@@ -56,7 +56,7 @@ impl Axis {
             return;
         };
         let (p, v) = self.profile.sample(now);
-        if self.prev_request.hold && leg.moves() && v == 0.0 {
+        if self.request.hold && leg.moves() && v == 0.0 {
             let min_move_ns = self.home_move(&h, leg, p, v).map_or(0, |(target, speed)| {
                 Profile::move_to(
                     now,
@@ -73,7 +73,7 @@ impl Axis {
                 h.run = Run::Waiting { min_move_ns };
             }
             // At rest: hold exactly here, whatever profile brought the axis.
-            self.profile = Profile::hold(now, p);
+            self.profile.set(Profile::hold(now, p));
             return;
         }
         self.start_leg(now, s);
@@ -92,7 +92,8 @@ impl Axis {
         let run = match leg {
             Leg::Seek(goal) => {
                 let search = self.begin_search(goal, p);
-                self.profile = self.jog(now, self.dir * self.cfg.home_speed);
+                self.profile
+                    .set(self.jog(now, self.dir * self.cfg.home_speed));
                 Run::Search(search)
             }
             Leg::Return(goal) => {
@@ -101,7 +102,8 @@ impl Axis {
                     search.seen_active = true;
                     self.arm_switch(false);
                 }
-                self.profile = self.jog(now, -self.dir * self.cfg.home_return_speed);
+                self.profile
+                    .set(self.jog(now, -self.dir * self.cfg.home_return_speed));
                 Run::Search(search)
             }
             Leg::Creep => {
@@ -109,16 +111,18 @@ impl Axis {
                 let target = h.rough_marker.unwrap_or(p);
                 let dir = if target >= p { 1.0 } else { -1.0 };
                 let search = self.begin_search(Goal::Marker, p);
-                self.profile = self.jog(now, dir * self.cfg.home_creep_speed);
+                self.profile
+                    .set(self.jog(now, dir * self.cfg.home_creep_speed));
                 Run::Search(search)
             }
             Leg::Watch(goal) => Run::Search(self.begin_search(goal, s.fb.position)),
             Leg::Stop => {
-                self.profile = Profile::stop(now, p, v, self.cfg.home_deceleration);
+                self.profile
+                    .set(Profile::stop(now, p, v, self.cfg.home_deceleration));
                 Run::Profile { to_home: false }
             }
             Leg::Release => {
-                self.profile = self.release_profile(now, s.fb.position);
+                self.profile.set(self.release_profile(now, s.fb.position));
                 Run::Profile { to_home: false }
             }
             Leg::Restore => {
@@ -129,17 +133,18 @@ impl Axis {
                 // Home Position inside the hard stop: stay; homed, not at HP.
                 None => return self.complete(now, false),
                 Some((target, speed)) => {
-                    self.profile = self.home_profile(now, target, speed);
+                    self.profile.set(self.home_profile(now, target, speed));
                     Run::Profile { to_home: true }
                 }
             },
             Leg::Continue => match self.home_move(&h, leg, p, v) {
                 Some((target, speed)) => {
-                    self.profile = self.home_profile(now, target, speed);
+                    self.profile.set(self.home_profile(now, target, speed));
                     Run::Profile { to_home: true }
                 }
                 None => {
-                    self.profile = Profile::stop(now, p, v, self.cfg.home_deceleration);
+                    self.profile
+                        .set(Profile::stop(now, p, v, self.cfg.home_deceleration));
                     Run::Profile { to_home: false }
                 }
             },
@@ -243,7 +248,7 @@ impl Axis {
     /// `Request::move_duration_ns` when a coordinator asks for it.
     fn home_profile(&self, now: u64, target: f64, speed: f64) -> Profile {
         let (p, v) = self.profile.sample(now);
-        let duration = self.prev_request.move_duration_ns;
+        let duration = self.request.move_duration_ns;
         if duration > 0 && v == 0.0 {
             Profile::move_to_in(
                 now,

@@ -36,6 +36,7 @@
 //!   us: the drive is disabled and the overrides restored at once.
 
 mod detect;
+mod followed;
 mod intake;
 mod latches;
 mod legs;
@@ -51,8 +52,10 @@ use crate::plan::Leg;
 use crate::position::wrap;
 use crate::profile::Profile;
 use crate::status::Status;
+use crate::time::secs_to_ns;
 use crate::validate::{effective_search_limit, validate, ConfigError};
-use intake::Sample;
+use followed::Followed;
+use intake::{Sample, Seen};
 use latches::Latches;
 use loss::FeedbackLoss;
 use plausible::Plausibility;
@@ -77,17 +80,26 @@ pub struct Axis {
     search_limit: f64,
     /// Home Direction as ±1.
     dir: f64,
+    /// Times of the configuration in ns, worked out once: `home_timeout`
+    /// (`None` when not positive), `enable_timeout`, `home_torque_time`.
+    home_timeout_ns: Option<u64>,
+    enable_timeout_ns: u64,
+    torque_time_ns: u64,
+    /// What [`Axis::output`] writes besides the motion, worked out once.
+    out: OutputLimits,
     status: Status,
-    prev_request: Request,
+    /// What the engine keeps of the latest request.
+    request: Kept,
     state: State,
-    profile: Profile,
+    profile: Followed,
     /// The power stage is requested on.
     enable: bool,
     /// Torque limits and error tolerances overridden (torque sequences).
     overrides: bool,
     latches: Latches,
-    /// Last two valid samples (`last` is the newest).
-    prev: Option<Sample>,
+    /// The newest valid sample, and what the detection needs of the one
+    /// before it.
+    prev: Option<Seen>,
     last: Option<Sample>,
     /// Time of the last usable sample, ns.
     last_sample_ns: Option<u64>,
@@ -115,11 +127,15 @@ impl Axis {
             config_error: errors.first().map(|e| e.exerr),
             search_limit: effective_search_limit(&cfg),
             dir: cfg.home_direction.sign(),
+            home_timeout_ns: (cfg.home_timeout > 0.0).then(|| secs_to_ns(cfg.home_timeout)),
+            enable_timeout_ns: secs_to_ns(cfg.enable_timeout),
+            torque_time_ns: secs_to_ns(cfg.home_torque_time),
+            out: OutputLimits::new(&cfg),
             cfg,
             status: Status::default(),
-            prev_request: Request::default(),
+            request: Kept::default(),
             state: State::Idle,
-            profile: Profile::hold(0, 0.0),
+            profile: Followed::new(Profile::hold(0, 0.0)),
             enable: false,
             overrides: false,
             latches: Latches::default(),
@@ -219,7 +235,8 @@ impl Axis {
     pub fn step(&mut self, now_ns: u64, feedback: Option<&Feedback>, request: &Request) -> Command {
         let fresh = self.intake(now_ns, feedback, request.stalled);
         self.requests(now_ns, request);
-        match fresh {
+        // A fresh sample is the newest one (requests never drop it).
+        match self.last.filter(|_| fresh) {
             Some(s) => self.advance(now_ns, &s),
             None => self.advance_blind(now_ns),
         }
@@ -233,21 +250,21 @@ impl Axis {
         self.status.stopping = matches!(self.state, State::Stopping { .. });
         self.status.waiting = false;
         self.status.min_move_ns = 0;
-        let State::Homing(h) = self.state else {
+        let State::Homing(h) = &self.state else {
             return;
         };
         self.status.leg = u8::try_from(h.leg).unwrap_or(u8::MAX);
-        match (h.run, h.current()) {
+        match (&h.run, h.current()) {
             (Run::Waiting { min_move_ns }, _) => {
                 self.status.waiting = true;
-                self.status.min_move_ns = min_move_ns;
+                self.status.min_move_ns = *min_move_ns;
             }
             (Run::Search(search), Some(Leg::Watch(_))) => {
                 let actual = self.last.map_or(search.start, |s| s.fb.position);
                 self.status.search_travel = (actual - search.start).abs();
             }
             (Run::Search(search), _) => {
-                self.status.search_travel = (self.profile.sample(now).0 - search.start).abs();
+                self.status.search_travel = (self.profile.at(now).0 - search.start).abs();
             }
             (Run::Profile { .. }, _) => {}
         }
@@ -258,8 +275,13 @@ impl Axis {
     // ------------------------------------------------------------------
 
     fn requests(&mut self, now: u64, req: &Request) {
-        let prev = self.prev_request;
-        self.prev_request = *req;
+        let prev = self.request;
+        self.request = Kept {
+            home: req.home,
+            stop: req.stop,
+            hold: req.hold,
+            move_duration_ns: req.move_duration_ns,
+        };
         if req.shutdown {
             if self.status.ip {
                 self.fail(now, ERR_SERVO_MESSAGE, EX_AXIS_SHUTDOWN, Abort::Disable);
@@ -342,7 +364,7 @@ impl Axis {
         let stopping = matches!(self.state, State::Stopping { .. });
         if !moving && !stopping && !s.fb.drive.enabled {
             // Nobody holds the axis: follow it, so enabling never jumps.
-            self.profile = Profile::hold(now, s.fb.position);
+            self.profile.set(Profile::hold(now, s.fb.position));
         }
         if matches!(self.state, State::Idle) && s.fb.drive.fault {
             self.enable = false;
@@ -359,7 +381,7 @@ impl Axis {
                     Abort::Disable,
                 );
             }
-            let v = self.profile.sample(now).1;
+            let v = self.profile.at(now).1;
             if (v > 0.0 && s.fb.overtravel_positive) || (v < 0.0 && s.fb.overtravel_negative) {
                 return self.fail(now, ERR_SERVO_MESSAGE, EX_OVERTRAVEL, Abort::Controlled);
             }
@@ -371,15 +393,16 @@ impl Axis {
             return;
         }
         let done = self.profile.is_done(now);
-        match self.state {
+        // By reference: the state is large, and each arm needs a few words.
+        match &self.state {
             State::Idle => {}
-            State::Enabling { since } => {
+            &State::Enabling { since } => {
                 if s.fb.drive.enabled && !s.fb.drive.fault {
                     self.begin(now, s);
                 } else if s.fb.drive.fault && self.enable {
                     // Fault reset: enable must go low before it goes high again.
                     self.enable = false;
-                } else if now.saturating_sub(since) > secs_to_ns(self.cfg.enable_timeout) {
+                } else if now.saturating_sub(since) > self.enable_timeout_ns {
                     self.fail(now, ERR_SERVO_MESSAGE, EX_ENABLE_TIMEOUT, Abort::Controlled);
                 } else {
                     self.enable = true;
@@ -397,13 +420,13 @@ impl Axis {
                 }
                 Run::Profile { to_home } if done => self.profile_done(now, s, to_home),
                 Run::Profile { .. } => {}
-                Run::Waiting { .. } if !self.prev_request.hold => self.start_leg(now, s),
+                Run::Waiting { .. } if !self.request.hold => self.start_leg(now, s),
                 Run::Waiting { .. } => {}
             },
-            State::Stopping { released } if done => {
+            &State::Stopping { released } if done => {
                 if self.overrides && !released {
                     self.state = State::Stopping { released: true };
-                    self.profile = self.release_profile(now, s.fb.position);
+                    self.profile.set(self.release_profile(now, s.fb.position));
                 } else {
                     self.overrides = false;
                     self.state = State::Idle;
@@ -427,8 +450,10 @@ impl Axis {
     }
 
     fn check_timeout(&mut self, now: u64) -> bool {
-        let t = self.cfg.home_timeout;
-        if self.status.ip && t > 0.0 && now.saturating_sub(self.status.started_ns) > secs_to_ns(t) {
+        let Some(t) = self.home_timeout_ns else {
+            return false;
+        };
+        if self.status.ip && now.saturating_sub(self.status.started_ns) > t {
             self.fail(now, ERR_TIMEOUT, 0, Abort::Controlled);
             return true;
         }
@@ -438,20 +463,21 @@ impl Axis {
     /// A commanded search leg that travelled beyond the search limit fails
     /// with ERR 1016 and the leg's EXERR (see `codes`).
     fn check_search_limit(&mut self, now: u64) -> bool {
-        let State::Homing(h) = self.state else {
+        let State::Homing(h) = &self.state else {
             return false;
         };
-        let (Run::Search(search), Some(leg)) = (h.run, h.current()) else {
+        let (Run::Search(search), Some(leg)) = (&h.run, h.current()) else {
             return false;
         };
+        let start = search.start;
         let exerr = match leg {
             Leg::Seek(_) => EX_SEARCH_SEEK,
             Leg::Return(_) => EX_SEARCH_RETURN,
             Leg::Creep => EX_SEARCH_CREEP,
             _ => return false,
         };
-        let p = self.profile.sample(now).0;
-        if (p - search.start).abs() > self.search_limit {
+        let p = self.profile.at(now).0;
+        if (p - start).abs() > self.search_limit {
             self.fail(now, ERR_SEARCH_LIMIT, exerr, Abort::Controlled);
             return true;
         }
@@ -491,8 +517,9 @@ impl Axis {
         self.status.finished_ns = Some(now);
         match how {
             Abort::Controlled => {
-                let (p, v) = self.profile.sample(now);
-                self.profile = Profile::stop(now, p, v, self.cfg.home_deceleration);
+                let (p, v) = self.profile.at(now);
+                self.profile
+                    .set(Profile::stop(now, p, v, self.cfg.home_deceleration));
                 self.state = State::Stopping { released: false };
             }
             Abort::Disable => {
@@ -501,7 +528,7 @@ impl Axis {
                 let hold = self
                     .last
                     .map_or(self.profile.sample(now).0, |s| s.fb.position);
-                self.profile = Profile::hold(now, hold);
+                self.profile.set(Profile::hold(now, hold));
                 self.state = State::Idle;
             }
         }
@@ -512,31 +539,27 @@ impl Axis {
     // ------------------------------------------------------------------
 
     fn output(&mut self, now: u64) -> Command {
-        let (mut p, mut v) = self.profile.sample(now);
+        let (mut p, mut v) = self.profile.at(now);
         if !p.is_finite() || !v.is_finite() {
             // Unreachable by construction; never let it out if it happens.
             p = self.last_command.position;
             v = 0.0;
-            self.profile = Profile::hold(now, p);
+            self.profile.set(Profile::hold(now, p));
         }
-        let servo = self.cfg.configuration == AxisConfiguration::Servo;
+        let o = &self.out;
         let (torque, ptol, vtol) = if self.overrides {
-            (self.cfg.home_torque_level, 0.0, 0.0)
+            (o.override_torque, 0.0, 0.0)
         } else {
-            (
-                self.cfg.torque_limit,
-                self.cfg.position_error_tolerance,
-                self.cfg.velocity_error_tolerance,
-            )
+            (o.torque, o.position_tolerance, o.velocity_tolerance)
         };
         let cmd = Command {
-            enable: self.enable && servo,
+            enable: self.enable && o.servo,
             position: p,
             velocity: v,
-            torque_limit_positive: finite_or(torque, 0.0),
-            torque_limit_negative: finite_or(torque, 0.0),
-            position_error_tolerance: finite_or(ptol, 0.0),
-            velocity_error_tolerance: finite_or(vtol, 0.0),
+            torque_limit_positive: torque,
+            torque_limit_negative: torque,
+            position_error_tolerance: ptol,
+            velocity_error_tolerance: vtol,
             marker_arm: LatchArm {
                 id: self.latches.marker_id,
                 edge: Edge::Rising,
@@ -552,18 +575,48 @@ impl Axis {
     }
 }
 
+/// What the engine keeps of the latest request: the rung and stop levels
+/// (their rising edges are what counts) and the coordination it follows.
+#[derive(Clone, Copy, Debug, Default)]
+struct Kept {
+    home: bool,
+    stop: bool,
+    /// `Request::hold`.
+    hold: bool,
+    /// `Request::move_duration_ns`.
+    move_duration_ns: u64,
+}
+
+/// The torque limits and error tolerances a command carries, finite (0 where
+/// the configuration's is not), from a configuration that never changes.
+#[derive(Clone, Copy, Debug)]
+struct OutputLimits {
+    /// The power stage may be enabled at all (a servo axis).
+    servo: bool,
+    torque: f64,
+    position_tolerance: f64,
+    velocity_tolerance: f64,
+    /// Home Torque Level, in force while a torque sequence overrides the
+    /// limits (the tolerances are then off).
+    override_torque: f64,
+}
+
+impl OutputLimits {
+    fn new(cfg: &AxisConfig) -> Self {
+        Self {
+            servo: cfg.configuration == AxisConfiguration::Servo,
+            torque: finite_or(cfg.torque_limit, 0.0),
+            position_tolerance: finite_or(cfg.position_error_tolerance, 0.0),
+            velocity_tolerance: finite_or(cfg.velocity_error_tolerance, 0.0),
+            override_torque: finite_or(cfg.home_torque_level, 0.0),
+        }
+    }
+}
+
 fn finite_or(x: f64, fallback: f64) -> f64 {
     if x.is_finite() {
         x
     } else {
         fallback
-    }
-}
-
-fn secs_to_ns(s: f64) -> u64 {
-    if s.is_finite() && s > 0.0 {
-        (s * 1e9).min(u64::MAX as f64) as u64
-    } else {
-        0
     }
 }

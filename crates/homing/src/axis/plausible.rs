@@ -29,6 +29,7 @@
 //! checked: there is no speed to check against.
 
 use crate::config::AxisConfig;
+use crate::time::ns_to_s;
 use crate::validate::effective_max_speed;
 
 #[derive(Clone, Copy, Debug)]
@@ -66,7 +67,7 @@ impl Plausibility {
     /// the span anew.
     pub fn position(&mut self, p: f64, now: u64) -> bool {
         if let (Some(v), Some(t0), Some((lo, hi))) = (self.max_speed, self.since, self.span) {
-            let elapsed = now.saturating_sub(t0) as f64 * 1e-9;
+            let elapsed = ns_to_s(now.saturating_sub(t0));
             let bound = v * elapsed * 1.5 + self.quantum;
             if p < lo - bound || p > hi + bound {
                 return false;
@@ -74,24 +75,28 @@ impl Plausibility {
         }
         self.since = Some(now);
         let c = self.last_command.unwrap_or(p);
-        self.span = Some((p.min(c), p.max(c)));
+        self.span = Some(if p <= c { (p, c) } else { (c, p) });
         true
     }
 
-    /// A command was sent: the axis may go there.
+    /// A command was sent: the axis may go there. (Compared, not
+    /// `f64::min`/`max`: commands are finite, and this runs every step.)
     pub fn commanded(&mut self, c: f64) {
         self.last_command = Some(c);
         if let Some((lo, hi)) = &mut self.span {
-            *lo = lo.min(c);
-            *hi = hi.max(c);
+            if c < *lo {
+                *lo = c;
+            }
+            if c > *hi {
+                *hi = c;
+            }
         }
     }
 
     /// How far a latch may lie outside the travel seen since its arming,
     /// for a sample `dt_ns` after the previous one; `None`: no check.
     pub fn latch_margin(&self, dt_ns: u64) -> Option<f64> {
-        self.max_speed
-            .map(|v| v * dt_ns as f64 * 1e-9 + self.quantum)
+        self.max_speed.map(|v| v * ns_to_s(dt_ns) + self.quantum)
     }
 }
 

@@ -13,8 +13,10 @@
 
 use super::testbench::{Bench, MS};
 use super::*;
-use motion_frames::{axis_to_command, AxisFeedback, INVALID_COUNTS, LAYOUT_VERSION};
-use motion_homing::AxisConfiguration;
+use motion_frames::{
+    axis_to_command, axis_to_feedback, AxisFeedback, INVALID_COUNTS, LAYOUT_VERSION, SW_NO_DATA,
+};
+use motion_homing::{AxisConfiguration, Feedback};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
@@ -203,11 +205,16 @@ fn garbage_feedback_never_becomes_feedback_nor_motion() {
             let mut b = Bench::new(motion_config::DEMO_TOML);
             b.run(20);
             let all = b.core.all_mask();
-            prop_assert!(b.home(all, false).axes[..axes].iter().all(|a| a.accepted));
+            prop_assert!(b.home(all, false).axes[..axes].iter().all(|a| a.accepted()));
             b.run(warm);
             for (g, then) in &script {
                 let f = frame(&b, g);
-                let before: Vec<Option<f64>> = b.core.axes.iter().map(Axis::raw_position).collect();
+                let before: Vec<Option<f64>> = b
+                    .core
+                    .axes()
+                    .iter()
+                    .map(|a| a.engine().raw_position())
+                    .collect();
                 garbage_cycle(&mut b, &f);
                 check_cycle(&b)?;
                 if !matches!(g, Garbage::Bytes(_)) {
@@ -215,7 +222,7 @@ fn garbage_feedback_never_becomes_feedback_nor_motion() {
                         let d = axis_to_feedback(&f.axes[j], a.engine.counts_per_unit);
                         let virtual_axis = a.engine.configuration == AxisConfiguration::Virtual;
                         if bad(&d, a.engine.max_position) && !virtual_axis {
-                            let after = b.core.axes[j].raw_position();
+                            let after = b.core.axes()[j].engine().raw_position();
                             prop_assert_eq!(
                                 after.map(f64::to_bits),
                                 before[j].map(f64::to_bits),

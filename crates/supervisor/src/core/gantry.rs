@@ -26,7 +26,9 @@
 use motion_config::{GantryConfig, MAX_SIDES};
 use motion_homing::codes::{ERR_GANTRY_SKEW, ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST};
 use motion_homing::plan::{plan_for, Leg};
-use motion_homing::{Axis, AxisConfig, Command};
+use motion_homing::AxisConfig;
+
+use super::slot::AxisSlot;
 
 /// What the coordinator asks of the sides this cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -105,9 +107,9 @@ impl GantryCoord {
         self.skew
     }
 
-    /// One cycle, before the engines step: `axes` and `cmds` as the previous
-    /// step left them.
-    pub fn step(&mut self, axes: &[Axis], cmds: &[Command]) -> Decision {
+    /// One cycle, before the engines step: the axes as the previous step
+    /// left them.
+    pub fn step(&mut self, axes: &[AxisSlot]) -> Decision {
         let mut d = Decision {
             hold: true,
             ..Decision::default()
@@ -160,7 +162,7 @@ impl GantryCoord {
             }
             self.released_leg = Some(leg);
             for (j, &i) in sides.iter().enumerate() {
-                self.start_cmd[j] = cmds[i].position;
+                self.start_cmd[j] = axes[i].command().position;
                 self.left_at[j] = None;
             }
             return d;
@@ -176,7 +178,7 @@ impl GantryCoord {
         for (j, &i) in sides.iter().enumerate() {
             let s = axes[i].status();
             if self.left_at[j].is_none() && (s.leg > leg || !s.ip) && !s.waiting {
-                self.left_at[j] = Some((cmds[i].position - self.start_cmd[j]).abs());
+                self.left_at[j] = Some((axes[i].command().position - self.start_cmd[j]).abs());
             }
         }
         let mut lo = f64::INFINITY;
@@ -198,7 +200,7 @@ impl GantryCoord {
         // A side still searching beyond the first event + max_skew: racked.
         let beyond = sides.iter().enumerate().any(|(j, &i)| {
             self.left_at[j].is_none()
-                && (cmds[i].position - self.start_cmd[j]).abs() > lo + self.max_skew
+                && (axes[i].command().position - self.start_cmd[j]).abs() > lo + self.max_skew
         });
         if beyond || (found == self.n && hi - lo > self.max_skew) {
             if beyond {

@@ -3,6 +3,7 @@
 //! IPC (for the core's and the keeper's tests).
 
 use super::*;
+use crate::shared::{Ack, Control};
 use motion_frames::feedback_to_axis;
 use motion_plant::Plant;
 

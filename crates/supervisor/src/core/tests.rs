@@ -3,7 +3,7 @@
 //! place (and made to fall silent or restart at will).
 
 use super::*;
-use motion_control::REASON_IO_NOT_ATTACHED;
+use crate::shared::{AxisAck, Control, Refusal};
 
 use super::testbench::{Bench, MS};
 
@@ -15,7 +15,7 @@ fn demo_homes_through_frames_in_config_order() {
     let all = b.core.all_mask();
     assert_eq!(all, 0b1111);
     let ack = b.home(all, false);
-    assert!(ack.axes[..4].iter().all(|a| a.accepted), "{ack:?}");
+    assert!(ack.axes[..4].iter().all(|a| a.accepted()), "{ack:?}");
     let mut first_start = [None; 4];
     for _ in 0..20_000 {
         b.cycle();
@@ -50,19 +50,14 @@ fn demo_homes_through_frames_in_config_order() {
     assert!(b.core.exit_done());
 }
 
-const TWO_IO: &str = r#"
-[supervisor]
-cycle_us = 1000
-cpu = 0
-
-[[io]]
-name = "bus0"
-[[io]]
-name = "bus1"
-
+/// A switch-homing axis (`extra`: its I/O process or home order): seek at
+/// 20 from -10 onto the switch [0, 5], return at 2 until it clears.
+fn switch_axis(name: &str, extra: &str) -> String {
+    format!(
+        r#"
 [[axis]]
-name = "A"
-io = "bus0"
+name = "{name}"
+{extra}
 home_sequence = "switch"
 home_speed = 20.0
 home_return_speed = 2.0
@@ -71,29 +66,28 @@ home_deceleration = 500.0
 [axis.sim]
 start = -10.0
 switch = [0.0, 5.0]
+"#
+    )
+}
 
-[[axis]]
-name = "B"
-io = "bus1"
-home_sequence = "switch"
-home_speed = 20.0
-home_return_speed = 2.0
-home_acceleration = 500.0
-home_deceleration = 500.0
-[axis.sim]
-start = -10.0
-switch = [0.0, 5.0]
-"#;
+/// Two I/O processes, one switch axis each: A on bus0, B on bus1.
+fn two_io() -> String {
+    format!(
+        "[supervisor]\ncycle_us = 1000\ncpu = 0\n\n[[io]]\nname = \"bus0\"\n[[io]]\nname = \"bus1\"\n{}{}",
+        switch_axis("A", "io = \"bus0\""),
+        switch_axis("B", "io = \"bus1\"")
+    )
+}
 
 /// Issue 7: losing one I/O process aborts homing only on its axes (12/40);
 /// the other axes carry on. Its return clears HomedStatus and is counted.
 #[test]
 fn losing_one_io_process_aborts_only_its_axes() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     assert!(b.core.all_attached());
     let ack = b.home(0b11, true);
-    assert!(ack.axes[0].accepted && ack.axes[1].accepted);
+    assert!(ack.axes[0].accepted() && ack.axes[1].accepted());
     b.run(300); // both seeking
     b.alive[1] = false;
     b.run(3000);
@@ -109,7 +103,7 @@ fn losing_one_io_process_aborts_only_its_axes() {
     assert!(!s.ios[1].attached && s.ios[0].attached);
     // A home request on B is refused while bus1 is gone.
     let ack = b.home(0b10, false);
-    assert_eq!(ack.axes[1].reason, REASON_IO_NOT_ATTACHED);
+    assert_eq!(ack.axes[1], AxisAck::Refused(Refusal::IoNotAttached));
     // bus1 comes back as a new process: attached again, counted.
     b.origin[1] = 99;
     b.alive[1] = true;
@@ -125,7 +119,7 @@ fn losing_one_io_process_aborts_only_its_axes() {
 /// clears HomedStatus of its axes.
 #[test]
 fn a_restarted_io_process_unhomes_its_axes() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.home(0b11, true);
     b.run(4000);
@@ -142,7 +136,7 @@ fn a_restarted_io_process_unhomes_its_axes() {
 
 #[test]
 fn stop_and_unhome() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.home(0b01, false);
     b.run(100);
@@ -154,28 +148,28 @@ fn stop_and_unhome() {
     b.run(4000);
     assert!(b.snap().axes[1].status.homed);
     b.control(Control::Unhome { id: 2, mask: 0b10 });
-    assert!(b.acks.pop().unwrap().axes[1].accepted);
+    assert!(b.acks.pop().unwrap().axes[1].accepted());
     b.run(1);
     assert!(!b.snap().axes[1].status.homed);
 }
 
 #[test]
 fn a_second_home_request_on_a_homing_axis_is_refused() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.home(0b01, false);
     b.run(3);
     let ack = b.home(0b11, false);
-    assert_eq!(ack.axes[0].reason, REASON_ALREADY_HOMING);
+    assert_eq!(ack.axes[0], AxisAck::Refused(Refusal::AlreadyHoming));
     assert!(
-        !ack.axes[1].accepted,
+        !ack.axes[1].accepted(),
         "nothing starts when one named axis is refused"
     );
 }
 
 #[test]
 fn trace_records_one_homing() {
-    let mut b = Bench::new(TWO_IO);
+    let mut b = Bench::new(&two_io());
     b.run(5);
     b.control(Control::Trace { id: 3, axis: 1 });
     b.home(0b10, false);
@@ -237,19 +231,7 @@ hard_stop = [-110.0, 110.0]
         "[supervisor]\ncycle_us = 1000\ncpu = 0\n{}{}{}\n[[gantry]]\nname = \"Y\"\naxes = [\"Y1\", \"Y2\"]\nmax_skew = {max_skew}\n",
         side("Y1", 1.0, 0.0),
         side("Y2", 1.5, rack),
-        r#"
-[[axis]]
-name = "X"
-home_order = 1
-home_sequence = "switch"
-home_speed = 20.0
-home_return_speed = 2.0
-home_acceleration = 500.0
-home_deceleration = 500.0
-[axis.sim]
-start = -10.0
-switch = [0.0, 5.0]
-"#
+        switch_axis("X", "home_order = 1")
     )
 }
 
@@ -258,7 +240,7 @@ fn a_racked_gantry_is_squared_by_its_own_switches_and_markers() {
     let mut b = Bench::new(&gantry_toml(0.3, 1.0, false));
     b.run(5);
     let ack = b.home(b.core.all_mask(), false);
-    assert!(ack.axes[..3].iter().all(|a| a.accepted));
+    assert!(ack.axes[..3].iter().all(|a| a.accepted()));
     let mut started = [None; 3];
     for _ in 0..20_000 {
         b.cycle();

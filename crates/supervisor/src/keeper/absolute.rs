@@ -21,7 +21,8 @@
 
 use super::append;
 use super::identity::identity;
-use crate::shared::{AxisAck, AxisSnap, Snapshot};
+use crate::control_thread::answer;
+use crate::shared::{AxisAck, AxisSnap, Refusal, Snapshot};
 use motion_config::MachineConfig;
 use motion_homing::RestoreRefusal;
 use motion_state::reference::{References, FORMAT};
@@ -299,7 +300,7 @@ impl Absolute {
         let Some(r) = self.stored.clone() else {
             return;
         };
-        if ack.accepted {
+        if ack.accepted() {
             log::info!(
                 "{name}: homed from the stored reference of {} (offset {}), without motion",
                 r.homed_at,
@@ -313,8 +314,10 @@ impl Absolute {
             append(record, &e);
             return;
         }
-        let passing = match ack.restore {
-            Some(RestoreRefusal::OutsideTravelLimits { position }) => {
+        let passing = match ack {
+            AxisAck::Refused(Refusal::Restore(RestoreRefusal::OutsideTravelLimits {
+                position,
+            })) => {
                 let (lo, hi) = m.axes[i].engine.travel_limits.unwrap_or((0.0, 0.0));
                 let why = format!(
                     "the stored reference puts the axis at {position}, outside its travel \
@@ -323,12 +326,17 @@ impl Absolute {
                 self.invalidate(m, i, &why, dir, record);
                 return;
             }
-            Some(x @ (RestoreRefusal::InvalidOffset | RestoreRefusal::NotAbsolute)) => {
+            AxisAck::Refused(Refusal::Restore(
+                x @ (RestoreRefusal::InvalidOffset | RestoreRefusal::NotAbsolute),
+            )) => {
                 self.invalidate(m, i, &x.to_string(), dir, record);
                 return;
             }
-            Some(x) => x.to_string(),
-            None => motion_control::reason_text(ack.reason).to_string(),
+            AxisAck::Refused(Refusal::Restore(x)) => x.to_string(),
+            AxisAck::Refused(r) => answer::reason(*r)
+                .map_or("refused", |r| r.text())
+                .to_string(),
+            AxisAck::Accepted | AxisAck::NotNamed => "refused".to_string(),
         };
         if self.said.as_deref() != Some(passing.as_str()) {
             log::info!("{name}: the stored reference waits: {passing}");

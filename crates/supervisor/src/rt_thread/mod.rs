@@ -1,16 +1,21 @@
 //! The real-time thread: pinned, SCHED_FIFO, its own allocation pool, one
 //! absolute deadline per cycle.
 //!
-//! One cycle:
+//! One cycle (`run` reads as this list):
 //! 1. sleep to the absolute deadline (`clock_nanosleep`, TIMER_ABSTIME);
-//! 2. take control requests (lock-free queue), answer them (lock-free queue);
+//! 2. take control requests (lock-free queue), answer them (lock-free
+//!    queue): `control_queue`;
 //! 3. take the newest feedback frame of every I/O process — the answer to
-//!    the previous cycle's command, which arrived while we slept;
-//! 4. step every axis's homing engine and the home sequences;
-//! 5. publish one command frame per I/O process and notify each;
+//!    the previous cycle's command, which arrived while we slept:
+//!    `IoPorts::receive`;
+//! 4. step every axis's homing engine and the home sequences: `Core::step`
+//!    (`IoPorts::step`);
+//! 5. publish one command frame per I/O process and notify each:
+//!    `IoPorts::publish`;
 //! 6. record wake-up latency and compute time (and the I/O round trip, from
 //!    the answer's own timestamp: command published → answer published);
-//!    now and then hand a histogram set and a status snapshot over.
+//!    now and then hand a histogram set and a status snapshot over
+//!    (`record.rs`: `Recorder`).
 //!
 //! Nothing waits for an answer: a cycle does its bounded work and goes back
 //! to sleep, so a slow I/O process can never push the next wake-up late (it
@@ -23,13 +28,15 @@
 //! TLSF pool. The count of system-allocator calls after warm-up is published
 //! for the no-allocation test.
 
-use crate::core::Core;
+mod record;
+
+use crate::core::{Core, CycleInfo};
 use crate::shared::{Phase, Shared, MAX_IOS};
-use crate::stats::HistSet;
 use motion_config::MachineConfig;
 use motion_frames::FeedbackFrame;
 use motion_ipc::{Domain, IpcError, SupervisorPorts};
-use motion_rt::{counting, enter_realtime, now_ns, rt_pool, PeriodicTimer, RtConfig, RtReport};
+use motion_rt::{enter_realtime, now_ns, rt_pool, PeriodicTimer, RtConfig, RtReport};
+use record::Recorder;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -121,12 +128,12 @@ fn block_signals() {
 }
 
 type FeedbackSample = iceoryx2::sample::Sample<iceoryx2::service::ipc::Service, FeedbackFrame, ()>;
+type Node = iceoryx2::node::Node<iceoryx2::service::ipc::Service>;
 
 fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
     block_signals();
-    let report = enter_realtime(&s.rt);
     let mut out = RtOutcome {
-        report: Some(report),
+        report: Some(enter_realtime(&s.rt)),
         error: None,
         cycles: 0,
         pool: None,
@@ -138,54 +145,136 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
             return out;
         }
     };
-    let mut ports: Vec<SupervisorPorts> = Vec::with_capacity(s.machine.ios.len());
-    for io in &s.machine.ios {
-        match SupervisorPorts::create(&node, &s.domain, &io.name) {
-            Ok(p) => ports.push(p),
-            Err(e) => {
-                out.error = Some(format!("I/O process {}: {e}", io.name));
-                return out;
-            }
+    let mut io = match IoPorts::open(&node, &s) {
+        Ok(io) => io,
+        Err(e) => {
+            out.error = Some(e);
+            return out;
         }
-    }
-    let n_io = ports.len().min(MAX_IOS);
+    };
     let mut core = Core::new(&s.machine);
-    let mut hist = shared
-        .stats_free
-        .pop()
-        .unwrap_or_else(|| Box::new(HistSet::new()));
-    let mut pending: Vec<Option<FeedbackSample>> = (0..n_io).map(|_| None).collect();
+    let mut rec = Recorder::new(&s, shared);
     if let Err(e) = rt_pool::enter(s.pool_bytes) {
         out.error = Some(format!("real-time allocation pool: {e:?}"));
         return out;
     }
     shared.set_phase(Phase::Running);
+    out.cycles = run(&s, shared, &mut core, &mut io, &mut rec);
+    out.pool = rt_pool::thread_stats();
+    // Tear down outside the loop: releasing iceoryx2 resources allocates.
+    drop(io);
+    drop(node);
+    out
+}
 
+/// The loop, one cycle per deadline, until leaving is complete; returns the
+/// cycles run.
+fn run(
+    s: &RtSettings,
+    shared: &Shared,
+    core: &mut Core,
+    io: &mut IoPorts,
+    rec: &mut Recorder,
+) -> u64 {
     let period = s.machine.supervisor.cycle_ns();
     let mut timer = PeriodicTimer::new(period);
-    let mut attached_cycles: u64 = 0;
-    // What the previous cycle did, for the worst wake-ups.
-    let mut prev = crate::stats::LateCycle::default();
-    let mut prev_end_ns: u64 = 0;
-    let mut baseline: Option<(u64, u64)> = None;
     let mut cycle: u64 = 0;
-
     loop {
         let wake = timer.wait();
         cycle += 1;
-
-        // Bounded: the queue holds at most 256 requests.
-        while let Some(c) = shared.control.pop() {
-            if let Some(ack) = core.control(c, wake.deadline_ns) {
-                // The answering side drains this queue every few ms; if it
-                // is full the requester times out and says so.
-                let _ = shared.acks.push(ack);
-            }
+        control_queue(shared, core, wake.deadline_ns);
+        io.receive(core);
+        // Woke more than a quarter cycle late (or missed a deadline): the CPU the
+        // I/O process shares was taken away too, and this thread, of higher
+        // priority, runs first when it comes back.
+        let stalled = wake.missed > 0 || wake.latency_ns > period / 4;
+        let info = io.step(core, wake.deadline_ns, stalled);
+        io.publish(core);
+        let t_published = now_ns();
+        trace_record(shared, core);
+        rec.cycle(
+            shared,
+            &wake,
+            t_published,
+            &info,
+            core.all_attached(),
+            cycle,
+        );
+        if cycle % s.snapshot_every == 0 || core.exiting() {
+            rec.snapshot_handed_over();
+            hand_over_snapshot(shared, core, wake.deadline_ns);
         }
+        let done = core.exit_done();
+        if cycle % s.stats_every == 0 || done {
+            rec.hand_over(shared);
+        }
+        if done {
+            return cycle;
+        }
+        rec.asleep(now_ns());
+    }
+}
 
-        let mut frames: [Option<&FeedbackFrame>; MAX_IOS] = [None; MAX_IOS];
-        for k in 0..n_io {
-            pending[k] = match ports[k].receive_latest() {
+/// Takes every request of the control queue and answers each one.
+/// Bounded: the queue holds at most 256 requests.
+fn control_queue(shared: &Shared, core: &mut Core, now_ns: u64) {
+    while let Some(c) = shared.control.pop() {
+        if let Some(ack) = core.control(c, now_ns) {
+            // The answering side drains this queue every few ms; if it
+            // is full the requester times out and says so.
+            let _ = shared.acks.push(ack);
+        }
+    }
+}
+
+/// This cycle's trace record, if a trace is recording, to the control
+/// thread (counted when the queue is full).
+fn trace_record(shared: &Shared, core: &Core) {
+    if let Some(r) = core.trace_record() {
+        if shared.trace.push(r).is_err() {
+            shared.trace_dropped.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+}
+
+/// A status snapshot to the control thread, in a box from the free queue.
+fn hand_over_snapshot(shared: &Shared, core: &Core, now_ns: u64) {
+    if let Some(mut snap) = shared.snap_free.pop() {
+        core.snapshot(now_ns, &mut snap);
+        if let Err(snap) = shared.snap_full.push(snap) {
+            recycle(&shared.snap_free, snap);
+        }
+    }
+}
+
+/// The frame ports of every I/O process, and the samples received in this
+/// cycle (held until the step has read them, released before the next
+/// receive).
+struct IoPorts {
+    ports: Vec<SupervisorPorts>,
+    pending: Vec<Option<FeedbackSample>>,
+}
+
+impl IoPorts {
+    fn open(node: &Node, s: &RtSettings) -> Result<Self, String> {
+        let mut ports: Vec<SupervisorPorts> = Vec::with_capacity(s.machine.ios.len());
+        for io in &s.machine.ios {
+            let p = SupervisorPorts::create(node, &s.domain, &io.name)
+                .map_err(|e| format!("I/O process {}: {e}", io.name))?;
+            ports.push(p);
+        }
+        let n_io = ports.len().min(MAX_IOS);
+        Ok(Self {
+            ports,
+            pending: (0..n_io).map(|_| None).collect(),
+        })
+    }
+
+    /// The newest feedback frame of every I/O process: the answer to the
+    /// previous command, which arrived while the thread slept.
+    fn receive(&mut self, core: &mut Core) {
+        for (k, (port, slot)) in self.ports.iter_mut().zip(&mut self.pending).enumerate() {
+            *slot = match port.receive_latest() {
                 Ok(sample) => sample,
                 Err(IpcError::Forged { .. } | IpcError::Layout { .. }) => {
                     core.note_refused(k);
@@ -194,105 +283,31 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
                 Err(_) => None,
             };
         }
-        for (slot, p) in frames.iter_mut().zip(&pending) {
-            *slot = p.as_ref().map(|s| s.payload());
+    }
+
+    /// The core's step on the frames received; the samples are released.
+    fn step(&mut self, core: &mut Core, now_ns: u64, stalled: bool) -> CycleInfo {
+        let mut frames: [Option<&FeedbackFrame>; MAX_IOS] = [None; MAX_IOS];
+        for (f, p) in frames.iter_mut().zip(&self.pending) {
+            *f = p.as_ref().map(|s| s.payload());
         }
-        // Woke more than a quarter cycle late (or missed a deadline): the CPU the
-        // I/O process shares was taken away too, and this thread, of higher
-        // priority, runs first when it comes back.
-        let stalled = wake.missed > 0 || wake.latency_ns > period / 4;
-        let info = core.step(wake.deadline_ns, stalled, &frames[..n_io]);
-        // Release the shared-memory samples before the next receive.
-        for p in pending.iter_mut() {
+        let n_io = self.pending.len();
+        let info = core.step(now_ns, stalled, &frames[..n_io]);
+        for p in self.pending.iter_mut() {
             *p = None;
         }
+        info
+    }
 
-        for (k, port) in ports.iter_mut().enumerate() {
+    /// Every I/O process's command frame, published and notified.
+    fn publish(&mut self, core: &mut Core) {
+        for (k, port) in self.ports.iter_mut().enumerate() {
             if let Ok(sent) = port.publish(|f| core.fill(k, f)) {
                 core.sent(k, sent.sequence, now_ns());
             }
             let _ = port.notify();
         }
-        let t_published = now_ns();
-        if let Some(r) = core.trace_record() {
-            if shared.trace.push(r).is_err() {
-                shared.trace_dropped.fetch_add(1, Ordering::Relaxed);
-            }
-        }
-
-        if core.all_attached() {
-            attached_cycles += 1;
-        }
-        if baseline.is_some() {
-            hist.note_late(crate::stats::LateCycle {
-                latency_ns: wake.latency_ns,
-                deadline_ns: wake.deadline_ns,
-                prev_slack_ns: wake.deadline_ns as i64 - prev_end_ns as i64,
-                ..prev
-            });
-            prev.prev_compute_ns = t_published.saturating_sub(wake.woke_ns);
-            prev.prev_snapshot = false;
-            prev.prev_stats = false;
-            hist.wakeup.saturating_record(wake.latency_ns.max(1));
-            hist.compute
-                .saturating_record(t_published.saturating_sub(wake.woke_ns).max(1));
-            if let Some(rt) = info.roundtrip_ns {
-                hist.roundtrip.saturating_record(rt.max(1));
-            }
-            hist.late_replies += u64::from(info.late_replies);
-            if wake.missed > 0 || t_published > wake.deadline_ns + period {
-                hist.deadline_misses += 1;
-            }
-            if hist.start_ns == 0 {
-                hist.start_ns = wake.deadline_ns;
-            }
-            hist.end_ns = wake.deadline_ns;
-            hist.cycles += 1;
-        } else if attached_cycles >= s.warmup_cycles || cycle >= s.warmup_limit {
-            baseline = Some((
-                counting::system_calls_on_this_thread(),
-                rt_pool::thread_stats().map_or(0, |p| p.pool_allocs),
-            ));
-            shared.measuring.store(true, Ordering::Release);
-        }
-
-        if cycle % s.snapshot_every == 0 || core.exiting() {
-            prev.prev_snapshot = true;
-            if let Some(mut snap) = shared.snap_free.pop() {
-                core.snapshot(wake.deadline_ns, &mut snap);
-                if let Err(snap) = shared.snap_full.push(snap) {
-                    recycle(&shared.snap_free, snap);
-                }
-            }
-        }
-        let done = core.exit_done();
-        if cycle % s.stats_every == 0 || done {
-            prev.prev_stats = true;
-            if let Some(fresh) = shared.stats_free.pop() {
-                let full = std::mem::replace(&mut hist, fresh);
-                if let Err(full) = shared.stats_full.push(full) {
-                    recycle(&shared.stats_free, full);
-                }
-            }
-            if let Some((sys0, pool0)) = baseline {
-                let sys = counting::system_calls_on_this_thread() - sys0;
-                let pool = rt_pool::thread_stats().map_or(0, |p| p.pool_allocs) - pool0;
-                shared.system_calls_in_cycle.store(sys, Ordering::Release);
-                shared.pool_allocs_in_cycle.store(pool, Ordering::Release);
-            }
-        }
-        if done {
-            break;
-        }
-        prev_end_ns = now_ns();
     }
-    out.cycles = cycle;
-    out.pool = rt_pool::thread_stats();
-    // Tear down outside the loop: releasing iceoryx2 resources allocates.
-    drop(pending);
-    drop(ports);
-    drop(node);
-    out
 }
 
 /// Puts a box back into circulation; never frees it on this thread (a free

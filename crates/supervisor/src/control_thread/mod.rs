@@ -1,0 +1,242 @@
+//! The control thread: a normal-priority thread of the daemon that serves
+//! the control service, publishes the status service at 100 Hz and collects
+//! what the real-time thread hands over (snapshots, histograms, trace
+//! records, acknowledgements).
+//!
+//! Requests reach the cycle only through the lock-free control queue, and
+//! their answers come back through the acknowledgement queue: the cycle never
+//! waits for this thread, and this thread never holds anything the cycle
+//! needs. `motion-supervisor home` uses this same path (as a client of the
+//! control service), so commissioning and the deployed daemon cannot drift
+//! apart.
+//!
+//! A request is decoded once, at the edge, into a [`Request`]; the rules
+//! are applied to that enum, one concern per function:
+//!
+//! * `axes.rs` — home, stop, unhome, trace: names → axes, the gantry rule,
+//!   the cycle's answer per axis, the keeper, the log line;
+//! * `pages.rs` — status, statistics, trace and histogram log, paged;
+//! * `answer.rs` — the cycle's answers (domain words) as the wire's reasons;
+//! * `pump.rs` — what the cycle hands over (snapshots, histograms, trace
+//!   records, acknowledgements) and the keeper's and I/O processes' news.
+
+pub(crate) mod answer;
+mod axes;
+mod pages;
+mod pump;
+
+pub use pages::io_reports;
+
+use crate::hlog::HlogFile;
+use crate::hub::SharedHub;
+use crate::keeper::Keeper;
+use crate::shared::{Ack, Control, Phase, Shared};
+use crate::status_fill;
+use motion_config::MachineConfig;
+use motion_control::{ControlRequest, ControlResponse, Request, Server};
+use motion_ipc::Domain;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Status frames per second.
+pub const STATUS_HZ: u64 = 100;
+/// How long a request waits for the cycle's answer.
+const ACK_TIMEOUT: Duration = Duration::from_secs(1);
+
+pub struct ControlSettings {
+    pub machine: MachineConfig,
+    pub domain: Domain,
+    /// `run --hlog FILE`.
+    pub hlog_file: Option<PathBuf>,
+    /// Serve the control and status services (false only for the
+    /// benchmark that measures what they cost: then the thread just collects
+    /// what the cycle hands over).
+    pub serve: bool,
+}
+
+/// Readiness of the control thread, for start-up.
+#[derive(Default)]
+pub struct Ready {
+    pub ready: AtomicBool,
+    pub failed: AtomicBool,
+}
+
+pub fn spawn(
+    s: ControlSettings,
+    shared: Arc<Shared>,
+    hub: SharedHub,
+    stop: Arc<AtomicBool>,
+    ready: Arc<Ready>,
+) -> std::io::Result<JoinHandle<()>> {
+    std::thread::Builder::new()
+        .name("motion-control".into())
+        .spawn(move || {
+            let serve = s.serve;
+            let mut t = ControlThread::new(s, shared, hub);
+            if !serve {
+                ready.ready.store(true, Ordering::Release);
+                while !stop.load(Ordering::Acquire) {
+                    t.pump();
+                    std::thread::sleep(Duration::from_millis(2));
+                }
+                t.pump();
+                return;
+            }
+            match Server::create(&t.s.domain) {
+                Ok(server) => {
+                    ready.ready.store(true, Ordering::Release);
+                    t.run(server, &stop);
+                }
+                Err(e) => {
+                    t.hub.lock().control_error = Some(format!("control plane: {e}"));
+                    ready.failed.store(true, Ordering::Release);
+                    // Keep collecting: the final report still needs the data.
+                    while !stop.load(Ordering::Acquire) {
+                        t.pump();
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                    t.pump();
+                }
+            }
+        })
+}
+
+struct ControlThread {
+    s: ControlSettings,
+    shared: Arc<Shared>,
+    hub: SharedHub,
+    acks: Vec<Ack>,
+    next_id: u32,
+    /// The last paged answer, and what it answers.
+    cache: Option<(pages::PageKey, Vec<u8>)>,
+    hlog: Option<HlogFile>,
+    ios: pump::IoWatch,
+    all_mask: u64,
+    keeper: Keeper,
+}
+
+impl ControlThread {
+    fn new(s: ControlSettings, shared: Arc<Shared>, hub: SharedHub) -> Self {
+        let start = hub.lock().start_time;
+        let hlog = s
+            .hlog_file
+            .as_ref()
+            .and_then(|p| match HlogFile::create(p, start) {
+                Ok(f) => Some(f),
+                Err(e) => {
+                    log::error!("{e}");
+                    None
+                }
+            });
+        let orders: Vec<Option<u32>> = s.machine.axes.iter().map(|a| a.home_order).collect();
+        let all_mask = crate::core::sequence::Sequencer::new(&orders).all_mask();
+        let keeper = Keeper::open(&s.machine);
+        Self {
+            keeper,
+            ios: pump::IoWatch::new(s.machine.ios.len()),
+            s,
+            shared,
+            hub,
+            acks: Vec::new(),
+            next_id: 1,
+            cache: None,
+            hlog,
+            all_mask,
+        }
+    }
+
+    fn run(&mut self, mut server: Server, stop: &AtomicBool) {
+        let period = Duration::from_nanos(1_000_000_000 / STATUS_HZ);
+        let mut next_status = Instant::now();
+        loop {
+            self.pump();
+            if let Err(e) = server.serve(|req, resp| self.handle(req, resp)) {
+                log::warn!("control service: {e}");
+            }
+            self.hub.lock().requests_refused = server.refused();
+            if Instant::now() >= next_status {
+                next_status += period;
+                if Instant::now() > next_status {
+                    next_status = Instant::now() + period;
+                }
+                self.publish_status(&mut server);
+            }
+            if stop.load(Ordering::Acquire) {
+                self.pump();
+                self.publish_status(&mut server);
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    fn publish_status(&self, server: &mut Server) {
+        let hub = self.hub.lock();
+        let Some(snap) = hub.snapshot.as_deref() else {
+            return;
+        };
+        let uptime = hub.started.elapsed().as_nanos() as u64;
+        let notes = self.keeper.notes();
+        if let Err(e) =
+            server.publish_status(|f| status_fill::fill(&self.s.machine, snap, notes, uptime, f))
+        {
+            log::warn!("status service: {e}");
+        }
+    }
+
+    /// Sends `c` to the cycle and waits for its answer.
+    fn ask(&mut self, make: impl FnOnce(u32) -> Control) -> Option<Ack> {
+        let id = self.next_id;
+        self.next_id = self.next_id.wrapping_add(1).max(1);
+        let c = make(id);
+        let until = Instant::now() + ACK_TIMEOUT;
+        while !self.shared.send(c) {
+            if Instant::now() > until {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        loop {
+            while let Some(a) = self.shared.acks.pop() {
+                self.acks.push(a);
+            }
+            if let Some(p) = self.acks.iter().position(|a| a.id == id) {
+                return Some(self.acks.swap_remove(p));
+            }
+            if Instant::now() > until || self.shared.phase() != Phase::Running {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
+    /// One request from the control service: decoded here, once.
+    fn handle(&mut self, req: &ControlRequest, r: &mut ControlResponse) {
+        match Request::decode(req) {
+            Ok(Request::Home {
+                axes,
+                parallel,
+                timeout_s,
+            }) => self.home(&axes, parallel, timeout_s, r),
+            Ok(Request::Stop { axes }) => self.stop(&axes, r),
+            Ok(Request::Unhome { axes }) => self.unhome(&axes, r),
+            Ok(Request::Trace { axes }) => self.trace(&axes, r),
+            Ok(Request::Status) => self.status(r),
+            Ok(Request::Stats {
+                since,
+                reset,
+                offset,
+            }) => self.paged(pages::PageKey::Stats(since), reset, offset, r),
+            Ok(Request::Hlog { since, offset }) => {
+                self.paged(pages::PageKey::Hlog(since), false, offset, r)
+            }
+            Ok(Request::TraceFetch { axis, offset }) => {
+                self.paged(pages::PageKey::Trace(axis), false, offset, r)
+            }
+            Err(e) => r.bad_request(&e.to_string()),
+        }
+    }
+}
