@@ -70,7 +70,10 @@ pub fn counts_to_units(counts: i64, counts_per_unit: f64) -> f64 {
 /// units/s (or a tolerance in units) → counts/s, not rounded.
 fn rate_to_counts(units: f64, counts_per_unit: f64) -> f64 {
     if cpu_usable(counts_per_unit) {
-        units * counts_per_unit
+        // A finite rate that overflows in counts saturates, as positions do
+        // in `units_to_counts`: a reading stays a (huge) number, never ±∞.
+        // NaN stays NaN (`clamp` keeps it): the receiver refuses it.
+        (units * counts_per_unit).clamp(-f64::MAX, f64::MAX)
     } else {
         f64::NAN
     }
@@ -281,6 +284,12 @@ mod tests {
             counts_to_units(i64::MIN + 1, CPU),
             (i64::MIN + 1) as f64 / CPU
         );
+        // A finite rate that overflows in counts saturates like a position
+        // (found by motion-io's command-frame fuzz test: a watchdog stop
+        // of a huge time step after a garbage command).
+        assert_eq!(rate_to_counts(f64::MAX, CPU), f64::MAX);
+        assert_eq!(rate_to_counts(-f64::MAX, CPU), -f64::MAX);
+        assert!(rate_to_counts(f64::NAN, CPU).is_nan());
     }
 
     #[test]
