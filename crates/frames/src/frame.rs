@@ -65,8 +65,12 @@ pub const FEEDBACK_FRAME_TYPE_NAME: &str = concat!(
 );
 
 /// [`AxisCommand::control_word`] bit 0: request the power stage on.
-/// Bits 1..=15 are reserved: sent as 0, ignored by the receiver.
 pub const CW_ENABLE: u16 = 1 << 0;
+/// [`AxisCommand::control_word`] bit 1: fault reset (MAFR). Its rising edge
+/// asks the drive to clear a fault: CiA 402 control word bit 7 on EtherCAT,
+/// the plant's fault in the `sim`. It never enables anything by itself.
+/// Bits 2..=15 are reserved: sent as 0, ignored by the receiver.
+pub const CW_FAULT_RESET: u16 = 1 << 1;
 
 /// [`AxisFeedback::status_word`] bit 0: power stage on and following the command.
 pub const SW_ENABLED: u16 = 1 << 0;
