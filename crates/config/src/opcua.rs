@@ -205,12 +205,12 @@ fn policies(r: &mut Reader, value: Option<&toml::Value>) -> Vec<Policy> {
     for s in list {
         match Policy::NAMES.iter().find(|(n, _)| *n == s) {
             Some((_, p)) if !out.contains(p) => out.push(*p),
-            Some(_) => r.problem("policies", format!("{} listed twice", names::shown(&s))),
+            Some(_) => r.problem("policies", format!("{} listed twice", names::shown(s))),
             None => r.problem(
                 "policies",
                 format!(
                     "{} is not one of {}",
-                    names::shown(&s),
+                    names::shown(s),
                     Policy::NAMES
                         .iter()
                         .map(|(n, _)| format!("\"{n}\""))
