@@ -178,7 +178,8 @@ async def expect_error(coro):
 
 
 async def anon_call(a):
-    async with await client(a) as c:
+    """A method call by an anonymous session, or by `--login` (a viewer)."""
+    async with await client(a, user=a.login, password=a.password) as c:
         ns, ax = await axis_node(c, a.axis)
         err = await expect_error(ax.call_method(f"{ns}:Home", ua.Variant(0.0, ua.VariantType.Double)))
         return {"error": err}
@@ -274,6 +275,7 @@ def main():
     p.add_argument("--name", default="client")
     p.add_argument("--other", default="stranger")
     p.add_argument("--user", default="op1")
+    p.add_argument("--login", default=None)
     p.add_argument("--password", default="")
     p.add_argument("--axis", default="X")
     p.add_argument("--want", default="true")
