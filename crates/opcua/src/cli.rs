@@ -13,6 +13,10 @@ pub struct Cli {
     /// The machine config (the daemon's), with its [opcua] section.
     #[arg(long, value_name = "FILE")]
     pub config: PathBuf,
+    /// The daemon's runtime directory (its session file), as given to
+    /// `motion-supervisor run --runtime-dir`; default: the config's.
+    #[arg(long, value_name = "DIR")]
+    pub runtime_dir: Option<PathBuf>,
     #[command(subcommand)]
     pub command: Option<Command>,
 }

@@ -28,7 +28,7 @@ fn main() {
         }
         return;
     }
-    let (machine, cfg) = match motion_config::opcua::load(&cli.config) {
+    let (mut machine, cfg) = match motion_config::opcua::load(&cli.config) {
         Ok(x) => x,
         Err(problems) => {
             for p in problems {
@@ -37,6 +37,13 @@ fn main() {
             std::process::exit(2);
         }
     };
+    if let Some(d) = cli.runtime_dir {
+        if let Err(e) = motion_config::args::runtime_dir(&d.to_string_lossy()) {
+            eprintln!("motion-opcua: --runtime-dir: {e}");
+            std::process::exit(2);
+        }
+        machine.supervisor.runtime_dir = Some(d);
+    }
     let r = match cli.command {
         Some(Command::HashPassword) => Ok(()),
         Some(Command::Trust { cert }) => motion_opcua::pki::trust(&cfg.pki_dir, &cert).map(|to| {
