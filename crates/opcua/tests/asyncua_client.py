@@ -185,6 +185,16 @@ async def anon_call(a):
         return {"error": err}
 
 
+async def none_call(a):
+    """Over the None endpoint (when configured): reads work, calls do not."""
+    c = Client(a.url, timeout=10)
+    async with c:
+        ns, ax = await axis_node(c, a.axis)
+        homed = await (await ax.get_child([f"{ns}:HomedStatus"])).read_value()
+        err = await expect_error(ax.call_method(f"{ns}:Home", ua.Variant(0.0, ua.VariantType.Double)))
+        return {"read": homed, "error": err}
+
+
 async def wrong_password(a):
     c = await client(a, user=a.user, password=a.password + "x")
     return {"error": await expect_error(c.connect())}
@@ -263,7 +273,7 @@ async def latency(a):
 
 
 SCENARIOS = {f.__name__.replace("_", "-"): f for f in
-             (gen_cert, endpoints, browse, home, er_event, anon_call, wrong_password,
+             (gen_cert, endpoints, browse, home, er_event, anon_call, none_call, wrong_password,
               untrusted, fuzz, connected, latency)}
 
 

@@ -442,7 +442,34 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
     assert_eq!(rig.ua("connected", &["--want", "true"])["connected"], true);
     let b = rig.ua("browse", &[]);
     assert_eq!(b["axes"]["X"]["HomedStatus"]["status"], "Good", "{b}");
+    assert_eq!(
+        Rig::stop(&mut rig.opcua),
+        Some(0),
+        "{}",
+        rig.text("opcua.err")
+    );
 
+    // A None endpoint only when configured, and then anonymous and read-only.
+    let text = std::fs::read_to_string(&rig.config).unwrap().replace(
+        "[opcua]\n",
+        "[opcua]\npolicies = [\"Basic256Sha256\", \"None\"]\n",
+    );
+    std::fs::write(&rig.config, text).unwrap();
+    rig.start_opcua();
+    rig.wait_log("opcua.err", "the None policy is offered", 1);
+    rig.wait_log("opcua.err", "Now listening", 3);
+    let eps = rig.ua("endpoints", &[]);
+    let none: Vec<&Value> = eps["endpoints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e[0] == "None")
+        .collect();
+    assert_eq!(none.len(), 1, "{eps}");
+    assert_eq!(none[0][2], serde_json::json!(["Anonymous"]), "{eps}");
+    let v = rig.ua("none-call", &[]);
+    assert!(v["read"].is_boolean(), "{v}");
+    assert_eq!(err_of(&v), "BadUserAccessDenied", "{v}");
     assert_eq!(
         Rig::stop(&mut rig.opcua),
         Some(0),
