@@ -46,16 +46,16 @@ REL = ROOT / "target/release"
 
 EXTRA_AXIS = """
 [[axis]]
-name = "I"
+name = "I"                  # homed at once, where it stands
+home_sequence = "immediate"
+home_mode = "active"
+home_position = 0.0
+home_timeout = 5.0
+counts_per_unit = 1000.0
 configuration = "servo"
 control_mode = "position"
 travel = "linear"
-counts_per_unit = 1000.0
 marker = false
-home_mode = "active"
-home_sequence = "immediate"
-home_position = 0.0
-home_timeout = 5.0
 """
 
 

@@ -329,6 +329,9 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
     assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
     let v = rig.ua("untrusted", &["--other", "stranger"]);
     assert!(err_of(&v).contains("Untrusted"), "{v}");
+    // The refusal is logged with the certificate's name and thumbprint.
+    let log = rig.text("opcua.err");
+    assert!(log.contains("CN=urn:motion-test:stranger ["), "{log}");
 
     // Browse and read every axis's variables (anonymous).
     let b = rig.ua("browse", &[]);
