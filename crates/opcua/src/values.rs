@@ -77,13 +77,13 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
     }
 
     fn put(
-        &mut self,
+        last: &mut HashMap<NodeId, Option<Variant>>,
         out: &mut Vec<(NodeId, DataValue)>,
         id: &NodeId,
         v: Option<Variant>,
         t: DateTime,
     ) {
-        if self.last.get(id) == Some(&v) {
+        if last.get(id) == Some(&v) {
             return;
         }
         // The stack drops the status of a value-less DataValue: an empty
@@ -93,7 +93,7 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
             None => (Variant::Empty, StatusCode::BadNoCommunication),
         };
         out.push((id.clone(), data_value(value, status, t)));
-        self.last.insert(id.clone(), v);
+        last.insert(id.clone(), v);
     }
 
     fn write(&self, out: Vec<(NodeId, DataValue)>) {
@@ -113,18 +113,14 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
         let mut out = Vec::new();
         let names = f.axis_names();
         for (a, name) in f.axes().iter().zip(&names) {
-            let ids = self
-                .axis_ids
-                .entry(name.clone())
-                .or_insert_with(|| {
-                    AXIS_LIVE
-                        .iter()
-                        .map(|v| axis_var_id(ns, name, v.name))
-                        .collect()
-                })
-                .clone();
-            for (v, id) in AXIS_LIVE.iter().zip(&ids) {
-                self.put(&mut out, id, (v.read)(a, &names), t);
+            let ids = self.axis_ids.entry(name.clone()).or_insert_with(|| {
+                AXIS_LIVE
+                    .iter()
+                    .map(|v| axis_var_id(ns, name, v.name))
+                    .collect()
+            });
+            for (v, id) in AXIS_LIVE.iter().zip(ids.iter()) {
+                Self::put(&mut self.last, &mut out, id, (v.read)(a, &names), t);
             }
             let er = a.has(ST_ER);
             let was = self.er.insert(name.clone(), er).unwrap_or(er);
@@ -136,18 +132,14 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
         }
         for io in f.ios() {
             let name = get_str(&io.name);
-            let ids = self
-                .io_ids
-                .entry(name.clone())
-                .or_insert_with(|| {
-                    IO_VARS
-                        .iter()
-                        .map(|v| io_var_id(ns, &name, v.name))
-                        .collect()
-                })
-                .clone();
-            for (v, id) in IO_VARS.iter().zip(&ids) {
-                self.put(&mut out, id, Some((v.read)(io)), t);
+            let ids = self.io_ids.entry(name.clone()).or_insert_with(|| {
+                IO_VARS
+                    .iter()
+                    .map(|v| io_var_id(ns, &name, v.name))
+                    .collect()
+            });
+            for (v, id) in IO_VARS.iter().zip(ids.iter()) {
+                Self::put(&mut self.last, &mut out, id, Some((v.read)(io)), t);
             }
         }
         for (name, v) in [
@@ -156,7 +148,13 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
             ("CycleTime", Variant::from(f.cycle_us)),
             ("Uptime", Variant::from(f.uptime_ns as f64 / 1e9)),
         ] {
-            self.put(&mut out, &id(ns, &format!("Machine.{name}")), Some(v), t);
+            Self::put(
+                &mut self.last,
+                &mut out,
+                &id(ns, &format!("Machine.{name}")),
+                Some(v),
+                t,
+            );
         }
         // Nodes the daemon does not know (another config?) fail the whole
         // write: keep only ours.
@@ -179,7 +177,8 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
             ("DeadlineMisses", l.deadline_misses),
             ("LateReplies", l.late_replies),
         ] {
-            self.put(
+            Self::put(
+                &mut self.last,
                 &mut out,
                 &id(ns, &format!("Machine.Latency.{name}")),
                 Some(v.into()),
@@ -193,7 +192,7 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
         {
             for (col, v) in LATENCY_COLUMNS.iter().zip(p.values()) {
                 let nid = id(ns, &format!("Machine.Latency.{series}.{col}"));
-                self.put(&mut out, &nid, Some(v.into()), t);
+                Self::put(&mut self.last, &mut out, &nid, Some(v.into()), t);
             }
         }
         self.write(out);
@@ -219,7 +218,7 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
             .collect();
         // `last` is empty now: the first frame after a reconnect writes
         // every value again.
-        self.put(&mut out, &connected, Some(false.into()), t);
+        Self::put(&mut self.last, &mut out, &connected, Some(false.into()), t);
         self.anchor = None;
         self.er.clear();
         self.write(out);
