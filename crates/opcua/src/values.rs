@@ -1,12 +1,15 @@
 //! Status frames and statistics into variable values.
 //!
 //! Only values that changed are written, each with the source timestamp
-//! of the cycle that produced it: the frame's cycle × cycle time, placed
-//! on the wall clock by the smallest (arrival − cycle × cycle time) seen in
-//! this daemon session — the cycle's own time plus the fastest the frame
-//! ever came (a constant, below a millisecond here). Monitored items with
-//! a sampling interval of 10 ms or less and a queue see every change the
-//! status service (100 Hz) carries.
+//! of the status frame that carried it: when the daemon published it (the
+//! frame's uptime), placed on the wall clock by the smallest (arrival −
+//! uptime) seen in this daemon session — the fastest a frame ever came,
+//! well below a millisecond. The frame holds the snapshot of a cycle at
+//! most one status period (10 ms) earlier. Not cycle × cycle time: the
+//! cycle counter skips the periods a late wake-up missed, so it falls
+//! behind the clock on a noisy host. Monitored items with a sampling
+//! interval of 10 ms or less and a queue see every change the status
+//! service (100 Hz) carries.
 //!
 //! An axis's ER going from false to true raises [`crate::events`]'s event.
 //! Without the daemon every live value turns `BadNoCommunication` (the last
@@ -24,9 +27,6 @@ use opcua::types::{DataValue, DateTime, NodeId, StatusCode, Variant};
 use std::collections::HashMap;
 use std::sync::Arc;
 
-/// 100 ns ticks per microsecond.
-const TICKS_PER_US: i64 = 10;
-
 /// Writes values into the address space and tells the subscriptions.
 pub struct Publisher<T: InMemoryNodeManagerImpl> {
     ns: u16,
@@ -37,7 +37,7 @@ pub struct Publisher<T: InMemoryNodeManagerImpl> {
     /// Node ids per axis name, in [`AXIS_LIVE`] order.
     axis_ids: HashMap<String, Vec<NodeId>>,
     io_ids: HashMap<String, Vec<NodeId>>,
-    /// Daemon session and wall-clock ticks of its cycle 0.
+    /// Daemon session and the wall-clock ticks of its uptime 0.
     anchor: Option<(u32, i64)>,
     /// ER per axis name, to see it rise.
     er: HashMap<String, bool>,
@@ -61,11 +61,11 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
         }
     }
 
-    /// The source timestamp of `f`'s cycle.
+    /// The source timestamp of `f`: when the daemon published it.
     fn source_time(&mut self, f: &StatusFrame) -> DateTime {
         let now = DateTime::now().ticks();
-        let since_start = (f.cycle as i64).saturating_mul(i64::from(f.cycle_us) * TICKS_PER_US);
-        let seen = now - since_start;
+        let since_start = i64::try_from(f.uptime_ns / 100).unwrap_or(i64::MAX / 2);
+        let seen = now.saturating_sub(since_start);
         let anchor = match self.anchor {
             Some((session, a)) if session == f.session && a <= seen && seen - a < 10_000_000 => a,
             // First frame of a session, a frame faster than any before, or
