@@ -21,6 +21,7 @@ mod io;
 mod keys;
 pub mod limits;
 pub mod names;
+pub mod opcua;
 mod problem;
 mod supervisor;
 
@@ -220,6 +221,7 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
     let io_tables = top.array_of_tables("io");
     let axis_tables = top.array_of_tables("axis");
     let gantry_tables = top.array_of_tables("gantry");
+    let opcua_table = top.table("opcua");
     top.finish();
 
     let supervisor = supervisor::parse(sup_table.as_ref(), &mut problems, &mut warnings);
@@ -251,6 +253,12 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
     }
     ethercat::parse::checks(&ios, &axes, &mut problems);
     let gantries = gantry::parse(&gantry_tables, &axes, &mut problems);
+    opcua::parse(
+        opcua_table.as_ref(),
+        &axes,
+        &supervisor.state_dir,
+        &mut problems,
+    );
     for (k, io) in ios.iter().enumerate() {
         if !axes.iter().any(|a| a.io == k) && problems.is_empty() {
             warnings.push(format!("I/O process {} drives no axis", io.name));

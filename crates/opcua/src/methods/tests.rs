@@ -1,0 +1,163 @@
+//! The method handlers' decoding and answering, fuzzed: any argument list
+//! (names, NaN, huge numbers, wrong types, too few or too many) is decoded
+//! into a bounded request or refused with a status — never a panic — and
+//! any control answer becomes outputs matching the declared arguments.
+
+use super::*;
+use opcua::types::{LocalizedText, UAString};
+use proptest::prelude::*;
+
+fn any_variant() -> impl Strategy<Value = Variant> {
+    let name = prop_oneof![
+        "[A-Za-z0-9_.-]{0,40}",
+        any::<String>(),
+        Just("X\0Y".to_string()),
+        Just("x".repeat(33)),
+    ];
+    prop_oneof![
+        Just(Variant::Empty),
+        any::<bool>().prop_map(Variant::from),
+        any::<f64>().prop_map(Variant::from),
+        prop_oneof![
+            Just(f64::NAN),
+            Just(f64::INFINITY),
+            Just(-1.0),
+            Just(1e308),
+            Just(86_400.0),
+            Just(86_400.5),
+            Just(0.0)
+        ]
+        .prop_map(Variant::from),
+        any::<f32>().prop_map(Variant::from),
+        any::<i64>().prop_map(Variant::from),
+        any::<u16>().prop_map(Variant::from),
+        name.clone().prop_map(|s| Variant::from(UAString::from(s))),
+        proptest::collection::vec(name, 0..70)
+            .prop_map(|v| { Variant::from(v.into_iter().map(UAString::from).collect::<Vec<_>>()) }),
+        proptest::collection::vec(any::<i32>(), 0..5).prop_map(Variant::from),
+        Just(Variant::from(LocalizedText::new("", "X"))),
+    ]
+}
+
+fn check_request(op: &Operation) {
+    let r = op.request();
+    assert!((r.axis_count as usize) <= MAX_AXES);
+    assert!(r.timeout_s.is_finite() && (0.0..=MAX_TIMEOUT_S).contains(&r.timeout_s));
+    assert!(matches!(r.kind, REQ_HOME | REQ_STOP | REQ_UNHOME));
+    let names = r.axis_names();
+    match op {
+        Operation::Home { axes, .. } | Operation::Stop { axes } | Operation::Unhome { axes } => {
+            assert_eq!(&names, axes, "every name carried as given");
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn any_arguments_are_decoded_or_refused(
+        m in 0..METHODS.len(),
+        axis in prop_oneof![Just(None), Just(Some("X")), "[A-Z]{1,3}".prop_map(|s| Some(Box::leak(s.into_boxed_str()) as &str))],
+        args in proptest::collection::vec(any_variant(), 0..5),
+    ) {
+        let spec = &METHODS[m];
+        match decode(spec, axis, &args) {
+            Ok(op) => {
+                prop_assert_eq!(args.len(), spec.inputs.len());
+                check_request(&op);
+                if spec.scope == Scope::Axis {
+                    let r = op.request();
+                    prop_assert_eq!(r.axis_names(), vec![axis.unwrap().to_string()]);
+                }
+            }
+            Err(CallError::Status(s)) => prop_assert!(s.is_bad()),
+            Err(CallError::Args(a)) => {
+                prop_assert_eq!(a.len(), args.len());
+                prop_assert!(a.iter().any(|s| s.is_bad()));
+            }
+        }
+    }
+
+    #[test]
+    fn any_answer_becomes_declared_outputs(
+        result in 0u32..6,
+        n in 0u32..80,
+        accepted in any::<bool>(),
+        reason in any::<u8>(),
+        err in any::<u16>(),
+        msg in any::<String>(),
+    ) {
+        let mut r = ControlResponse::zeroed();
+        r.result = result;
+        r.axis_count = n; // hostile counts are clamped by answers()
+        for a in r.axes.iter_mut() {
+            put_str(&mut a.name, "X");
+            a.accepted = accepted as u8;
+            a.reason = reason;
+            a.err = err;
+        }
+        put_str(&mut r.message, &msg);
+        for scope in [Scope::Axis, Scope::Machine] {
+            let out = outputs(scope, &r);
+            prop_assert_eq!(out.len(), output_args(scope).len());
+        }
+        let s = status_of(&r);
+        prop_assert_eq!(s.is_good(), result == RESULT_ACCEPTED);
+    }
+}
+
+#[test]
+fn a_home_call_carries_its_timeout_and_refusals_say_why() {
+    let home = spec("Home", Scope::Axis).unwrap();
+    assert_eq!(
+        decode(home, Some("X"), &[Variant::from(5.0)]),
+        Ok(Operation::Home {
+            axes: vec!["X".into()],
+            parallel: false,
+            timeout_s: 5.0
+        })
+    );
+    assert_eq!(
+        decode(home, Some("X"), &[Variant::from(f64::NAN)]),
+        Err(CallError::Args(vec![StatusCode::BadOutOfRange]))
+    );
+    assert_eq!(
+        decode(home, Some("X"), &[Variant::from("5")]),
+        Err(CallError::Args(vec![StatusCode::BadTypeMismatch]))
+    );
+    assert_eq!(
+        decode(home, Some("X"), &[]),
+        Err(CallError::Status(StatusCode::BadArgumentsMissing))
+    );
+    let all = spec("HomeAll", Scope::Machine).unwrap();
+    let op = decode(
+        all,
+        None,
+        &[
+            Variant::from(vec![UAString::from("X"), UAString::from("Z")]),
+            Variant::from(true),
+            Variant::from(0.0),
+        ],
+    )
+    .unwrap();
+    assert_eq!(op.request().flags, FLAG_PARALLEL);
+    // A refusal: BadInvalidState with the reason and ERR/EXERR as outputs.
+    let mut r = ControlResponse::zeroed();
+    r.result = RESULT_REFUSED;
+    r.axis_count = 1;
+    put_str(&mut r.axes[0].name, "X");
+    r.axes[0].reason = REASON_INSTRUCTION;
+    r.axes[0].err = 41;
+    r.axes[0].exerr = 20;
+    assert_eq!(status_of(&r), StatusCode::BadInvalidState);
+    let out = outputs(Scope::Axis, &r);
+    assert_eq!(out[0], Variant::from(false));
+    assert_eq!(out[1], Variant::from("refused by the Home instruction"));
+    assert_eq!(
+        (out[2].clone(), out[3].clone()),
+        (Variant::from(41u16), Variant::from(20u16))
+    );
+    r.axes[0].reason = REASON_UNKNOWN_AXIS;
+    assert_eq!(status_of(&r), StatusCode::BadInvalidArgument);
+}

@@ -1,0 +1,161 @@
+//! `motion-opcua --config FILE`: the server.
+//!
+//! Endpoints: one per configured policy, all Sign & Encrypt (a configured
+//! `None` policy adds an unsecured endpoint for anonymous readers only),
+//! at `[opcua] endpoint` (127.0.0.1:4840 by default). Client certificates
+//! must be trusted ([`crate::pki`]); users per [`crate::auth`]. The values
+//! come from the bridge thread ([`crate::bridge`]), which joins the daemon
+//! like `motionctl`.
+
+use crate::auth::Roles;
+use crate::bridge::{self, Handle, Target};
+use crate::manager::{Builder, MachineManager};
+use crate::values::Publisher;
+use crate::{pki, space::NAMESPACE_URI};
+use motion_config::opcua::{OpcuaConfig, Policy};
+use motion_config::MachineConfig;
+use opcua::crypto::SecurityPolicy;
+use opcua::server::node_manager::memory::{InMemoryNodeManager, InMemoryNodeManagerBuilder};
+use opcua::server::{ServerBuilder, ServerEndpoint, ANONYMOUS_USER_TOKEN_ID};
+use opcua::types::MessageSecurityMode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Sampling and publishing as fast as the status service publishes.
+pub const MIN_INTERVAL_MS: f64 = 10.0;
+/// Values a monitored item may queue (a 10 s publishing interval at 100 Hz).
+pub const MAX_QUEUE: usize = 1000;
+
+fn stack_policy(p: Policy) -> (SecurityPolicy, MessageSecurityMode) {
+    match p {
+        Policy::Basic256Sha256 => (
+            SecurityPolicy::Basic256Sha256,
+            MessageSecurityMode::SignAndEncrypt,
+        ),
+        Policy::Aes128Sha256RsaOaep => (
+            SecurityPolicy::Aes128Sha256RsaOaep,
+            MessageSecurityMode::SignAndEncrypt,
+        ),
+        Policy::Aes256Sha256RsaPss => (
+            SecurityPolicy::Aes256Sha256RsaPss,
+            MessageSecurityMode::SignAndEncrypt,
+        ),
+        Policy::None => (SecurityPolicy::None, MessageSecurityMode::None),
+    }
+}
+
+/// The server, configured (not yet running).
+fn builder(
+    machine: &MachineConfig,
+    cfg: &OpcuaConfig,
+    roles: Arc<Roles>,
+    bridge: Handle,
+) -> ServerBuilder {
+    let mut b = ServerBuilder::new()
+        .application_name("motion-opcua")
+        .application_uri(pki::application_uri())
+        .product_uri(NAMESPACE_URI)
+        .host(cfg.host.clone())
+        .port(cfg.port)
+        .pki_dir(cfg.pki_dir.clone())
+        .certificate_path(pki::CERT)
+        .private_key_path(pki::KEY)
+        .create_sample_keypair(false)
+        .trust_client_certs(false)
+        .check_cert_time(true)
+        .discovery_urls(vec![cfg.endpoint.clone()])
+        .subscription_poll_interval_ms(MIN_INTERVAL_MS as u64)
+        .with_authenticator(roles.clone())
+        .with_node_manager(InMemoryNodeManagerBuilder::new(Builder {
+            machine: machine.clone(),
+            cfg: cfg.clone(),
+            roles,
+            bridge,
+        }));
+    let anon = [ANONYMOUS_USER_TOKEN_ID.to_string()];
+    for p in &cfg.policies {
+        let (policy, mode) = stack_policy(*p);
+        b = b.add_endpoint(
+            p.name(),
+            ServerEndpoint::new(cfg.path.clone(), policy, mode, &anon),
+        );
+    }
+    if let Some(p) = cfg.policies.iter().find(|p| **p != Policy::None) {
+        b = b.default_endpoint(p.name());
+    }
+    let l = b.limits_mut();
+    l.subscriptions.min_sampling_interval_ms = MIN_INTERVAL_MS;
+    l.subscriptions.min_publishing_interval_ms = MIN_INTERVAL_MS;
+    l.subscriptions.max_monitored_item_queue_size = MAX_QUEUE;
+    b
+}
+
+/// Serves until SIGINT/SIGTERM. Returns the exit code.
+pub async fn serve(machine: MachineConfig, cfg: OpcuaConfig) -> Result<(), String> {
+    for u in &cfg.users {
+        crate::password::parses(&u.password_hash)
+            .map_err(|e| format!("[[opcua.user]] {}: password_hash: {e}", u.name))?;
+    }
+    if pki::ensure(&cfg.pki_dir, &cfg.host)? {
+        log::info!(
+            "created the server certificate {} and its key (0600)",
+            cfg.pki_dir.join(pki::CERT).display()
+        );
+    }
+    if cfg.offers_none() {
+        log::warn!("the None policy is offered (configured): anonymous, read-only sessions there");
+    }
+    let roles = Arc::new(Roles::new(&cfg));
+    let (tx, rx) = std::sync::mpsc::channel();
+    let (server, handle) = builder(&machine, &cfg, roles, Handle { jobs: tx })
+        .build()
+        .map_err(|e| format!("OPC UA server: {e}"))?;
+    let manager = handle
+        .node_managers()
+        .get_of_type::<InMemoryNodeManager<MachineManager>>()
+        .ok_or("OPC UA server: our node manager is missing")?;
+    let ns = handle
+        .get_namespace_index(NAMESPACE_URI)
+        .ok_or("OPC UA server: our namespace is missing")?;
+    let publisher = Publisher::new(ns, manager, handle.subscriptions().clone());
+    let stop = Arc::new(AtomicBool::new(false));
+    let target = Target {
+        prefix: machine.supervisor.service_prefix.clone(),
+        runtime_dir: machine.supervisor.runtime_dir.clone(),
+    };
+    let bridge_stop = stop.clone();
+    let thread = std::thread::Builder::new()
+        .name("motion-bridge".into())
+        .spawn(move || bridge::run(target, publisher, rx, bridge_stop))
+        .map_err(|e| format!("cannot start the bridge thread: {e}"))?;
+    let h = handle.clone();
+    tokio::spawn(async move {
+        use tokio::signal::unix::{signal, SignalKind};
+        let (Ok(mut int), Ok(mut term)) = (
+            signal(SignalKind::interrupt()),
+            signal(SignalKind::terminate()),
+        ) else {
+            return;
+        };
+        tokio::select! {
+            _ = int.recv() => {}
+            _ = term.recv() => {}
+        }
+        log::info!("stopping");
+        h.cancel();
+    });
+    log::info!(
+        "serving {} ({}) for the supervisor with service prefix {:?}",
+        cfg.endpoint,
+        cfg.policies
+            .iter()
+            .map(|p| p.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+        machine.supervisor.service_prefix
+    );
+    let r = server.run().await;
+    stop.store(true, Ordering::Release);
+    let _ = thread.join();
+    r.map_err(|e| format!("OPC UA server: {e}"))
+}
