@@ -21,13 +21,16 @@ fn systemd_units_verify() {
     for (unit, as_name) in [
         ("motion-supervisor.service", "motion-supervisor.service"),
         ("motion-io@.service", "motion-io@bus0.service"),
+        ("motion-opcua.service", "motion-opcua.service"),
     ] {
         let text = std::fs::read_to_string(format!("{deploy}/{unit}")).unwrap();
         let sup = bin("motion-supervisor");
         let io = bin("motion-io");
+        let opcua = bin("motion-opcua");
         let text = text
             .replace("/usr/bin/motion-supervisor", sup.to_str().unwrap())
-            .replace("/usr/bin/motion-io", io.to_str().unwrap());
+            .replace("/usr/bin/motion-io", io.to_str().unwrap())
+            .replace("/usr/bin/motion-opcua", opcua.to_str().unwrap());
         let path = dir.path().join(as_name);
         std::fs::write(&path, text).unwrap();
         files.push(path);

@@ -46,11 +46,12 @@ fn release_date(changelog: &str) -> Option<String> {
 }
 
 /// The shipped binaries' command lines.
-fn commands() -> [clap::Command; 3] {
+fn commands() -> [clap::Command; 4] {
     [
         motion_supervisor::cli::Cli::command(),
         motion_io::cli::Options::command(),
         motionctl::cli::Cli::command(),
+        motion_opcua::cli::Cli::command(),
     ]
 }
 
@@ -184,6 +185,9 @@ mod tests {
             "man/motionctl-unhome.1.gz",
             "man/motionctl-stats.1.gz",
             "man/motionctl-trace.1.gz",
+            "man/motion-opcua.1.gz",
+            "man/motion-opcua-trust.1.gz",
+            "completions/bash/motion-opcua",
             "completions/bash/motionctl",
             "completions/zsh/_motion-io",
             "completions/fish/motion-supervisor.fish",
