@@ -2,9 +2,9 @@
 //! `motion_rt::host`), other real-time threads seen while it runs, the
 //! bench's own threads set up like the cycle's, and the programs it starts.
 
-pub use motion_rt::host::{cpus, kernel, loadavg, other_rt_tasks, preemption, RtTask};
+pub use motion_harness::bins::{beside_this_exe, find_in_path, is_executable};
+pub use motion_rt::host::{cpus, kernel, loadavg, other_rt_tasks, preemption};
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
 
 /// The kernel and its real-time settings, read once at the start.
 pub struct Env {
@@ -33,13 +33,8 @@ impl Env {
     /// `kernel K | preemption: P | N CPUs`: how every report's second line
     /// starts.
     pub fn head(&self) -> String {
-        let Env {
-            kernel,
-            preemption,
-            cpus,
-            ..
-        } = self;
-        format!("kernel {kernel} | preemption: {preemption} | {cpus} CPUs")
+        let (k, p, n) = (&self.kernel, &self.preemption, self.cpus);
+        format!("kernel {k} | preemption: {p} | {n} CPUs")
     }
 }
 
@@ -54,8 +49,10 @@ pub struct OtherRt {
 
 impl OtherRt {
     pub fn new(bench: &'static str) -> Self {
-        let seen = BTreeSet::new();
-        Self { bench, seen }
+        Self {
+            bench,
+            seen: BTreeSet::new(),
+        }
     }
 
     /// Looks for other real-time threads now (`when` says when, for the
@@ -119,23 +116,4 @@ pub fn can_use_fifo(priority: i32) -> Result<(), String> {
     })
     .join()
     .unwrap_or_else(|_| Err("probe thread panicked".into()))
-}
-
-/// `name` in `$PATH`.
-pub fn find_in_path(name: &str) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|d| d.join(name))
-        .find(|p| is_executable(p))
-}
-
-pub fn is_executable(p: &Path) -> bool {
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
-}
-
-/// `name` in the directory of this executable (`target/release/`).
-pub fn sibling_exe(name: &str) -> Option<PathBuf> {
-    let p = std::env::current_exe().ok()?.parent()?.join(name);
-    is_executable(&p).then_some(p)
 }

@@ -5,8 +5,10 @@
 //! (0; 1 if something failed; 130 if interrupted, the partial results
 //! printed and written all the same).
 
-use crate::host::{Env, OtherRt};
+use crate::flags::Cycle;
+use crate::host::{loadavg, Env, OtherRt};
 use crate::proc;
+use crate::table::Text;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -63,6 +65,36 @@ impl Bench {
             "rt_throttling": e.throttling,
             "other_rt_threads": self.other_rt.list(),
         })
+    }
+
+    /// `kernel … | preemption: … | N CPUs | load before B, after A | wall
+    /// W s`: the second line of the soak's and deadpeer's reports.
+    pub fn load_line(&self, wall: f64) -> String {
+        let (head, before, after) = (self.env.head(), &self.env.load_before, loadavg());
+        format!("{head} | load before {before}, after {after} | wall {wall:.0} s")
+    }
+
+    /// What the soak's and deadpeer's JSON start with: the cycle, the
+    /// kernel, the load before and after, the wall time.
+    pub fn json_head(&self, cy: &Cycle, wall: f64) -> Value {
+        json!({
+            "period_us": cy.period_us,
+            "cpu": cy.cpu,
+            "priority": cy.priority,
+            "kernel": self.env.kernel,
+            "preemption": self.env.preemption,
+            "load_before": self.env.load_before,
+            "load_after": loadavg(),
+            "wall_s": wall,
+        })
+    }
+
+    /// `WARNING: other real-time threads WHEN: …` in `t`, if there were any.
+    pub fn other_rt_warning(&self, t: &mut Text, when: &str) {
+        if !self.other_rt.is_empty() {
+            let list = self.other_rt.list().join("; ");
+            t.line(format!("WARNING: other real-time threads {when}: {list}"));
+        }
     }
 
     /// Nothing was measured: the failures on stderr, then 130 if
@@ -126,6 +158,15 @@ impl Drop for Bench {
 /// The temporary directory of bench `name` in this process.
 pub fn tmp_dir(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("motion-bench-{name}-{}", std::process::id()))
+}
+
+/// The `status` object of a report's JSON: ok, interrupted, the failures.
+pub fn status(interrupted: bool, failures: &[String]) -> Value {
+    json!({
+        "ok": failures.is_empty() && !interrupted,
+        "interrupted": interrupted,
+        "failures": failures,
+    })
 }
 
 /// The object `v` with the members of `more` added.

@@ -3,39 +3,38 @@
 //! The supervisor measures its own cycle; a bench only starts it and reads,
 //! every bench the same way.
 
-use crate::drive;
-use crate::hist::{self, new_hist, pct_of, Pct};
-use crate::proc::Ended;
+use crate::drive::{self, Binaries};
+use crate::proc::{Ended, Running};
+use crate::{histogram, hlog, percentiles};
 use hdrhistogram::Histogram;
-use motion_report::Latency;
+use motion_report::{Latency, Percentiles, RunReport};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Duration;
 
 /// Share of missed deadlines above which a bench fails.
 pub const MAX_MISS_RATIO: f64 = 0.01;
 
-/// Writes `toml` to `tmp/TAG.toml` and returns `motion-supervisor run
-/// --config it --duration LEN --json --hlog tmp/TAG.hlog --service-prefix
-/// PREFIX` with the interval log's path.
-pub fn command(
-    supervisor: &Path,
+/// Starts the daemon of the machine `toml` (written to `tmp/TAG.toml`)
+/// under `prefix` for `len` s, its intervals logged to `tmp/TAG.hlog`, with
+/// the `extra` arguments; returns it and the log's path.
+pub fn start(
+    b: &Binaries,
     tmp: &Path,
-    tag: &str,
-    toml: &str,
-    prefix: &str,
+    (tag, toml, prefix): (&str, &str, &str),
     len: f64,
-) -> Result<(Command, PathBuf), String> {
-    let cfg = tmp.join(format!("{tag}.toml"));
+    extra: &[&str],
+) -> Result<(Running, PathBuf), String> {
+    let (cfg, log) = (
+        tmp.join(format!("{tag}.toml")),
+        tmp.join(format!("{tag}.hlog")),
+    );
     std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
-    let hlog = tmp.join(format!("{tag}.hlog"));
-    let mut cmd = Command::new(supervisor);
-    cmd.args(["run", "--config"]).arg(&cfg);
-    cmd.args(["--duration", &len.to_string(), "--json", "--hlog"])
-        .arg(&hlog);
-    cmd.args(["--service-prefix", prefix]);
-    Ok((cmd, hlog))
+    let mut cmd = drive::run_command(b, &cfg, prefix);
+    cmd.args(["--duration", &len.to_string(), "--hlog"])
+        .arg(&log);
+    let run = Running::spawn(cmd.args(extra), "motion-supervisor run", true, false)?;
+    Ok((run, log))
 }
 
 /// What one slice measured.
@@ -63,38 +62,36 @@ pub struct Slice {
 /// cycle did not run SCHED_FIFO).
 pub fn read(
     ended: &Ended,
-    hlog: &Path,
+    log: &Path,
     start: Duration,
     len: f64,
 ) -> Result<(Slice, Vec<String>), String> {
-    let stderr = ended.stderr.trim();
-    let tail = match stderr.is_empty() {
-        true => String::new(),
-        false => format!("; its stderr: {}", drive::tail(stderr, 8)),
+    let tail = match ended.stderr.trim() {
+        "" => String::new(),
+        e => format!("; its stderr: {}", drive::tail(e, 8)),
     };
     if !ended.success() {
         return Err(format!("{}{tail}", ended.describe()));
     }
-    let report: motion_report::RunReport = (ended.stdout.lines().rev())
+    let report: RunReport = (ended.stdout.lines().rev())
         .find_map(|l| serde_json::from_str(l.trim()).ok())
         .ok_or_else(|| format!("no run report on its stdout{tail}"))?;
     if report.latency.cycles == 0 {
         return Err(format!("it measured no cycles{tail}"));
     }
-    let mut warnings = report.warnings.clone();
-    let rt = &report.rt;
+    let (mut warnings, rt) = (report.warnings, report.rt);
     warnings.extend(rt.iter().flat_map(|r| r.warnings.iter().cloned()));
     if rt.as_ref().map(|r| r.policy.as_str()) != Some("SCHED_FIFO") {
         warnings.push(format!("the cycle did not run SCHED_FIFO (rt: {rt:?})"));
     }
-    let iv = hist::read_interval_log(hlog)?;
+    let iv = hlog::read(log)?;
     let io: Vec<f64> = report.cpu.io.iter().filter_map(|(_, c)| *c).collect();
     let slice = Slice {
         start,
         len,
-        wakeup: hist::sum_tag(&iv, "wakeup"),
-        compute: hist::sum_tag(&iv, "compute"),
-        roundtrip: hist::sum_tag(&iv, "roundtrip"),
+        wakeup: hlog::sum(&iv, "wakeup"),
+        compute: hlog::sum(&iv, "compute"),
+        roundtrip: hlog::sum(&iv, "roundtrip"),
         lat: report.latency,
         cpu: report.cpu.supervisor,
         io_cpu: (!io.is_empty()).then(|| io.iter().sum()),
@@ -110,9 +107,9 @@ pub struct Group {
     /// Wake-up latency of every slice (the plot's curve).
     pub wake: Histogram<u64>,
     /// Wake-up, compute and I/O round trip, µs.
-    pub w: Pct,
-    pub c: Pct,
-    pub r: Pct,
+    pub w: Percentiles,
+    pub c: Percentiles,
+    pub r: Percentiles,
     pub cycles: u64,
     pub misses: u64,
     pub late: u64,
@@ -127,15 +124,15 @@ pub struct Group {
 impl Group {
     pub fn of(slices: &[&Slice]) -> Self {
         let merged = |f: fn(&Slice) -> &Histogram<u64>| {
-            let mut h = new_hist();
-            slices.iter().for_each(|s| hist::merge(&mut h, f(s)));
+            let mut h = histogram();
+            slices.iter().for_each(|s| hlog::merge(&mut h, f(s)));
             h
         };
         // percentiles of the merged logs, min and max exact from the JSON
-        let exact = |h: &Histogram<u64>, f: fn(&Latency) -> Pct| {
+        let exact = |h: &Histogram<u64>, f: fn(&Latency) -> Percentiles| {
             let v = slices.iter().map(|s| f(&s.lat)).filter(|p| p.count > 0);
-            let v: Vec<Pct> = v.collect();
-            let mut p = pct_of(h);
+            let v: Vec<Percentiles> = v.collect();
+            let mut p = percentiles(h);
             if !v.is_empty() {
                 p.min = v.iter().map(|p| p.min).fold(f64::INFINITY, f64::min);
                 p.max = v.iter().map(|p| p.max).fold(0.0, f64::max);
@@ -143,11 +140,8 @@ impl Group {
             p
         };
         let weighted = |f: fn(&Slice) -> Option<f64>| {
-            let (mut sum, mut wall) = (0.0, 0.0);
-            for (x, s) in slices.iter().filter_map(|s| Some((f(s)?, s))) {
-                sum += x * s.wall_s;
-                wall += s.wall_s;
-            }
+            let v = slices.iter().filter_map(|s| Some((f(s)?, s.wall_s)));
+            let (sum, wall) = v.fold((0.0, 0.0), |(a, w), (x, t)| (a + x * t, w + t));
             (wall > 0.0).then(|| sum / wall)
         };
         let sum = |f: fn(&Latency) -> u64| slices.iter().map(|s| f(&s.lat)).sum::<u64>();
@@ -208,9 +202,9 @@ impl Group {
     }
 }
 
-/// `a / b` per column of [`Pct::values`] in a report's JSON, two decimals;
-/// null where `b` is 0.
-pub fn ratio_json(a: &Pct, b: &Pct) -> Value {
+/// `a / b` per column of [`Percentiles::values`] in a report's JSON, two
+/// decimals; null where `b` is 0.
+pub fn ratio_json(a: &Percentiles, b: &Percentiles) -> Value {
     let keys = ["min", "p50", "p99", "p999", "p9999", "max"];
     let r = a.ratio(b).map(|x| x.map(|x| motion_report::round(x, 2)));
     Value::Object(

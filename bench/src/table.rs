@@ -1,9 +1,12 @@
-//! The cells and rows of the benches' printed tables: a name in a column of
-//! its own width, then right-aligned cells of 9 characters.
+//! The cells and lines of the benches' printed tables: a line is cells in
+//! columns of fixed widths; most tables are a name, then right-aligned
+//! cells of 9 characters.
 
-use crate::hist::Pct;
+pub use motion_report::table::thousands;
+use motion_report::Percentiles;
+use std::fmt::Display;
 
-/// Column names of [`Pct::values`].
+/// Column names of [`Percentiles::values`].
 pub const COLUMNS: [&str; 6] = ["min", "p50", "p99", "p99.9", "p99.99", "max"];
 
 /// A µs figure for a table cell: one decimal below 1000, none above.
@@ -25,25 +28,18 @@ pub fn ratio_of(a: Option<f64>, b: Option<f64>) -> Option<f64> {
     a.zip(b).filter(|(_, b)| *b > 0.0).map(|(a, b)| a / b)
 }
 
-/// 12345678 → "12,345,678".
-pub fn thousands(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
+/// `cells` in columns of `widths` characters, right-aligned (a negative
+/// width: left-aligned in its absolute value).
+pub fn line<S: Display>(widths: &[i32], cells: impl IntoIterator<Item = S>) -> String {
+    let cell = |(c, &w): (S, &i32)| match w < 0 {
+        true => format!("{c:<0$}", w.unsigned_abs() as usize),
+        false => format!("{c:>0$}", w as usize),
+    };
+    cells.into_iter().zip(widths).map(cell).collect()
 }
 
 /// `name` left-aligned in `width`, then each cell right-aligned in 9.
-pub fn row<S: std::fmt::Display>(
-    name: &str,
-    width: usize,
-    cells: impl IntoIterator<Item = S>,
-) -> String {
+pub fn row<S: Display>(name: &str, width: usize, cells: impl IntoIterator<Item = S>) -> String {
     let mut s = format!("{name:<width$}");
     for c in cells {
         s += &format!("{c:>9}");
@@ -51,14 +47,15 @@ pub fn row<S: std::fmt::Display>(
     s
 }
 
-/// The cells of `p` at the columns `cols` (indices into [`Pct::values`]).
-pub fn us_cells(p: &Pct, cols: &[usize]) -> Vec<String> {
+/// The cells of `p` at the columns `cols` (indices into
+/// [`Percentiles::values`]).
+pub fn us_cells(p: &Percentiles, cols: &[usize]) -> Vec<String> {
     let v = p.values();
     cols.iter().map(|&i| us(v[i])).collect()
 }
 
 /// The ratios `a / b` at the columns `cols`.
-pub fn ratio_cells(a: &Pct, b: &Pct, cols: &[usize]) -> Vec<String> {
+pub fn ratio_cells(a: &Percentiles, b: &Percentiles, cols: &[usize]) -> Vec<String> {
     let r = a.ratio(b);
     cols.iter().map(|&i| ratio(r[i])).collect()
 }
@@ -80,20 +77,11 @@ mod tests {
 
     #[test]
     fn cells() {
-        assert_eq!(
-            (thousands(1234567).as_str(), thousands(12).as_str()),
-            ("1,234,567", "12")
-        );
-        assert_eq!(
-            (us(999.94).as_str(), us(1234.4).as_str()),
-            ("999.9", "1234")
-        );
-        assert_eq!(
-            (ratio(Some(0.5)).as_str(), ratio(None).as_str()),
-            ("0.50", "-")
-        );
+        assert_eq!([us(999.94), us(1234.4)], ["999.9", "1234"]);
+        assert_eq!([ratio(Some(0.5)), ratio(None)], ["0.50", "-"]);
         assert_eq!(ratio_of(Some(1.0), Some(4.0)), Some(0.25));
         assert_eq!(ratio_of(Some(1.0), Some(0.0)), None);
         assert_eq!(row("ab", 4, ["1", "x"]), "ab          1        x");
+        assert_eq!(line(&[-4, 3, 2], ["ab", "1", "x", "cut"]), "ab    1 x");
     }
 }

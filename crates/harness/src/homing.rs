@@ -21,6 +21,13 @@ pub struct HomeRun {
     pub seconds: f64,
 }
 
+impl HomeRun {
+    /// It gave rows, and every axis homed (PC, homed, no error).
+    pub fn succeeded(&self) -> bool {
+        !self.rows.is_empty() && self.rows.iter().all(AxisResult::succeeded)
+    }
+}
+
 /// The last line of `stdout` that parses as a JSON object.
 pub fn last_json(stdout: &str) -> Option<serde_json::Value> {
     stdout

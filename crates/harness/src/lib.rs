@@ -19,6 +19,7 @@
 //! * [`homing`] — homing runs and their tally (the benches).
 //! * [`procs`] — processes found in `/proc`; stress-ng.
 //! * [`spy`] — the frame spy on one I/O process's topics.
+//! * [`cyclictest`] — the jitter bench's reference: its command and histogram.
 //! * [`ecat`] — the EtherCAT veth rig with emulated drives.
 //!
 //! Invariants: every process it starts ends (SIGTERM, then SIGKILL) when
@@ -31,6 +32,7 @@
 pub mod bins;
 pub mod check;
 pub mod commands;
+pub mod cyclictest;
 pub mod daemon;
 pub mod ecat;
 pub mod generated;

@@ -2,6 +2,19 @@
 
 use crate::AxisResult;
 
+/// 12345678 → "12,345,678": sample counts in the benches' tables and plots.
+pub fn thousands(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 fn opt(x: Option<f64>, width: usize) -> String {
     match x {
         Some(v) => format!("{v:>width$.4}"),
@@ -163,4 +176,16 @@ pub fn status(r: &crate::StatusReport) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn thousands() {
+        let t = |n| super::thousands(n);
+        assert_eq!(
+            [t(1234567), t(12), t(999), t(1000)],
+            ["1,234,567", "12", "999", "1,000"]
+        );
+    }
 }

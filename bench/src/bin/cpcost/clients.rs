@@ -7,25 +7,24 @@
 //! slice's end (failed after the supervisor's `--duration` ran out: it was
 //! stopping), with how long it took from start to exit.
 //!
-//! The periodic clients run on threads of the bench (waiting for their
-//! `motionctl` in 5 ms steps); every `motionctl` started is ended before
-//! [`Attached::detach`] returns.
+//! The bench's thread polls them every few ms ([`Attached::poll`]): a
+//! request ends, the next one starts when it is due; every `motionctl`
+//! started has ended when [`Attached::detach`] returns.
 
-use motion_bench::drive::{self, last_json};
-use motion_bench::proc::{self, Running};
+use motion_bench::drive::{self, last_json, rows_of};
+use motion_bench::proc::{Ended, Running};
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// How long one status or stats request may take before it is ended and
 /// counted as failed (motionctl itself gives up after 2 s without an answer).
 const REQUEST_TIMEOUT: Duration = Duration::from_secs(10);
-/// How long one `home X` may take (X homes in about 2 s).
-const HOME_TIMEOUT_S: f64 = 30.0;
+/// `home X` (X homes in about 2 s): motionctl gives up after 30 s, the
+/// bench ends it after 60.
+const HOME: &[&str] = &["home", "X", "--json", "--timeout", "30"];
+const HOME_WAIT: Duration = Duration::from_secs(60);
 /// At most this many problem lines are kept per kind of request.
 const MAX_DETAILS: usize = 20;
 
@@ -67,13 +66,13 @@ impl Count {
         Some((*v.get(v.len() / 2)?, *v.last()?))
     }
 
-    /// Counts one request's outcome: `end`ed means the supervisor is gone
-    /// or past its `--duration` (`cut`).
-    fn add(&mut self, r: Result<(), String>, started: Instant, cut: Instant, end: &AtomicBool) {
+    /// Counts one request's outcome, `ms` long; `cut`: the supervisor is
+    /// gone or past its `--duration`.
+    fn add(&mut self, r: Result<(), String>, ms: f64, cut: bool) {
         self.made += 1;
         match r {
-            Ok(()) => self.ms.push(started.elapsed().as_secs_f64() * 1e3),
-            Err(_) if end.load(Ordering::Acquire) || Instant::now() >= cut => self.cut_off += 1,
+            Ok(()) => self.ms.push(ms),
+            Err(_) if cut => self.cut_off += 1,
             Err(e) => {
                 self.failed += 1;
                 self.note(e);
@@ -135,154 +134,180 @@ pub struct Plan {
     pub homing: bool,
 }
 
+/// One client: the same request again and again, one at a time.
+struct Client {
+    /// `motionctl`'s arguments after `--service-prefix P`.
+    args: &'static [&'static str],
+    /// From one start to the next (a request that takes longer delays the
+    /// next one: no burst to catch up); None: back to back, none started
+    /// past the cut (it would only be cut off: X takes ~3 s to home).
+    every: Option<Duration>,
+    next: Instant,
+    /// The request in flight, since when.
+    busy: Option<(Running, Instant)>,
+    count: Count,
+}
+
 /// The clients attached to one supervisor.
 pub struct Attached {
-    end: Arc<AtomicBool>,
+    motionctl: PathBuf,
+    prefix: String,
+    /// When the supervisor's `--duration` runs out at the earliest.
     cut: Instant,
-    watch: Option<Running>,
+    watch: Running,
     /// When the watch was seen to have ended by itself.
     watch_ended: Option<Instant>,
-    /// The status and stats pollers and the homing client.
-    threads: [Option<JoinHandle<Count>>; 3],
+    /// status, stats, and home X.
+    clients: Vec<Client>,
 }
 
 /// Attaches every client to the supervisor of `prefix`, whose `--duration`
 /// runs out at `cut` at the earliest.
 pub fn attach(motionctl: &Path, prefix: &str, p: &Plan, cut: Instant) -> Result<Attached, String> {
-    let end = Arc::new(AtomicBool::new(false));
     let mut cmd = Command::new(motionctl);
     cmd.args(["--service-prefix", prefix, "status", "--watch"]);
     // not captured: stdout stays /dev/null, stderr is still read
     cmd.stdout(Stdio::null()).stderr(Stdio::piped());
     let watch = Running::spawn(&mut cmd, "motionctl status --watch", false, false)?;
-    let ctx = || (motionctl.to_path_buf(), prefix.to_string(), end.clone());
-    let (every, (m, pf, e)) = (p.status_every, ctx());
-    let status = client(move || periodic(&m, &pf, &["status", "--json"], every, cut, &e))?;
-    let (every, (m, pf, e)) = (p.stats_every, ctx());
-    let stats = client(move || periodic(&m, &pf, &["stats", "--json"], every, cut, &e))?;
-    let (m, pf, e) = ctx();
-    let home = p
-        .homing
-        .then(|| client(move || homing(&m, &pf, cut, &e)))
-        .transpose()?;
-    let threads = [Some(status), Some(stats), home];
+    let client = |args, every| Client {
+        args,
+        every,
+        next: Instant::now(),
+        busy: None,
+        count: Count::default(),
+    };
+    let mut clients = vec![
+        client(&["status", "--json"], Some(p.status_every)),
+        client(&["stats", "--json"], Some(p.stats_every)),
+    ];
+    if p.homing {
+        clients.push(client(HOME, None));
+    }
+    let (motionctl, prefix) = (motionctl.to_path_buf(), prefix.to_string());
     Ok(Attached {
-        end,
+        motionctl,
+        prefix,
         cut,
-        watch: Some(watch),
+        watch,
         watch_ended: None,
-        threads,
+        clients,
     })
 }
 
+impl Client {
+    /// The longest one request may take.
+    fn timeout(&self) -> Duration {
+        self.every.map_or(HOME_WAIT, |_| REQUEST_TIMEOUT)
+    }
+
+    fn start(&mut self, motionctl: &Path, prefix: &str) {
+        let mut cmd = Command::new(motionctl);
+        cmd.args(["--service-prefix", prefix]).args(self.args);
+        match Running::spawn(&mut cmd, "motionctl", true, false) {
+            Ok(r) => self.busy = Some((r, Instant::now())),
+            Err(e) => self.counted(Err(e), 0.0, false),
+        }
+    }
+
+    /// The request in flight to its end (ended at its timeout), counted;
+    /// `cut`: the supervisor is gone or past its `--duration`.
+    fn end(&mut self, cut: bool) {
+        if let Some((r, t)) = self.busy.take() {
+            let left = self.timeout().saturating_sub(t.elapsed());
+            let ended = r.wait(left, Duration::from_secs(1));
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            self.counted(check(self.args, &ended), ms, cut);
+        }
+    }
+
+    /// Counts a request; the next one is due a period after this one was,
+    /// at once if that has passed (back to back: at once).
+    fn counted(&mut self, r: Result<(), String>, ms: f64, cut: bool) {
+        self.count.add(r, ms, cut);
+        let now = Instant::now();
+        self.next = self.every.map_or(now, |every| (self.next + every).max(now));
+    }
+}
+
 impl Attached {
-    /// Notes when the watch ended by itself (call it now and then while the
+    /// Counts the requests that ended, starts those that are due, notes
+    /// when the watch ended by itself (call it every few ms while the
     /// supervisor runs).
     pub fn poll(&mut self) {
-        if self.watch_ended.is_none() && self.watch.as_mut().is_some_and(|w| !w.running()) {
+        self.note_watch();
+        for c in &mut self.clients {
+            if let Some((r, t)) = &mut c.busy {
+                if r.running() && t.elapsed() < c.timeout() {
+                    continue;
+                }
+                c.end(Instant::now() >= self.cut);
+            }
+            let now = Instant::now();
+            if c.busy.is_none() && now >= c.next && (c.every.is_some() || now < self.cut) {
+                c.start(&self.motionctl, &self.prefix);
+            }
+        }
+    }
+
+    fn note_watch(&mut self) {
+        if self.watch_ended.is_none() && !self.watch.running() {
             self.watch_ended = Some(Instant::now());
         }
     }
 
-    /// Ends every client (the watch with SIGTERM, the pollers after their
-    /// request in flight) and returns the counts.
+    /// Ends every client (the requests in flight once they end, counted as
+    /// cut off if they fail; the watch with SIGTERM) and returns the counts.
     pub fn detach(mut self) -> Clients {
-        self.poll();
-        self.end.store(true, Ordering::Release);
-        let mut c = Clients::default();
-        if let Some(w) = self.watch.take() {
-            c.watch.made = 1;
-            let ended = w.wait(Duration::ZERO, Duration::from_secs(3));
-            match self.watch_ended {
-                None => {}
-                Some(t) if t >= self.cut => c.watch.cut_off = 1,
-                Some(_) => {
-                    c.watch.failed = 1;
-                    c.watch.note(format!(
-                        "status --watch ended while the supervisor ran: {}; {}",
-                        ended.describe(),
-                        drive::tail(&ended.stderr, 3)
-                    ));
-                }
+        self.note_watch();
+        let mut counts = self.clients.into_iter().map(|mut c| {
+            c.end(true);
+            c.count
+        });
+        let mut c = Clients {
+            status: counts.next().unwrap_or_default(),
+            stats: counts.next().unwrap_or_default(),
+            home: counts.next().unwrap_or_default(),
+            ..Clients::default()
+        };
+        c.watch.made = 1;
+        let ended = self.watch.wait(Duration::ZERO, Duration::from_secs(3));
+        match self.watch_ended {
+            None => {}
+            Some(t) if t >= self.cut => c.watch.cut_off = 1,
+            Some(_) => {
+                c.watch.failed = 1;
+                c.watch.note(format!(
+                    "status --watch ended while the supervisor ran: {}; {}",
+                    ended.describe(),
+                    drive::tail(&ended.stderr, 3)
+                ));
             }
         }
-        let [status, stats, home] = self.threads.each_mut().map(|h| {
-            let panicked = || Count {
-                details: vec!["client thread panicked".into()],
-                failed: 1,
-                ..Count::default()
-            };
-            h.take()
-                .map(|h| h.join().unwrap_or_else(|_| panicked()))
-                .unwrap_or_default()
-        });
-        Clients {
-            status,
-            stats,
-            home,
-            ..c
-        }
+        c
     }
 }
 
-impl Drop for Attached {
-    fn drop(&mut self) {
-        // detach() not reached (an error on the way): the threads still end
-        // after their request; the watch ends with its Running.
-        self.end.store(true, Ordering::Release);
-    }
-}
-
-/// Runs a client on a thread of its own.
-fn client(f: impl FnOnce() -> Count + Send + 'static) -> Result<JoinHandle<Count>, String> {
-    let b = std::thread::Builder::new().name("cpcost-client".into());
-    b.spawn(f)
-        .map_err(|e| format!("cannot start a client thread: {e}"))
-}
-
-/// Whether a client goes on: not ended, not interrupted.
-fn going(end: &AtomicBool) -> bool {
-    !end.load(Ordering::Acquire) && !proc::stop_requested()
-}
-
-/// `motionctl --service-prefix P ARGS...` every `every` (a request that
-/// takes longer delays the next one: no burst to catch up) until `end`.
-fn periodic(
-    m: &Path,
-    prefix: &str,
-    args: &[&str],
-    every: Duration,
-    cut: Instant,
-    end: &AtomicBool,
-) -> Count {
-    let mut c = Count::default();
-    let mut next = Instant::now();
-    while going(end) {
-        let started = Instant::now();
-        c.add(request(m, prefix, args), started, cut, end);
-        next = (next + every).max(Instant::now());
-        // in steps of at most 20 ms, to see `end` and a stop request
-        while Instant::now() < next && going(end) {
-            std::thread::sleep((next - Instant::now()).min(Duration::from_millis(20)));
-        }
-    }
-    c
-}
-
-/// One `motionctl --service-prefix P ARGS... --json` to its end: Ok if it
-/// exited 0 and printed a JSON object without `errors`.
-fn request(motionctl: &Path, prefix: &str, args: &[&str]) -> Result<(), String> {
-    let what = args.join(" ");
-    let mut cmd = Command::new(motionctl);
-    cmd.args(["--service-prefix", prefix]).args(args);
-    let mut r = Running::spawn(&mut cmd, "motionctl", true, false)?;
-    let until = Instant::now() + REQUEST_TIMEOUT;
-    while r.running() && Instant::now() < until && !proc::stop_requested() {
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    // ended: collects its output; still running: terminated (timed out)
-    let ended = r.wait(Duration::ZERO, Duration::from_secs(1));
+/// Whether a request of `args` succeeded: `home X` if X homed, every other
+/// if motionctl exited 0 and printed a JSON object without `errors`.
+fn check(args: &[&str], ended: &Ended) -> Result<(), String> {
     let json = last_json(&ended.stdout);
+    if args == HOME {
+        let rows = json.as_ref().map(rows_of).unwrap_or_default();
+        if !rows.is_empty() && rows.iter().all(|x| x.succeeded()) {
+            return Ok(());
+        }
+        let rows: Vec<String> = (rows.iter())
+            .map(|x| {
+                format!(
+                    "{} pc {} er {} homed {} err {}/{}",
+                    x.name, x.pc, x.er, x.homed, x.err, x.exerr
+                )
+            })
+            .collect();
+        let (how, tail) = (ended.describe(), drive::tail(&ended.stderr, 2));
+        return Err(format!("home X: {how}; rows {}; {tail}", rows.join(", ")));
+    }
+    let what = args.join(" ");
     let errors = json.as_ref().and_then(|j| j.get("errors"));
     match (ended.success(), &json, errors) {
         (false, _, _) => {
@@ -293,33 +318,4 @@ fn request(motionctl: &Path, prefix: &str, args: &[&str]) -> Result<(), String> 
         (true, Some(_), Some(e)) => Err(format!("{what}: errors {e}")),
         (true, None, _) => Err(format!("{what}: no JSON object on its stdout")),
     }
-}
-
-/// `motionctl home X --json` back to back until `end`, none started past
-/// `cut` (it would only be cut off: X takes ~3 s to home).
-fn homing(motionctl: &Path, prefix: &str, cut: Instant, end: &AtomicBool) -> Count {
-    let mut c = Count::default();
-    while going(end) && Instant::now() < cut {
-        let started = Instant::now();
-        let run = drive::ctl_home(motionctl, prefix, &["X"], false, HOME_TIMEOUT_S);
-        let r = run.and_then(|run| {
-            match !run.rows.is_empty() && run.rows.iter().all(|x| x.succeeded()) {
-                true => Ok(()),
-                false => {
-                    let rows: Vec<String> = (run.rows.iter())
-                        .map(|x| {
-                            format!(
-                                "{} pc {} er {} homed {} err {}/{}",
-                                x.name, x.pc, x.er, x.homed, x.err, x.exerr
-                            )
-                        })
-                        .collect();
-                    let (how, tail) = (run.ended.describe(), drive::tail(&run.ended.stderr, 2));
-                    Err(format!("home X: {how}; rows {}; {tail}", rows.join(", ")))
-                }
-            }
-        });
-        c.add(r, started, cut, end);
-    }
-    c
 }

@@ -8,10 +8,12 @@ use crate::cli::Opts;
 use crate::clients::{Clients, Count};
 use crate::slice::Done;
 use crate::variant::Variant;
-use motion_bench::hist::Pct;
-use motion_bench::outcome::{with, Bench};
+use motion_bench::outcome::{status, with, Bench};
 use motion_bench::slice::{ratio_json, Group, MAX_MISS_RATIO};
-use motion_bench::table::{ratio, ratio_cells, ratio_of, row, thousands, us_cells, Text, COLUMNS};
+use motion_bench::table::{
+    line, ratio, ratio_cells, ratio_of, row, thousands, us_cells, Text, COLUMNS,
+};
+use motion_report::Percentiles;
 use serde_json::{json, Value};
 
 /// The columns of the tables (p99.99 left out: a minute of cycles gives it
@@ -95,14 +97,10 @@ pub fn text(
          demo machine (4 axes) idle, {:.0} s per variant in {} slice(s) of ≤ {} s, variants alternating",
         cy.period_us, 1e6 / f64::from(cy.period_us), cy.priority, cy.cpu, a.secs, a.slices, o.slicing.slice
     ));
-    let (throttling, before, after) = (
-        &env.throttling,
-        &env.load_before,
-        motion_bench::host::loadavg(),
-    );
+    let (head, throttling, before) = (env.head(), &env.throttling, &env.load_before);
+    let after = motion_bench::host::loadavg();
     t.line(format!(
-        "{} | RT throttling {throttling} | load {before} before, {after} after",
-        env.head()
+        "{head} | RT throttling {throttling} | load {before} before, {after} after"
     ));
     if !env.is_rt {
         t.line("not a PREEMPT_RT kernel: latencies are upper bounds; compare the rows (same machine, alternating slices)");
@@ -130,12 +128,7 @@ pub fn text(
             leftovers.0, leftovers.1
         ));
     }
-    if !b.other_rt.is_empty() {
-        let list = b.other_rt.list().join("; ");
-        t.line(format!(
-            "WARNING: other real-time threads ran during the bench: {list}"
-        ));
-    }
+    b.other_rt_warning(&mut t, "ran during the bench");
     for w in warnings {
         t.line(format!("supervisor warning: {w}"));
     }
@@ -143,7 +136,7 @@ pub fn text(
 }
 
 /// One latency of a variant.
-type Pick = fn(&Group) -> &Pct;
+type Pick = fn(&Group) -> &Percentiles;
 
 /// Per latency one row per variant, and the ratios to (a).
 fn latencies(t: &mut Text, groups: &[Merged]) {
@@ -174,39 +167,37 @@ fn latencies(t: &mut Text, groups: &[Merged]) {
 
 /// Cycles, deadline misses, late replies and CPU use per variant.
 fn cycles(t: &mut Text, groups: &[Merged]) {
+    const WIDTHS: [i32; 7] = [2, -24, 10, 22, 14, 16, 15];
     let a = &groups[0].g;
-    let line = |name: &str, cells: [String; 5]| {
-        let [c, m, l, s, i] = cells;
-        format!("  {name:<24}{c:>10}{m:>22}{l:>14}{s:>16}{i:>15}")
-    };
     let head = [
+        "",
+        "",
         "cycles",
         "deadline misses",
         "late replies",
         "supervisor CPU",
         "motion-io CPU",
     ];
-    t.line(line("", head.map(String::from)));
+    t.line(line(&WIDTHS, head));
     for m in groups.iter().filter(|m| m.g.ran()) {
         let g = &m.g;
         let misses = format!("{} ({:.3} %)", g.misses, g.miss_ratio * 100.0);
+        let (cycles, late) = (thousands(g.cycles), g.late.to_string());
         let cells = [
-            thousands(g.cycles),
-            misses,
-            g.late.to_string(),
-            pct(g.cpu),
-            pct(g.io_cpu),
+            "",
+            m.variant.label(),
+            &cycles,
+            &misses,
+            &late,
+            &pct(g.cpu),
+            &pct(g.io_cpu),
         ];
-        t.line(line(m.variant.label(), cells));
+        t.line(line(&WIDTHS, cells));
     }
     for m in groups[1..].iter().filter(|m| m.g.ran() && a.ran()) {
         let (g, name) = (&m.g, format!("ratio ({})/(a)", m.variant.letter()));
-        let cpu = [ratio_of(g.cpu, a.cpu), ratio_of(g.io_cpu, a.io_cpu)].map(ratio);
-        let [s, i] = cpu;
-        t.line(line(
-            &name,
-            [String::new(), String::new(), String::new(), s, i],
-        ));
+        let [s, i] = [ratio_of(g.cpu, a.cpu), ratio_of(g.io_cpu, a.io_cpu)].map(ratio);
+        t.line(line(&WIDTHS, ["", &name, "", "", "", &s, &i]));
     }
     let max = MAX_MISS_RATIO * 100.0;
     t.line(format!(
@@ -324,10 +315,6 @@ pub fn json(
         "variants": variants,
         "ratios": ratios,
         "warnings": warnings,
-        "status": {
-            "ok": failures.is_empty() && !interrupted,
-            "interrupted": interrupted,
-            "failures": failures,
-        },
+        "status": status(interrupted, failures),
     })
 }

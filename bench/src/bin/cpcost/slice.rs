@@ -7,7 +7,7 @@ use crate::clients::{self, Clients};
 use crate::variant::Variant;
 use motion_bench::drive::{self, Binaries};
 use motion_bench::machine;
-use motion_bench::proc::{self, Running};
+use motion_bench::proc;
 use motion_bench::slice::{self, Slice};
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -39,15 +39,16 @@ pub fn run(
     let prefix = format!("mbc{}{}{i}", std::process::id(), v.letter());
     let (toml, _) = machine::demo_with(&o.cycle.supervisor(&prefix))?;
     let tag = format!("{}{i}", v.letter());
-    let (mut cmd, hlog) = slice::command(&b.supervisor, tmp, &tag, &toml, &prefix, len)?;
-    if !v.serves() {
-        cmd.arg("--no-control-plane");
-    }
+    let extra: &[&str] = if v.serves() {
+        &[]
+    } else {
+        &["--no-control-plane"]
+    };
     let t0 = Instant::now();
     // its --duration starts after its own start-up: it cannot end before this
     let cut = t0 + Duration::from_secs_f64(len);
     let limit = Duration::from_secs_f64(len + 60.0);
-    let mut sup = Running::spawn(&mut cmd, "motion-supervisor run", true, false)?;
+    let (mut sup, hlog) = slice::start(b, tmp, (&tag, &toml, &prefix), len, extra)?;
     let (mut clients, mut attach_s, mut attach_failed) = (Clients::default(), None, None);
     if v.serves() {
         let wait = Duration::from_secs_f64(len.min(10.0));
@@ -62,7 +63,7 @@ pub fn run(
                 attach_s = Some(t0.elapsed().as_secs_f64());
                 while sup.running() && !proc::stop_requested() && t0.elapsed() < limit {
                     a.poll();
-                    std::thread::sleep(Duration::from_millis(20));
+                    std::thread::sleep(Duration::from_millis(5));
                 }
                 clients = a.detach();
             }

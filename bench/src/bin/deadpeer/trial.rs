@@ -19,6 +19,7 @@ use motion_bench::{machine, outcome::Bench};
 use motion_frames::CW_ENABLE;
 use motion_ipc::monotonic_ns;
 use serde::Serialize;
+use std::path::Path;
 use std::process::Command;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -78,31 +79,13 @@ fn cruising(c: &Cmd, cruise: f64) -> bool {
 
 /// A supervisor of the long-seek axis under `prefix`, ready, and the pid of
 /// the one motion-io it spawned.
-fn daemon(
-    o: &Opts,
-    b: &Binaries,
-    tmp: &std::path::Path,
-    prefix: &str,
-) -> Result<(Running, u32), String> {
-    let (toml, _) = machine::long_seek_axis_with(
-        &o.cycle.supervisor(prefix),
-        tmp.to_str(),
-        o.speed,
-        o.speed * 60.0,
-    )?;
+fn daemon(o: &Opts, b: &Binaries, tmp: &Path, prefix: &str) -> Result<(Running, u32), String> {
+    let s = o.cycle.supervisor(prefix);
+    let (toml, _) = machine::long_seek_axis_with(&s, tmp.to_str(), o.speed, o.speed * 60.0)?;
     let cfg = tmp.join(format!("{prefix}.toml"));
     std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
-    let mut daemon = drive::spawn_run(b, &cfg, prefix, None, None)?;
-    if let Err(e) =
-        drive::wait_until_ready(&b.motionctl, prefix, &mut daemon, Duration::from_secs(20))
-    {
-        let ended = drive::stop_run(daemon, Duration::from_secs(20));
-        return Err(format!(
-            "{prefix}: {e} ({}; {})",
-            ended.describe(),
-            drive::tail(&ended.stderr, 5)
-        ));
-    }
+    let daemon = drive::start_run(b, &cfg, prefix, Duration::from_secs(20))
+        .map_err(|e| format!("{prefix}: {e}"))?;
     match drive::io_children(daemon.pid()).as_slice() {
         [p] => Ok((daemon, *p)),
         io => {

@@ -45,32 +45,21 @@ impl Homing64 {
 
     /// The progress line's part.
     pub fn progress(&self) -> String {
-        let Homing64 {
-            started,
-            ok,
-            failed,
-            cut_off,
-            ..
-        } = self;
-        format!(
-            "; {started} homing(s) of 64 axes: {ok} ok, {failed} failed, {cut_off} cut off by the slice's end"
-        )
+        let (n, ok, failed, cut) = (self.started, self.ok, self.failed, self.cut_off);
+        format!("; {n} homing(s) of 64 axes: {ok} ok, {failed} failed, {cut} cut off by the slice's end")
     }
 
     /// The report's line for `secs` s of 64-axis slices.
     pub fn line(&self, secs: f64) -> String {
-        let (
-            Homing64 {
-                started,
-                ok,
-                failed,
-                cut_off,
-                ..
-            },
-            t,
-        ) = (self, &self.tally);
+        let (n, ok, failed, cut, t) = (
+            self.started,
+            self.ok,
+            self.failed,
+            self.cut_off,
+            &self.tally,
+        );
         format!(
-            "64 axes: {started} parallel homing(s) in {secs:.0} s ({:.1} s each): {ok} all homed, {failed} with a failed axis, {cut_off} cut off by a slice's end; \
+            "64 axes: {n} parallel homing(s) in {secs:.0} s ({:.1} s each): {ok} all homed, {failed} with a failed axis, {cut} cut off by a slice's end; \
              axis homings {}: {} ok, {} ERR 12/40 (feedback lost), {} other error(s), {} not homed",
             self.mean_s(), t.axis_homings, t.ok, t.feedback_lost, t.other_errors, t.not_homed
         )
@@ -109,7 +98,7 @@ pub fn home_while(
         h.started += 1;
         let run = drive::ctl_home(motionctl, prefix, &[], true, len + 10.0)?;
         let what = format!("{prefix} homing {}", h.started);
-        if !run.rows.is_empty() && run.rows.iter().all(|x| x.succeeded()) {
+        if run.succeeded() {
             h.ok += 1;
             h.tally.add(&what, &run);
             h.durations.push(started.elapsed().as_secs_f64());

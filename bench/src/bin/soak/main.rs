@@ -4,11 +4,9 @@
 //! that failed with ERR 12 / EXERR 40 (feedback lost) or anything else, and
 //! every axis that ended not homed. See `bench/README.md`.
 //!
-//! This file is the sequence — checks, stage, the one-axis part, the
-//! 64-axis part, the report — and what every homing shares ([`Ctx`]); the
-//! modules are its steps: [`cli`] the command line, [`parts`] the two parts
-//! (with [`daemon_block`] for a block through one daemon), [`report`] what a
-//! part counts, the table and soak.json.
+//! The sequence: checks, stage, the one-axis and the 64-axis [`parts`]
+//! (a block through one daemon: [`daemon_block`]), the [`report`]; [`Ctx`]
+//! is what every homing shares.
 
 mod cli;
 mod daemon_block;
@@ -57,6 +55,7 @@ fn run(o: &Opts) -> Result<i32, String> {
     let mut ctx = Ctx {
         b: bins,
         tmp,
+        evidence: out.join("soak-evidence"),
         other_cpu,
         leftovers: vec![],
         not_cleaned: vec![],
@@ -93,6 +92,8 @@ pub struct Ctx {
     pub b: Binaries,
     /// Configs and traces of the runs.
     pub tmp: PathBuf,
+    /// Where what tells why a homing failed is kept.
+    pub evidence: PathBuf,
     /// Not the cycle's CPU: stress-ng and the spy go there.
     pub other_cpu: usize,
     /// What runs left in /dev/shm (cleaned by the bench).
@@ -121,10 +122,9 @@ impl Ctx {
     pub fn check_leftovers(&mut self, prefix: &str) {
         let (found, remaining) = drive::clean_leftovers(prefix);
         if !found.is_empty() {
-            let all = if remaining.is_empty() {
-                "cleaned"
-            } else {
-                "NOT all cleaned"
+            let all = match remaining.is_empty() {
+                true => "cleaned",
+                false => "NOT all cleaned",
             };
             eprintln!("soak: WARNING: {prefix} left {} ({all})", found.join(", "));
             self.leftovers.extend(found);
