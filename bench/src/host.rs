@@ -1,42 +1,10 @@
-//! The machine a bench runs on as its reports show it (the facts come from
-//! `motion_rt::host`), other real-time threads seen while it runs, the
-//! bench's own threads set up like the cycle's, and the programs it starts.
+//! The machine a bench runs on (the facts come from `motion_rt::host`),
+//! other real-time threads seen while it runs, and the bench's own threads
+//! set up like the cycle's.
 
 pub use motion_harness::bins::{beside_this_exe, find_in_path, is_executable};
-pub use motion_rt::host::{cpus, kernel, loadavg, other_rt_tasks, preemption};
+pub use motion_rt::host::{cpus, loadavg, other_rt_tasks, Host};
 use std::collections::BTreeSet;
-
-/// The kernel and its real-time settings, read once at the start.
-pub struct Env {
-    pub kernel: String,
-    pub preemption: String,
-    pub is_rt: bool,
-    pub cpus: usize,
-    pub throttling: String,
-    /// Load average at the start.
-    pub load_before: String,
-}
-
-impl Env {
-    pub fn probe() -> Self {
-        let (preemption, is_rt) = preemption();
-        Env {
-            kernel: kernel(),
-            preemption,
-            is_rt,
-            cpus: cpus(),
-            throttling: motion_rt::host::rt_throttling(),
-            load_before: loadavg(),
-        }
-    }
-
-    /// `kernel K | preemption: P | N CPUs`: how every report's second line
-    /// starts.
-    pub fn head(&self) -> String {
-        let (k, p, n) = (&self.kernel, &self.preemption, self.cpus);
-        format!("kernel {k} | preemption: {p} | {n} CPUs")
-    }
-}
 
 /// Other real-time threads (not this bench's): each is warned about once,
 /// when first seen, and all are reported at the end, since they compete
@@ -96,24 +64,4 @@ pub fn enter_rt(cpu: Option<usize>, priority: Option<i32>) -> Vec<String> {
     let locked = mlockall(F::MCL_CURRENT | F::MCL_FUTURE).err();
     let locked = locked.map(|e| format!("mlockall: {e}"));
     pinned.into_iter().chain(locked).collect()
-}
-
-/// Whether this process may run a thread SCHED_FIFO at `priority` (tried
-/// on a throw-away thread).
-pub fn can_use_fifo(priority: i32) -> Result<(), String> {
-    std::thread::spawn(move || {
-        let cfg = motion_rt::RtConfig {
-            priority,
-            lock_memory: false,
-            prefault_stack: 0,
-            ..motion_rt::RtConfig::default()
-        };
-        let r = motion_rt::enter_realtime(&cfg);
-        match r.policy {
-            motion_rt::SchedPolicy::Fifo => Ok(()),
-            _ => Err(r.warnings.join("; ")),
-        }
-    })
-    .join()
-    .unwrap_or_else(|_| Err("probe thread panicked".into()))
 }

@@ -6,7 +6,7 @@
 //! printed and written all the same).
 
 use crate::flags::Cycle;
-use crate::host::{loadavg, Env, OtherRt};
+use crate::host::{loadavg, Host, OtherRt};
 use crate::proc;
 use crate::table::Text;
 use serde_json::{json, Value};
@@ -17,7 +17,7 @@ use std::time::Instant;
 pub struct Bench {
     /// The binary's name, in front of its stderr lines.
     pub name: &'static str,
-    pub env: Env,
+    pub host: Host,
     pub other_rt: OtherRt,
     /// Configs, logs and histograms of the runs (removed on drop).
     pub tmp: PathBuf,
@@ -35,11 +35,11 @@ impl Bench {
             std::fs::create_dir_all(d)
                 .map_err(|e| format!("cannot create {}: {e}", d.display()))?;
         }
-        let (env, mut other_rt) = (Env::probe(), OtherRt::new(name));
+        let (host, mut other_rt) = (Host::read(), OtherRt::new(name));
         other_rt.note("before the bench");
         Ok(Bench {
             name,
-            env,
+            host,
             other_rt,
             tmp,
             t0: Instant::now(),
@@ -48,15 +48,15 @@ impl Bench {
 
     /// Says so on stderr when the kernel is not PREEMPT_RT.
     pub fn warn_not_rt(&self) {
-        if !self.env.is_rt {
-            let (name, p) = (self.name, &self.env.preemption);
+        if !self.host.is_rt {
+            let (name, p) = (self.name, &self.host.preemption);
             eprintln!("{name}: kernel is not PREEMPT_RT ({p}): the numbers are upper bounds");
         }
     }
 
     /// The `environment` object of a report's JSON.
     pub fn environment(&self) -> Value {
-        let e = &self.env;
+        let e = &self.host;
         json!({
             "kernel": e.kernel,
             "preemption": e.preemption,
@@ -70,7 +70,7 @@ impl Bench {
     /// `kernel … | preemption: … | N CPUs | load before B, after A | wall
     /// W s`: the second line of the soak's and deadpeer's reports.
     pub fn load_line(&self, wall: f64) -> String {
-        let (head, before, after) = (self.env.head(), &self.env.load_before, loadavg());
+        let (head, before, after) = (self.host.head(), &self.host.load, loadavg());
         format!("{head} | load before {before}, after {after} | wall {wall:.0} s")
     }
 
@@ -81,9 +81,9 @@ impl Bench {
             "period_us": cy.period_us,
             "cpu": cy.cpu,
             "priority": cy.priority,
-            "kernel": self.env.kernel,
-            "preemption": self.env.preemption,
-            "load_before": self.env.load_before,
+            "kernel": self.host.kernel,
+            "preemption": self.host.preemption,
+            "load_before": self.host.load,
             "load_after": loadavg(),
             "wall_s": wall,
         })

@@ -30,7 +30,9 @@ pub struct Merged {
 }
 
 impl Merged {
-    pub fn of(variant: Variant, done: &[&Done]) -> Self {
+    /// The slices of `variant` among `done`.
+    pub fn of(variant: Variant, done: &[Done]) -> Self {
+        let done: Vec<&Done> = done.iter().filter(|d| d.variant == variant).collect();
         let mut clients = Clients::default();
         done.iter().for_each(|d| clients.merge(&d.clients));
         let attach: Vec<f64> = done.iter().filter_map(|d| d.attach_s).collect();
@@ -91,13 +93,13 @@ pub fn text(
     warnings: &[String],
     leftovers: (usize, usize),
 ) -> String {
-    let (mut t, a, cy, env) = (Text::default(), &groups[0].g, &o.cycle, &b.env);
+    let (mut t, a, cy, env) = (Text::default(), &groups[0].g, &o.cycle, &b.host);
     t.line(format!(
         "== cpcost: what the control plane costs the cycle — period {} µs ({:.0} Hz), SCHED_FIFO {} on CPU {}, \
          demo machine (4 axes) idle, {:.0} s per variant in {} slice(s) of ≤ {} s, variants alternating",
         cy.period_us, 1e6 / f64::from(cy.period_us), cy.priority, cy.cpu, a.secs, a.slices, o.slicing.slice
     ));
-    let (head, throttling, before) = (env.head(), &env.throttling, &env.load_before);
+    let (head, throttling, before) = (env.head(), &env.throttling, &env.load);
     let after = motion_bench::host::loadavg();
     t.line(format!(
         "{head} | RT throttling {throttling} | load {before} before, {after} after"
@@ -309,7 +311,7 @@ pub fn json(
         "stats_every_ms": o.stats_every_ms,
         "wall_s": wall_s,
         "environment": with(b.environment(), json!({
-            "load_before": b.env.load_before,
+            "load_before": b.host.load,
             "load_after": motion_bench::host::loadavg(),
         })),
         "variants": variants,

@@ -93,13 +93,13 @@ fn run(o: &Opts) -> Result<i32, String> {
     let bins = Binaries::find(o.files.supervisor.as_deref())?;
     let out = o.files.out("");
     let b = Bench::start("deadpeer", Some(&out))?;
-    let (cy, env) = (&o.cycle, &b.env);
+    let (cy, env) = (&o.cycle, &b.host);
     let signals: Vec<&str> = o.signals.iter().map(|s| s.name()).collect();
     eprintln!(
         "deadpeer: {} trial(s) per signal ({}), {} µs cycle, SCHED_FIFO {} on CPU {} (motion-io there too), \
          spy on CPU {}; feedback_timeout_ms 10 (default); kernel {} ({}); load {}",
         o.trials, signals.join(", "), cy.period_us, cy.priority, cy.cpu, o.spy_cpu(), env.kernel,
-        env.preemption, env.load_before
+        env.preemption, env.load
     );
     let (mut trials, mut leftovers, mut interrupted) = (Vec::new(), Vec::new(), false);
     'all: for &sig in &o.signals {

@@ -26,7 +26,7 @@ pub fn print(o: &Opts, b: &Bench, results: &[(Mode, Measured)], leftovers: &[Str
         cy.priority,
         cy.cpu
     ));
-    let env = &b.env;
+    let env = &b.host;
     t.line(format!(
         "kernel {} | {} | {} CPUs | payload {PING} B → {PONG} B (CommandFrame → FeedbackFrame; bare: [u8; {PING}] → [u8; {PONG}])",
         env.kernel, env.preemption, env.cpus

@@ -40,14 +40,14 @@ pub fn hlog(
             cy.period_us, cy.priority, cy.cpu
         ),
         "tags: ours = motion-supervisor run (wake-up), demo machine idle; ours_axes64 = the same with 64 axes homing in parallel again and again; ours_ethercat = the same with motion-io --backend ethercat (--ethercat), cyclictest = cyclictest (1 us bins, recorded at the bin's lower edge)",
-        &format!("kernel {} ({})", b.env.kernel, b.env.preemption),
+        &format!("kernel {} ({})", b.host.kernel, b.host.preemption),
     ];
     hlog::write(path, &comments, t0_wall, &iv)
 }
 
 /// The plot of `m` in `path`.
 pub fn svg(path: &Path, o: &Opts, b: &Bench, m: &Summary) -> Result<(), String> {
-    let (cy, env) = (&o.cycle, &b.env);
+    let (cy, env) = (&o.cycle, &b.host);
     let title = format!(
         "Wake-up latency, period {} µs: motion-supervisor vs cyclictest, {:.0} s each",
         cy.period_us,

@@ -106,7 +106,7 @@ fn cyclictest(o: &Opts) -> Option<PathBuf> {
         );
         return None;
     };
-    if let Err(e) = host::can_use_fifo(o.cycle.priority) {
+    if let Err(e) = motion_rt::fifo_allowed(o.cycle.priority) {
         eprintln!(
             "jitter: WARNING: no real-time scheduling for this user ({e}); cyclictest cannot run \
              like that: SKIPPING the cyclictest half (the supervisor warns and runs SCHED_OTHER)"

@@ -108,7 +108,7 @@ impl Summary {
 
 /// The report's text.
 pub fn text(o: &Opts, b: &Bench, m: &Summary, c: &Collected) -> String {
-    let (cy, demo, env) = (&o.cycle, m.group(Variant::Demo), &b.env);
+    let (cy, demo, env) = (&o.cycle, m.group(Variant::Demo), &b.host);
     let mut t = Text::default();
     let load = match o.stress {
         true => format!(", stress-ng --cpu 1 on CPU {}", cy.other_cpu()),

@@ -61,13 +61,13 @@ fn run(o: &Opts) -> Result<i32, String> {
         not_cleaned: vec![],
         seq: 0,
     };
-    let (cy, env, other) = (&o.cycle, &b.env, ctx.other_cpu);
+    let (cy, env, other) = (&o.cycle, &b.host, ctx.other_cpu);
     eprintln!(
         "soak: {} one-axis homings via {:?} in blocks of {} ({:.0} % with stress-ng on CPU {other}), \
          {} parallel homings of 64 axes{}; {} µs cycle, SCHED_FIFO {} on CPU {}; kernel {} ({}); load {}",
         o.homings, o.via, o.block, o.stress_share * 100.0, o.runs64,
         if o.stress64 { " with stress-ng" } else { "" },
-        cy.period_us, cy.priority, cy.cpu, env.kernel, env.preemption, env.load_before
+        cy.period_us, cy.priority, cy.cpu, env.kernel, env.preemption, env.load
     );
     let one = parts::one_axis(o, &mut ctx)?;
     let mut axes64 = Part::default();
