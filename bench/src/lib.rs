@@ -2,9 +2,9 @@
 //! `jitter`, `cpcost`, `ipc`, `soak`, `deadpeer` — are thin sequences of
 //! these and of the crates: [`flags`] their common command-line groups,
 //! [`outcome`] how a run starts and ends, [`host`] the machine, [`slice`] a
-//! supervisor run read back, [`table`] the printed figures. The rest is
-//! the harness's (starting, driving and observing the binaries), the
-//! supervisor's (histograms and their `.hlog`) and `motion-plot`'s.
+//! supervisor run read back. The rest is the harness's (starting, driving
+//! and observing the binaries), the supervisor's (histograms and their
+//! `.hlog`), `motion-report`'s (the tables' cells) and `motion-plot`'s.
 //!
 //! Nothing here runs in a real-time loop except the IPC bench's measuring
 //! thread; the rest is orchestration, parsing and reporting.
@@ -13,12 +13,12 @@ pub mod flags;
 pub mod host;
 pub mod outcome;
 pub mod slice;
-pub mod table;
 
 pub use motion_harness::generated as machine;
 pub use motion_harness::process as proc;
 pub use motion_harness::{cyclictest, ecat, spy};
 pub use motion_plot as plot;
+pub use motion_report::table;
 pub use motion_supervisor::hlog;
 pub use motion_supervisor::stats::{histogram, percentiles};
 
@@ -29,4 +29,5 @@ pub mod drive {
     pub use motion_harness::homing::*;
     pub use motion_harness::leftovers::clean_leftovers;
     pub use motion_harness::procs::{io_children, stress};
+    pub use motion_harness::runs::{self, Measured};
 }

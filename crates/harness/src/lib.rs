@@ -16,7 +16,8 @@
 //!   [`temp`] — a test's scratch directory.
 //! * [`check`] — rows by name, positions within a tolerance, homed axes.
 //! * [`peer`] — the supervisor's side of a `motion-io`, played by a test.
-//! * [`homing`] — homing runs and their tally (the benches).
+//! * [`homing`] — homing runs and their tally (the benches); [`runs`] — a
+//!   timed daemon run and what it measured, read back (the slice benches).
 //! * [`procs`] — processes found in `/proc`; stress-ng.
 //! * [`spy`] — the frame spy on one I/O process's topics.
 //! * [`cyclictest`] — the jitter bench's reference: its command and histogram.
@@ -43,6 +44,7 @@ pub mod peer;
 mod placement;
 pub mod process;
 pub mod procs;
+pub mod runs;
 pub mod spy;
 pub mod temp;
 

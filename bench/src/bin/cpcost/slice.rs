@@ -1,15 +1,15 @@
 //! The slices: one `motion-supervisor run` of one variant on the demo
 //! machine (with `--no-control-plane` for (a)), the clients attached for
 //! (b) and (c) once the daemon answers, then what it measured
-//! (`motion_bench::slice`); the variants alternate, odd slices in reverse
+//! (`motion_harness::runs`); the variants alternate, odd slices in reverse
 //! order (neither variant always follows the other).
 
 use crate::cli::Opts;
 use crate::clients::{self, Clients};
 use crate::variant::Variant;
-use motion_bench::drive::{self, Binaries};
+use motion_bench::drive::{self, runs, Binaries};
 use motion_bench::outcome::Bench;
-use motion_bench::slice::{self, Slice};
+use motion_bench::slice::Slice;
 use motion_bench::table::us;
 use motion_bench::{machine, proc};
 use std::collections::BTreeSet;
@@ -76,7 +76,7 @@ fn one(
     // its --duration starts after its own start-up: it cannot end before this
     let cut = t0 + Duration::from_secs_f64(len);
     let limit = Duration::from_secs_f64(len + 60.0);
-    let (mut sup, hlog) = slice::start(b, &bench.tmp, (&tag, &toml, &prefix), len, extra)?;
+    let (mut sup, hlog) = runs::start(b, &bench.tmp, (&tag, &toml, &prefix), len, extra)?;
     let (mut clients, mut attach_s, mut failed) = (Clients::default(), None, None);
     if v.serves() {
         let wait = Duration::from_secs_f64(len.min(10.0));
@@ -114,9 +114,9 @@ fn one(
     }
     let read = match failed {
         Some(e) => Err(e),
-        None => slice::read(&ended, &hlog, Duration::ZERO, len),
+        None => runs::read(&ended, &hlog),
     };
-    let (slice, warnings) = match read {
+    let (m, warnings) = match read {
         Ok(x) => x,
         Err(e) => {
             let (k, label) = (i + 1, v.label());
@@ -126,6 +126,11 @@ fn one(
         }
     };
     r.warnings.extend(warnings);
+    let slice = Slice {
+        start: Duration::ZERO,
+        len,
+        m,
+    };
     let d = Done {
         variant: v,
         slice,
@@ -139,10 +144,11 @@ fn one(
 
 /// One line per slice on stderr.
 fn progress(i: usize, n: usize, d: &Done) {
-    let (v, l, c) = (d.variant, &d.slice.lat, &d.clients);
+    let (v, l, c) = (d.variant, &d.slice.m.report.latency, &d.clients);
     let cpu = d
         .slice
-        .cpu
+        .m
+        .cpu()
         .map_or("-".into(), |c| format!("{:.1} %", c * 100.0));
     let requests = match v.serves() {
         true => format!(

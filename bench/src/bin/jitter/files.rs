@@ -28,7 +28,7 @@ pub fn hlog(
         let tag = v.names().tag;
         c.ours[v as usize]
             .iter()
-            .map(move |s| (tag, s.start, Duration::from_secs_f64(s.len), &s.wakeup))
+            .map(move |s| (tag, s.start, Duration::from_secs_f64(s.len), &s.m.wakeup))
     });
     let mut iv: Vec<hlog::Interval> = ours.collect();
     iv.extend(c.ct.iter().map(|s| ("cyclictest", s.start, s.len, &s.hdr)));

@@ -10,12 +10,12 @@
 use crate::cli::Opts;
 use crate::homing64::{self, Homing64};
 use motion_bench::cyclictest::{self, CtHistogram};
-use motion_bench::drive::{self, Binaries};
+use motion_bench::drive::{self, runs, Binaries};
 use motion_bench::ecat::{self, BusRun, EcatRig};
 use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine};
 use motion_bench::proc::{self, Running};
-use motion_bench::slice::{self, Slice};
+use motion_bench::slice::Slice;
 use motion_bench::table::us;
 use motion_bench::{histogram, plot::RGBColor};
 use std::collections::BTreeSet;
@@ -202,7 +202,7 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
     };
     let (start, t) = (p.t0.elapsed(), Instant::now());
     let tag = format!("{}{i}", n.letter);
-    let (mut run, log) = slice::start(p.bins, p.tmp, (&tag, &toml, &prefix), len, &[])?;
+    let (mut run, log) = runs::start(p.bins, p.tmp, (&tag, &toml, &prefix), len, &[])?;
     let homing = (v == Variant::Axes64)
         .then(|| homing64::home_while(&p.bins.motionctl, &prefix, &mut run, t, len))
         .transpose()?;
@@ -212,7 +212,7 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
         c.interrupted = true;
         return Ok(false);
     }
-    let (s, warnings) = match slice::read(&ended, &log, start, len) {
+    let (m, warnings) = match runs::read(&ended, &log) {
         Ok(x) => x,
         Err(e) => {
             let (k, label) = (i + 1, n.label);
@@ -221,7 +221,7 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
             return Ok(false);
         }
     };
-    let (l, w) = (&s.lat, &s.lat.wakeup_us);
+    let (l, w) = (&m.report.latency, &m.report.latency.wakeup_us);
     let mut line = format!(
         "jitter: slice {}/{} {:<11} {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies)",
         i + 1, p.slices, format!("{}:", n.label), l.cycles, us(w.p99), us(w.max), l.deadline_misses, l.late_replies
@@ -236,7 +236,7 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
     eprintln!("{line}");
     c.warnings
         .extend(warnings.into_iter().map(|w| format!("{}{w}", n.warn)));
-    c.ours[v as usize].push(s);
+    c.ours[v as usize].push(Slice { start, len, m });
     let (found, remaining) = drive::clean_leftovers(&prefix);
     if !found.is_empty() {
         let all = if remaining.is_empty() {

@@ -43,31 +43,27 @@ fn run(o: &Opts) -> Result<i32, String> {
     let bins = Binaries::find(o.files.supervisor.as_deref())?;
     let stress = o.stress_share > 0.0 || o.stress64;
     if stress && (host::cpus() < 2 || host::find_in_path("stress-ng").is_none()) {
-        return Err(
-            "stress-ng (apt-get install -y stress-ng) and a second CPU are needed \
-                    (or --stress-share 0)"
-                .into(),
-        );
+        let needed = "stress-ng (apt-get install -y stress-ng) and a second CPU are needed";
+        return Err(format!("{needed} (or --stress-share 0)"));
     }
     let out = o.files.out("");
     let b = Bench::start("soak", Some(&out))?;
-    let (tmp, other_cpu) = (b.tmp.clone(), o.cycle.other_cpu());
     let mut ctx = Ctx {
         b: bins,
-        tmp,
+        tmp: b.tmp.clone(),
         evidence: out.join("soak-evidence"),
-        other_cpu,
+        other_cpu: o.cycle.other_cpu(),
         leftovers: vec![],
         not_cleaned: vec![],
         seq: 0,
     };
-    let (cy, env, other) = (&o.cycle, &b.host, ctx.other_cpu);
+    let (cy, h, other) = (&o.cycle, &b.host, ctx.other_cpu);
+    let with = if o.stress64 { " with stress-ng" } else { "" };
     eprintln!(
         "soak: {} one-axis homings via {:?} in blocks of {} ({:.0} % with stress-ng on CPU {other}), \
-         {} parallel homings of 64 axes{}; {} µs cycle, SCHED_FIFO {} on CPU {}; kernel {} ({}); load {}",
+         {} parallel homings of 64 axes{with}; {} µs cycle, SCHED_FIFO {} on CPU {}; kernel {} ({}); load {}",
         o.homings, o.via, o.block, o.stress_share * 100.0, o.runs64,
-        if o.stress64 { " with stress-ng" } else { "" },
-        cy.period_us, cy.priority, cy.cpu, env.kernel, env.preemption, env.load
+        cy.period_us, cy.priority, cy.cpu, h.kernel, h.preemption, h.load
     );
     let one = parts::one_axis(o, &mut ctx)?;
     let mut axes64 = Part::default();
