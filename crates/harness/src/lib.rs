@@ -17,7 +17,8 @@
 //! * [`check`] — rows by name, positions within a tolerance, homed axes.
 //! * [`peer`] — the supervisor's side of a `motion-io`, played by a test.
 //! * [`homing`] — homing runs and their tally (the benches); [`runs`] — a
-//!   timed daemon run and what it measured, read back (the slice benches).
+//!   timed daemon run and what it measured, read back (the slice benches);
+//!   [`clients`] — a deployed machine's motionctl clients as a load.
 //! * [`procs`] — processes found in `/proc`; stress-ng.
 //! * [`spy`] — the frame spy on one I/O process's topics.
 //! * [`cyclictest`] — the jitter bench's reference: its command and histogram.
@@ -32,6 +33,7 @@
 
 pub mod bins;
 pub mod check;
+pub mod clients;
 pub mod commands;
 pub mod cyclictest;
 pub mod daemon;

@@ -10,7 +10,6 @@
 //! print them ([`report`]), write cpcost.json.
 
 mod cli;
-mod clients;
 mod report;
 mod slice;
 mod variant;

@@ -5,9 +5,9 @@
 //! cpcost.json with the same figures.
 
 use crate::cli::Opts;
-use crate::clients::{Clients, Count};
 use crate::slice::Done;
 use crate::variant::Variant;
+use motion_bench::clients::{Clients, Count, HOME, STATS, STATUS, WATCH};
 use motion_bench::outcome::{status, with, Bench};
 use motion_bench::slice::{ratio_json, Group, MAX_MISS_RATIO};
 use motion_bench::table::{line, ratio, ratio_cells, ratio_of, row, thousands, us_cells, Text};
@@ -207,22 +207,18 @@ fn client_requests(t: &mut Text, o: &Opts, m: &Merged) {
         c.failed(),
         c.cut_off()
     ));
-    let mut kinds = vec![
-        ("status --watch (one per slice)".to_string(), &c.watch),
+    let kinds = [
+        ("status --watch (one per slice)".to_string(), WATCH),
         (
             format!("status --json every {} ms", o.status_every_ms),
-            &c.status,
+            STATUS,
         ),
-        (
-            format!("stats --json every {} ms", o.stats_every_ms),
-            &c.stats,
-        ),
+        (format!("stats --json every {} ms", o.stats_every_ms), STATS),
+        ("home X --json, back to back".into(), HOME),
     ];
-    if m.variant == Variant::Homing {
-        kinds.push(("home X --json, back to back".into(), &c.home));
-    }
-    for (what, c) in kinds {
-        t.line(requests(&what, c));
+    let shown = if m.variant == Variant::Homing { 4 } else { 3 };
+    for (what, k) in &kinds[..shown] {
+        t.line(requests(what, &c.0[*k]));
     }
     c.details()
         .take(10)
@@ -244,17 +240,18 @@ fn group_json(o: &Opts, m: &Merged) -> Value {
     if !g.ran() {
         return json!({ "ran": false });
     }
+    let ms = |k: usize| c.0[k].ms_p50_max();
     let clients = json!({
         "made": c.made(),
         "failed": c.failed(),
         "cut_off": c.cut_off(),
-        "watch": c.watch,
-        "status": c.status,
-        "status_request_ms_p50_max": c.status.ms_p50_max(),
-        "stats": c.stats,
-        "stats_request_ms_p50_max": c.stats.ms_p50_max(),
-        "home": c.home,
-        "home_request_ms_p50_max": c.home.ms_p50_max(),
+        "watch": c.0[WATCH],
+        "status": c.0[STATUS],
+        "status_request_ms_p50_max": ms(STATUS),
+        "stats": c.0[STATS],
+        "stats_request_ms_p50_max": ms(STATS),
+        "home": c.0[HOME],
+        "home_request_ms_p50_max": ms(HOME),
     });
     let more = json!({
         "ran": true,

@@ -5,8 +5,8 @@
 //! order (neither variant always follows the other).
 
 use crate::cli::Opts;
-use crate::clients::{self, Clients};
 use crate::variant::Variant;
+use motion_bench::clients::{self, Clients};
 use motion_bench::drive::{self, runs, Binaries};
 use motion_bench::outcome::Bench;
 use motion_bench::slice::Slice;

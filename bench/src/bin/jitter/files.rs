@@ -106,7 +106,7 @@ pub fn json(
         m.group(Variant::Axes64),
         m.group(Variant::Ethercat),
     );
-    let ct_ran = m.ct.ran();
+    let (ct_ran, h) = (m.ct.ran(), &c.homing64);
     let bus: Vec<Value> = (c.bus_runs.iter())
         .map(|b| json!({"cycles": b.cycles, "min": b.min, "p50": b.p50, "p99": b.p99, "p999": b.p999, "max": b.max, "lost_frames": b.lost}))
         .collect();
@@ -127,7 +127,14 @@ pub fn json(
         "ours_axes64": if a64.ran() { with(Group::json(a64), json!({
             "machine": "64 axes (motion_bench::machine::axes64_with), motionctl home --parallel again and again",
             "hlog_samples": a64.wake.len(),
-            "homing": c.homing64.json(),
+            "homing": {
+                "started": h.started,
+                "all_homed": h.ok,
+                "with_failed_axis": h.failed,
+                "cut_off_by_slice_end": h.cut_off,
+                "axes": h.tally,
+                "mean_duration_s": h.mean_s(),
+            },
         })) } else { skipped() },
         "ours_ethercat": if ecat.ran() {
             with(Group::json(ecat), json!({ "bus_roundtrip_us_per_slice": bus }))

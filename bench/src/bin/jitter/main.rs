@@ -10,7 +10,6 @@
 
 mod cli;
 mod files;
-mod homing64;
 mod report;
 mod slices;
 

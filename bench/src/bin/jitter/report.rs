@@ -214,7 +214,12 @@ fn others(t: &mut Text, m: &Summary, c: &Collected) {
     ));
     let a64 = m.group(Variant::Axes64);
     if a64.ran() {
-        t.line(c.homing64.line(a64.secs));
+        let (h, y) = (&c.homing64, &c.homing64.tally);
+        t.line(format!(
+            "64 axes: {} parallel homing(s) in {:.0} s ({:.1} s each): {} all homed, {} with a failed axis, {} cut off by a slice's end; \
+             axis homings {}: {} ok, {} ERR 12/40 (feedback lost), {} other error(s), {} not homed",
+            h.started, a64.secs, h.mean_s(), h.ok, h.failed, h.cut_off, y.axis_homings, y.ok, y.feedback_lost, y.other_errors, y.not_homed
+        ));
         for d in c.homing64.tally.details.iter().take(10) {
             t.line(format!("  {d}"));
         }

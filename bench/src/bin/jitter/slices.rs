@@ -8,9 +8,8 @@
 //! reported); so does SIGINT/SIGTERM.
 
 use crate::cli::Opts;
-use crate::homing64::{self, Homing64};
 use motion_bench::cyclictest::{self, CtHistogram};
-use motion_bench::drive::{self, runs, Binaries};
+use motion_bench::drive::{self, runs, Binaries, Repeated};
 use motion_bench::ecat::{self, BusRun, EcatRig};
 use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine};
@@ -141,7 +140,8 @@ pub struct CtSlice {
 pub struct Collected {
     /// Per variant (`Variant as usize`), its slices.
     pub ours: [Vec<Slice>; 3],
-    pub homing64: Homing64,
+    /// The 64-axis machine's homings (`motionctl home --parallel`).
+    pub homing64: Repeated,
     /// motion-io's bus round trips, one per EtherCAT slice that reported it.
     pub bus_runs: Vec<BusRun>,
     pub ct: Vec<CtSlice>,
@@ -203,9 +203,10 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
     let (start, t) = (p.t0.elapsed(), Instant::now());
     let tag = format!("{}{i}", n.letter);
     let (mut run, log) = runs::start(p.bins, p.tmp, (&tag, &toml, &prefix), len, &[])?;
-    let homing = (v == Variant::Axes64)
-        .then(|| homing64::home_while(&p.bins.motionctl, &prefix, &mut run, t, len))
-        .transpose()?;
+    let homing = match v {
+        Variant::Axes64 => Some(home_while(p, &prefix, &mut run, t, len)?),
+        _ => None,
+    };
     let left = Duration::from_secs_f64(len + 60.0).saturating_sub(t.elapsed());
     let ended = run.wait(left, Duration::from_secs(10));
     if ended.interrupted {
@@ -227,7 +228,8 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
         i + 1, p.slices, format!("{}:", n.label), l.cycles, us(w.p99), us(w.max), l.deadline_misses, l.late_replies
     );
     if let Some(h) = homing {
-        line += &h.progress();
+        let (n, ok, failed, cut) = (h.started, h.ok, h.failed, h.cut_off);
+        line += &format!("; {n} homing(s) of 64 axes: {ok} ok, {failed} failed, {cut} cut off by the slice's end");
         c.homing64.merge(h);
     }
     if v == Variant::Ethercat {
@@ -250,6 +252,22 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
         ));
     }
     Ok(true)
+}
+
+/// The 64-axis machine homed again and again, once it is ready, while it
+/// is measured (so that the cycle computes every axis moving).
+fn home_while(
+    p: &Plan,
+    prefix: &str,
+    run: &mut Running,
+    t: Instant,
+    len: f64,
+) -> Result<Repeated, String> {
+    let m = &p.bins.motionctl;
+    match drive::wait_until_ready(m, prefix, run, Duration::from_secs_f64(len)) {
+        Ok(()) => Repeated::run(m, prefix, run, t, len),
+        Err(_) => Ok(Repeated::default()),
+    }
 }
 
 /// motion-io's bus round trip from the summary it logged (kept in `c`),

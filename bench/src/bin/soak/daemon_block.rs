@@ -14,7 +14,7 @@ use motion_bench::drive::{self, HomeRun};
 use motion_bench::proc::Ended;
 use motion_bench::spy::{Recording, Spy};
 use motion_bench::{host, machine, proc};
-use motion_report::{AxisResult, RunReport};
+use motion_report::RunReport;
 use serde_json::{json, Value};
 use std::path::Path;
 use std::process::Command;
@@ -48,7 +48,7 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
         }
         let csv = ctx.tmp.join(format!("{prefix}-{i}.csv"));
         let run = match o.trace {
-            true => traced_home(&ctx.b.motionctl, &prefix, &csv, o.timeout)?,
+            true => drive::traced_home(&ctx.b.motionctl, &prefix, "X", &csv, o.timeout)?,
             false => drive::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?,
         };
         if run.ended.interrupted {
@@ -102,50 +102,6 @@ fn still_homed(ctx: &Ctx, prefix: &str, i: u32, part: &mut Part) {
             a.err, a.exerr
         ));
     }
-}
-
-/// One homing of X recorded by `motionctl trace X --home --out CSV`; its
-/// result row from `motionctl status` once the trace has ended.
-fn traced_home(
-    motionctl: &Path,
-    prefix: &str,
-    csv: &Path,
-    timeout: f64,
-) -> Result<HomeRun, String> {
-    let mut cmd = Command::new(motionctl);
-    cmd.args([
-        "--service-prefix",
-        prefix,
-        "trace",
-        "X",
-        "--home",
-        "--json",
-        "--out",
-    ]);
-    cmd.arg(csv).args(["--timeout", &timeout.to_string()]);
-    let limit = Duration::from_secs_f64(timeout + 30.0);
-    let mut run = drive::home_run(&mut cmd, "motionctl trace", limit)?;
-    let status = drive::status(motionctl, prefix);
-    let row = |a: &motion_report::AxisStatus| AxisResult {
-        name: a.name.clone(),
-        pc: a.pc,
-        er: a.er,
-        err: a.err,
-        exerr: a.exerr,
-        homed: a.homed,
-        error: a.error.clone(),
-        duration_s: Some(a.elapsed_s),
-        ..AxisResult::default()
-    };
-    run.rows = status
-        .iter()
-        .flat_map(|s| s.axes.first())
-        .map(row)
-        .collect();
-    if let Some(st) = status {
-        run.json = Some(json!({"trace": run.json.take(), "status": st}));
-    }
-    Ok(run)
 }
 
 /// Keeps what tells why homing `i` of `prefix` failed: its row, when it
