@@ -160,6 +160,19 @@ pub fn tmp_dir(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("motion-bench-{name}-{}", std::process::id()))
 }
 
+/// Cleans what the run of `prefix` left in /dev/shm; if it left anything:
+/// the files and `(then cleaned by the bench[, NOT all]): FILES`.
+pub fn cleaned(prefix: &str) -> Option<(Vec<String>, String)> {
+    let (found, remaining) = crate::drive::clean_leftovers(prefix);
+    let all = if remaining.is_empty() {
+        ""
+    } else {
+        ", NOT all"
+    };
+    let note = format!("(then cleaned by the bench{all}): {}", found.join(", "));
+    (!found.is_empty()).then_some((found, note))
+}
+
 /// The `status` object of a report's JSON: ok, interrupted, the failures.
 pub fn status(interrupted: bool, failures: &[String]) -> Value {
     json!({

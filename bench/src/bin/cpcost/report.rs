@@ -157,15 +157,8 @@ fn latencies(t: &mut Text, groups: &[Merged]) {
 fn cycles(t: &mut Text, groups: &[Merged]) {
     const WIDTHS: [i32; 6] = [-26, 10, 22, 14, 16, 15];
     let a = &groups[0].g;
-    let head = [
-        "",
-        "cycles",
-        "deadline misses",
-        "late replies",
-        "supervisor CPU",
-        "motion-io CPU",
-    ];
-    t.line(line(&WIDTHS, head));
+    let head = "|cycles|deadline misses|late replies|supervisor CPU|motion-io CPU";
+    t.line(line(&WIDTHS, head.split('|')));
     for m in groups.iter().filter(|m| m.g.ran()) {
         let g = &m.g;
         let (name, misses) = (

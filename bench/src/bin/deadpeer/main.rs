@@ -185,13 +185,9 @@ fn report(
         f64::from(cy.period_us) / 1000.0
     ));
     t.line("");
-    let head = [
-        "signal", "trials", "min ms", "p50 ms", "p90 ms", "max ms", "mean", "",
-    ];
-    let head = head
-        .into_iter()
-        .chain(["from last feedback p50/max", "12/40 result"]);
-    t.line(line(&WIDTHS, head));
+    let head =
+        "signal|trials|min ms|p50 ms|p90 ms|max ms|mean||from last feedback p50/max|12/40 result";
+    t.line(line(&WIDTHS, head.split('|')));
     let mut summary = Vec::new();
     for &sig in &o.signals {
         let ts: Vec<&Trial> = trials.iter().filter(|t| t.signal == sig).collect();

@@ -13,9 +13,10 @@
 
 use crate::{Opts, Sig};
 use motion_bench::drive::{self, Binaries};
+use motion_bench::machine;
+use motion_bench::outcome::{self, Bench};
 use motion_bench::proc::{self, Running};
 use motion_bench::spy::{Cmd, Recording, Spy};
-use motion_bench::{machine, outcome::Bench};
 use motion_frames::CW_ENABLE;
 use motion_ipc::monotonic_ns;
 use serde::Serialize;
@@ -135,15 +136,8 @@ pub fn run(
     let mut home = None;
     let result = spy.as_ref().map_err(String::clone).and_then(|_| {
         let mut cmd = Command::new(&b.motionctl);
-        cmd.args([
-            "--service-prefix",
-            &prefix,
-            "home",
-            "X",
-            "--json",
-            "--timeout",
-            "120",
-        ]);
+        cmd.args(["--service-prefix", &prefix]);
+        cmd.args(["home", "X", "--json", "--timeout", "120"]);
         home = Some(Running::spawn(&mut cmd, "motionctl home", true, false)?);
         signal(o, &shared, io_pid, sig, &mut t)
     });
@@ -165,17 +159,8 @@ pub fn run(
         t.problems
             .push(format!("the supervisor ended with {how} ({tail})"));
     }
-    let (found, remaining) = drive::clean_leftovers(&prefix);
-    if !found.is_empty() {
-        let all = if remaining.is_empty() {
-            ""
-        } else {
-            ", NOT all"
-        };
-        t.problems.push(format!(
-            "left behind (then cleaned by the bench{all}): {}",
-            found.join(", ")
-        ));
+    if let Some((found, note)) = outcome::cleaned(&prefix) {
+        t.problems.push(format!("left behind {note}"));
         leftovers.extend(found);
     }
     let _ = std::fs::remove_file(bench.tmp.join(format!("{prefix}.toml")));

@@ -13,6 +13,7 @@ use motion_bench::drive::{self, runs, Binaries, Repeated};
 use motion_bench::ecat::{self, BusRun, EcatRig};
 use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine};
+use motion_bench::outcome;
 use motion_bench::proc::{self, Running};
 use motion_bench::slice::Slice;
 use motion_bench::table::us;
@@ -239,17 +240,9 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
     c.warnings
         .extend(warnings.into_iter().map(|w| format!("{}{w}", n.warn)));
     c.ours[v as usize].push(Slice { start, len, m });
-    let (found, remaining) = drive::clean_leftovers(&prefix);
-    if !found.is_empty() {
-        let all = if remaining.is_empty() {
-            ""
-        } else {
-            ", NOT all"
-        };
-        c.warnings.insert(format!(
-            "left in /dev/shm after a run (then cleaned by the bench{all}): {}",
-            found.join(", ")
-        ));
+    if let Some((_, note)) = outcome::cleaned(&prefix) {
+        c.warnings
+            .insert(format!("left in /dev/shm after a run {note}"));
     }
     Ok(true)
 }

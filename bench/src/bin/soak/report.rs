@@ -97,9 +97,13 @@ pub struct Outcome {
     pub wall: f64,
 }
 
-/// The columns of the homings' table and of the supervisors' one.
+/// The columns of the homings' table and of the supervisors' one: their
+/// widths (negative: left-aligned) and headings.
 const HOMINGS: [i32; 9] = [-34, 9, 7, 10, 8, 10, 9, 10, 8];
+const HOMINGS_HEAD: &str = "part|homings|ok|12/40|other|not homed|no rows|lost betw|time s";
 const SUPERVISORS: [i32; 11] = [-34, 8, 11, 8, 9, 7, 7, 7, 7, 9, 12];
+const SUPERVISORS_HEAD: &str =
+    "supervisors (sum)|runs|cycles|misses|late rep|gap 1|2-3|4-10|>10|longest|wake max µs";
 
 /// The printed report.
 pub fn text(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> String {
@@ -110,18 +114,7 @@ pub fn text(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> String {
     ));
     t.line(b.load_line(out.wall));
     t.line("");
-    let head = [
-        "part",
-        "homings",
-        "ok",
-        "12/40",
-        "other",
-        "not homed",
-        "no rows",
-        "lost betw",
-        "time s",
-    ];
-    t.line(line(&HOMINGS, head));
+    t.line(line(&HOMINGS, HOMINGS_HEAD.split('|')));
     let row = |name: &str, p: &Part, between: bool| {
         let y = &p.tally;
         let lost = match between && o.via == Via::Daemon {
@@ -180,20 +173,7 @@ pub fn text(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> String {
 
 /// The supervisors' own figures per part.
 fn supervisors(t: &mut Text, parts: &[Part; 3]) {
-    let head = [
-        "supervisors (sum)",
-        "runs",
-        "cycles",
-        "misses",
-        "late rep",
-        "gap 1",
-        "2-3",
-        "4-10",
-        ">10",
-        "longest",
-        "wake max µs",
-    ];
-    t.line(line(&SUPERVISORS, head));
+    t.line(line(&SUPERVISORS, SUPERVISORS_HEAD.split('|')));
     for (name, p) in ["1 axis, no load", "1 axis, stress-ng", "64 axes"]
         .iter()
         .zip(parts)
