@@ -15,8 +15,8 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use crate::homing::{last_json, rows_of, tail};
-use crate::process::{Ended, Running};
+use crate::homing::{last_json, rows_of};
+use crate::process::{tail, Ended, Running};
 
 /// The kinds of request, in the order of [`Clients`]: `status --watch`
 /// (one per slice; failed = ended by itself while the supervisor ran),

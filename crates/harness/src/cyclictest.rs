@@ -4,8 +4,7 @@
 //! `# Min Latencies:`, `# Avg Latencies:`, `# Max Latencies:`, `# Histogram
 //! Overflows:` (samples at or above MAXUS, not in any bin).
 
-use crate::homing::tail;
-use crate::process::Ended;
+use crate::process::{tail, Ended};
 use hdrhistogram::Histogram;
 use std::path::Path;
 use std::process::Command;

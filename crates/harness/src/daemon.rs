@@ -120,7 +120,7 @@ pub fn start_run(
         Ok(()) => Ok(run),
         Err(e) => {
             let ended = stop_run(run, Duration::from_secs(20));
-            let tail = crate::homing::tail(&ended.stderr, 5);
+            let tail = crate::process::tail(&ended.stderr, 5);
             Err(format!("{e} ({}; {tail})", ended.describe()))
         }
     }

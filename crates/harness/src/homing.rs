@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 use motion_report::AxisResult;
 use serde::Serialize;
 
+pub use crate::process::tail;
 use crate::process::{Ended, Running};
 
 /// One `motionctl home --json` (or `motion-supervisor home --json`): how it
@@ -299,12 +300,6 @@ impl Repeated {
         let n = self.durations.len().max(1) as f64;
         self.durations.iter().sum::<f64>() / n
     }
-}
-
-/// The last `n` lines of `s`, joined with " | ".
-pub fn tail(s: &str, n: usize) -> String {
-    let lines: Vec<&str> = s.trim().lines().collect();
-    lines[lines.len().saturating_sub(n)..].join(" | ")
 }
 
 #[cfg(test)]

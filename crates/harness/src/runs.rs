@@ -12,8 +12,7 @@ use motion_supervisor::hlog;
 
 use crate::bins::Binaries;
 use crate::daemon::run_command;
-use crate::homing::tail;
-use crate::process::{Ended, Running};
+use crate::process::{tail, Ended, Running};
 
 /// Starts the daemon of the machine `toml` (written to `dir/TAG.toml`)
 /// under `prefix` for `len` s, its intervals logged to `dir/TAG.hlog`, with
