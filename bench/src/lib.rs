@@ -16,7 +16,7 @@ pub mod slice;
 
 pub use motion_harness::generated as machine;
 pub use motion_harness::process as proc;
-pub use motion_harness::{clients, cyclictest, ecat, spy};
+pub use motion_harness::{bare, clients, cyclictest, ecat, spy};
 pub use motion_plot as plot;
 pub use motion_report::table;
 pub use motion_supervisor::hlog;

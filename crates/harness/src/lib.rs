@@ -20,7 +20,8 @@
 //!   timed daemon run and what it measured, read back (the slice benches);
 //!   [`clients`] — a deployed machine's motionctl clients as a load.
 //! * [`procs`] — processes found in `/proc`; stress-ng.
-//! * [`spy`] — the frame spy on one I/O process's topics.
+//! * [`spy`] — the frame spy on one I/O process's topics; [`bare`] — plain
+//!   iceoryx2 ports of the frames' sizes and their echo (the IPC bench's floor).
 //! * [`cyclictest`] — the jitter bench's reference: its command and histogram.
 //! * [`ecat`] — the EtherCAT veth rig with emulated drives.
 //!
@@ -31,6 +32,7 @@
 //! read through `motion-report`'s typed structs, the same definitions the
 //! binaries write.
 
+pub mod bare;
 pub mod bins;
 pub mod check;
 pub mod clients;

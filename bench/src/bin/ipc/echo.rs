@@ -6,12 +6,11 @@
 //! Its command line is its own parser, not a subcommand of the bench's:
 //! its flags mean other things than the bench's flags of the same name.
 
-use crate::bare::{BareSide, PING, PONG};
 use clap::{Parser, ValueEnum};
+use motion_bench::bare::{self, BareSide, PING, PONG};
 use motion_bench::host;
 use motion_bench::proc;
 use motion_ipc::{cleanup_domain, Domain};
-use motion_rt::now_ns;
 use std::time::{Duration, Instant};
 
 /// The peer's role (`echo`, the only one).
@@ -104,30 +103,10 @@ fn echo(prefix: &str, spin: bool) -> Result<(), String> {
         .create_node("bench-echo")
         .map_err(|e| e.to_string())?;
     let mut x = BareSide::<PONG, PING>::create(&node, prefix, "pong", "ping")?;
-    let r = echo_loop(&mut x, spin);
+    let r = bare::echo(&mut x, spin, proc::stop_requested);
     drop((x, node));
     let _ = cleanup_domain(&domain);
     r
-}
-
-/// Echoes until stopped: the newest ping only (older ones are dropped, as
-/// motion-io answers only the newest command).
-fn echo_loop(x: &mut BareSide<PONG, PING>, spin: bool) -> Result<(), String> {
-    while !proc::stop_requested() {
-        if !spin {
-            // bounded, so that the stop flag is seen even without pings
-            x.wait_fd_until(now_ns() + 100_000_000);
-        }
-        match x.receive_latest() {
-            Some(seq) => {
-                x.pending = None;
-                x.publish(seq)?;
-            }
-            None if spin => std::hint::spin_loop(),
-            None => {}
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -10,7 +10,6 @@
 //! sequence: the stage (motion-io, real-time settings), one [`run_mode`] per
 //! mode, the [`report`].
 
-mod bare;
 mod cli;
 mod echo;
 mod exchange;

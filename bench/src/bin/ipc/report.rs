@@ -3,10 +3,10 @@
 //! their ratio per percentile, and what could make the numbers wrong (other
 //! real-time threads, shared memory left behind).
 
-use crate::bare::{PING, PONG};
 use crate::cli::Opts;
 use crate::measure::Measured;
 use crate::mode::Mode;
+use motion_bench::bare::{PING, PONG};
 use motion_bench::outcome::Bench;
 use motion_bench::percentiles;
 use motion_bench::table::{ratio_cells, row, thousands, us_cells, Text};

@@ -1,10 +1,10 @@
-//! The bare side of the `bare-*` modes: plain iceoryx2 ports carrying byte
-//! arrays of the frames' sizes, built with the frames' settings
-//! (`motion_ipc::ports::{topic_builder, event_builder}`), used by both the
-//! measuring thread and the echo peer. The bare round trip differs from
-//! motion-io's only in what motion-io does with a frame.
+//! Plain iceoryx2 ports carrying byte arrays of the frames' sizes, built
+//! with the frames' settings (`motion_ipc::ports::{topic_builder,
+//! event_builder}`), and the echo that answers on them: the IPC bench's
+//! floor, what iceoryx2 itself costs with the frames' payloads, so that the
+//! round trip through motion-io differs from it only in what motion-io does
+//! with a frame.
 
-use crate::exchange::Exchange;
 use iceoryx2::node::Node;
 use iceoryx2::port::{listener::Listener, notifier::Notifier};
 use iceoryx2::port::{publisher::Publisher, subscriber::Subscriber};
@@ -15,7 +15,7 @@ use motion_ipc::ports::{event_builder, topic_builder, SUBSCRIBER_BUFFER};
 use motion_ipc::wait::{ppoll_until, PollWake};
 use std::fmt::Debug;
 
-/// Bare payloads: the sizes of the frames.
+/// The payloads: the sizes of the command and the feedback frame.
 pub const PING: usize = std::mem::size_of::<CommandFrame>();
 pub const PONG: usize = std::mem::size_of::<FeedbackFrame>();
 
@@ -85,7 +85,8 @@ impl<const TX: usize, const RX: usize> BareSide<TX, RX> {
         })
     }
 
-    fn try_wait(&mut self) -> bool {
+    /// Takes a pending wake-up, if there is one.
+    pub fn try_wait(&mut self) -> bool {
         matches!(self.listener.try_wait(|_| {}), Ok(n) if n > 0)
     }
 
@@ -131,20 +132,73 @@ impl<const TX: usize, const RX: usize> BareSide<TX, RX> {
     }
 }
 
-impl<const TX: usize, const RX: usize> Exchange for BareSide<TX, RX> {
-    fn clear(&mut self) {
-        let _ = self.try_wait();
-    }
-    fn send(&mut self) -> Result<u64, String> {
+impl<const TX: usize, const RX: usize> BareSide<TX, RX> {
+    /// Publishes the next sequence number (from 1); returns it.
+    pub fn send_next(&mut self) -> Result<u64, String> {
         let seq = self.next;
         self.next += 1;
         self.publish(seq)?;
         Ok(seq)
     }
-    fn wait_until(&mut self, deadline_ns: u64) -> bool {
-        self.wait_fd_until(deadline_ns)
+}
+
+/// Echoes until `stop` says so: the newest ping answered with a pong
+/// carrying its sequence number, older ones dropped (as motion-io answers
+/// only the newest command). Waiting in `ppoll` on the listener's
+/// descriptor, bounded so that `stop` is seen without pings, or spinning.
+pub fn echo(
+    x: &mut BareSide<PONG, PING>,
+    spin: bool,
+    mut stop: impl FnMut() -> bool,
+) -> Result<(), String> {
+    while !stop() {
+        if !spin {
+            x.wait_fd_until(motion_rt::now_ns() + 100_000_000);
+        }
+        match x.receive_latest() {
+            Some(seq) => {
+                x.pending = None;
+                x.publish(seq)?;
+            }
+            None if spin => std::hint::spin_loop(),
+            None => {}
+        }
     }
-    fn answer(&mut self) -> Option<u64> {
-        self.receive_latest()
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use motion_ipc::{cleanup_domain, Domain};
+
+    #[test]
+    fn a_ping_is_echoed_with_its_sequence_number() {
+        let root = std::path::PathBuf::from(format!("/tmp/mhb{}", std::process::id() % 1_000_000));
+        let prefix = format!("mhbare{}", std::process::id());
+        let domain = Domain::establish(&prefix, Some(&root)).unwrap();
+        {
+            let node = domain.create_node("bench").unwrap();
+            let mut ping = BareSide::<PING, PONG>::create(&node, &prefix, "ping", "pong").unwrap();
+            let mut pong = BareSide::<PONG, PING>::create(&node, &prefix, "pong", "ping").unwrap();
+            assert_eq!((ping.send_next(), ping.send_next()), (Ok(1), Ok(2)));
+            assert!(pong.wait_fd_until(motion_rt::now_ns() + 1_000_000_000));
+            let mut rounds = 0;
+            echo(&mut pong, true, || {
+                rounds += 1;
+                rounds > 100
+            })
+            .unwrap();
+            assert!(ping.wait_fd_until(motion_rt::now_ns() + 1_000_000_000));
+            assert_eq!(
+                ping.receive_latest(),
+                Some(2),
+                "only the newest ping answered"
+            );
+            assert!(!ping.try_wait() && ping.receive_latest().is_none());
+        }
+        assert!(cleanup_domain(&domain).domain_gone());
+        domain.withdraw();
+        let _ = std::fs::remove_dir_all(&root);
     }
 }
