@@ -8,7 +8,8 @@
 //! * [`bins`] — where `motion-supervisor`, `motion-io` and `motionctl` are;
 //!   [`commands`] runs them as a test does.
 //! * [`daemon`] — `motion-supervisor run`: ready when `status --json`, read
-//!   as the typed report, shows its I/O attached; status; stop.
+//!   as the typed report, shows its I/O attached; started and ready in one
+//!   call (the benches); status; stop.
 //! * [`machines`] — the fixture machines (`tests/machines/*.toml`) with
 //!   stated overrides, written as a test's temporary config;
 //!   [`generated`] — the machines the benches generate.
@@ -16,7 +17,8 @@
 //!   [`temp`] — a test's scratch directory.
 //! * [`check`] — rows by name, positions within a tolerance, homed axes.
 //! * [`peer`] — the supervisor's side of a `motion-io`, played by a test.
-//! * [`homing`] — homing runs and their tally (the benches); [`runs`] — a
+//! * [`homing`] — homing runs, their tally, homings repeated while a
+//!   daemon is measured, a traced homing (the benches); [`runs`] — a
 //!   timed daemon run and what it measured, read back (the slice benches);
 //!   [`clients`] — a deployed machine's motionctl clients as a load.
 //! * [`procs`] — processes found in `/proc`; stress-ng.
