@@ -112,59 +112,41 @@ mod tests {
         s: Slicing<5000, 500>,
     }
 
-    fn parse(args: &[&str]) -> Result<T, clap::Error> {
-        T::try_parse_from(std::iter::once("t").chain(args.iter().copied()))
+    fn parse(args: &str) -> Result<T, clap::Error> {
+        T::try_parse_from(std::iter::once("t").chain(args.split_whitespace()))
     }
 
     #[test]
     fn defaults_values_and_mistakes() {
-        let t = parse(&["--cpu", "0"]).unwrap();
+        let t = parse("--cpu 0").unwrap();
+        let c = &t.c;
         assert_eq!(
-            (t.c.period_us, t.c.cpu, t.c.priority, t.c.other_cpu()),
+            (c.period_us, c.cpu, c.priority, c.other_cpu()),
             (1000, 0, 80, 1)
         );
         assert!(t.f.out("x").ends_with("bench/out/x") && t.f.supervisor.is_none());
-        let t = parse(&[
-            "--cpu=0",
-            "--period-us=250",
-            "--priority",
-            "90",
-            "--out",
-            "/o",
-        ])
-        .unwrap();
+        assert_eq!((t.s.duration, t.s.slice), (60.0, 5.0));
+        let t = parse("--cpu=0 --period-us=250 --priority 90 --out /o").unwrap();
         assert_eq!(
             (t.c.period_us, t.c.priority, t.f.out("x")),
             (250, 90, "/o".into())
         );
         assert_eq!(t.c.supervisor("p").service_prefix, "p");
-        let beyond = "4096";
-        for (args, flag) in [
-            (&["--priority", "0"][..], "--priority"),
-            (&["--priority", "100"], "--priority"),
-            (&["--period-us", "x"], "--period-us"),
-            (&["--cpu", beyond], "--cpu"),
+        for args in [
+            "--priority 0",
+            "--priority 100",
+            "--period-us x",
+            "--cpu 4096",
         ] {
-            let e = parse(args).unwrap_err();
-            assert_eq!(
-                e.kind(),
-                clap::error::ErrorKind::ValueValidation,
-                "{args:?}"
-            );
-            assert!(e.to_string().contains(flag), "{args:?}: {e}");
+            let (e, flag) = (parse(args).unwrap_err(), args.split(' ').next().unwrap());
+            assert_eq!(e.kind(), clap::error::ErrorKind::ValueValidation, "{args}");
+            assert!(e.to_string().contains(flag), "{args}: {e}");
         }
-        assert!(parse(&["--cpu", "0", "--cpu", "0"]).is_err() && parse(&["stray"]).is_err());
-        let s = parse(&["--cpu=0", "--duration", "12", "--slice=5"])
-            .unwrap()
-            .s;
+        assert!(parse("--cpu 0 --cpu 0").is_err() && parse("stray").is_err());
+        let s = parse("--cpu=0 --duration 12 --slice=5").unwrap().s;
         assert_eq!((s.count(), s.len(0), s.len(2)), (3, 5.0, 2.0));
-        assert_eq!((t.s.duration, t.s.slice), (60.0, 5.0));
-        for bad in [
-            &["--slice", "0.4"][..],
-            &["--duration", "0"],
-            &["--duration", "-1"],
-        ] {
-            assert!(parse(&[bad, &["--cpu=0"]].concat()).is_err(), "{bad:?}");
+        for bad in ["--slice 0.4", "--duration 0", "--duration -1"] {
+            assert!(parse(&format!("{bad} --cpu=0")).is_err(), "{bad}");
         }
     }
 }

@@ -1,47 +1,10 @@
-//! The machine a bench runs on as its reports show it (the facts come from
-//! `motion_rt::host`), other real-time threads seen while it runs, the
-//! bench's own threads set up like the cycle's, and the programs it starts.
+//! The machine a bench runs on (the facts come from `motion_rt::host`),
+//! other real-time threads seen while it runs, and the bench's own threads
+//! set up like the cycle's.
 
-pub use motion_rt::host::{cpus, kernel, loadavg, other_rt_tasks, preemption, RtTask};
+pub use motion_harness::bins::{beside_this_exe, find_in_path, is_executable};
+pub use motion_rt::host::{cpus, loadavg, other_rt_tasks, Host};
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
-
-/// The kernel and its real-time settings, read once at the start.
-pub struct Env {
-    pub kernel: String,
-    pub preemption: String,
-    pub is_rt: bool,
-    pub cpus: usize,
-    pub throttling: String,
-    /// Load average at the start.
-    pub load_before: String,
-}
-
-impl Env {
-    pub fn probe() -> Self {
-        let (preemption, is_rt) = preemption();
-        Env {
-            kernel: kernel(),
-            preemption,
-            is_rt,
-            cpus: cpus(),
-            throttling: motion_rt::host::rt_throttling(),
-            load_before: loadavg(),
-        }
-    }
-
-    /// `kernel K | preemption: P | N CPUs`: how every report's second line
-    /// starts.
-    pub fn head(&self) -> String {
-        let Env {
-            kernel,
-            preemption,
-            cpus,
-            ..
-        } = self;
-        format!("kernel {kernel} | preemption: {preemption} | {cpus} CPUs")
-    }
-}
 
 /// Other real-time threads (not this bench's): each is warned about once,
 /// when first seen, and all are reported at the end, since they compete
@@ -54,8 +17,10 @@ pub struct OtherRt {
 
 impl OtherRt {
     pub fn new(bench: &'static str) -> Self {
-        let seen = BTreeSet::new();
-        Self { bench, seen }
+        Self {
+            bench,
+            seen: BTreeSet::new(),
+        }
     }
 
     /// Looks for other real-time threads now (`when` says when, for the
@@ -99,43 +64,4 @@ pub fn enter_rt(cpu: Option<usize>, priority: Option<i32>) -> Vec<String> {
     let locked = mlockall(F::MCL_CURRENT | F::MCL_FUTURE).err();
     let locked = locked.map(|e| format!("mlockall: {e}"));
     pinned.into_iter().chain(locked).collect()
-}
-
-/// Whether this process may run a thread SCHED_FIFO at `priority` (tried
-/// on a throw-away thread).
-pub fn can_use_fifo(priority: i32) -> Result<(), String> {
-    std::thread::spawn(move || {
-        let cfg = motion_rt::RtConfig {
-            priority,
-            lock_memory: false,
-            prefault_stack: 0,
-            ..motion_rt::RtConfig::default()
-        };
-        let r = motion_rt::enter_realtime(&cfg);
-        match r.policy {
-            motion_rt::SchedPolicy::Fifo => Ok(()),
-            _ => Err(r.warnings.join("; ")),
-        }
-    })
-    .join()
-    .unwrap_or_else(|_| Err("probe thread panicked".into()))
-}
-
-/// `name` in `$PATH`.
-pub fn find_in_path(name: &str) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|d| d.join(name))
-        .find(|p| is_executable(p))
-}
-
-pub fn is_executable(p: &Path) -> bool {
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
-}
-
-/// `name` in the directory of this executable (`target/release/`).
-pub fn sibling_exe(name: &str) -> Option<PathBuf> {
-    let p = std::env::current_exe().ok()?.parent()?.join(name);
-    is_executable(&p).then_some(p)
 }

@@ -5,8 +5,10 @@
 //! (0; 1 if something failed; 130 if interrupted, the partial results
 //! printed and written all the same).
 
-use crate::host::{Env, OtherRt};
+use crate::flags::Cycle;
+use crate::host::{loadavg, Host, OtherRt};
 use crate::proc;
+use crate::table::Text;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -15,7 +17,7 @@ use std::time::Instant;
 pub struct Bench {
     /// The binary's name, in front of its stderr lines.
     pub name: &'static str,
-    pub env: Env,
+    pub host: Host,
     pub other_rt: OtherRt,
     /// Configs, logs and histograms of the runs (removed on drop).
     pub tmp: PathBuf,
@@ -33,11 +35,11 @@ impl Bench {
             std::fs::create_dir_all(d)
                 .map_err(|e| format!("cannot create {}: {e}", d.display()))?;
         }
-        let (env, mut other_rt) = (Env::probe(), OtherRt::new(name));
+        let (host, mut other_rt) = (Host::read(), OtherRt::new(name));
         other_rt.note("before the bench");
         Ok(Bench {
             name,
-            env,
+            host,
             other_rt,
             tmp,
             t0: Instant::now(),
@@ -46,15 +48,15 @@ impl Bench {
 
     /// Says so on stderr when the kernel is not PREEMPT_RT.
     pub fn warn_not_rt(&self) {
-        if !self.env.is_rt {
-            let (name, p) = (self.name, &self.env.preemption);
+        if !self.host.is_rt {
+            let (name, p) = (self.name, &self.host.preemption);
             eprintln!("{name}: kernel is not PREEMPT_RT ({p}): the numbers are upper bounds");
         }
     }
 
     /// The `environment` object of a report's JSON.
     pub fn environment(&self) -> Value {
-        let e = &self.env;
+        let e = &self.host;
         json!({
             "kernel": e.kernel,
             "preemption": e.preemption,
@@ -63,6 +65,36 @@ impl Bench {
             "rt_throttling": e.throttling,
             "other_rt_threads": self.other_rt.list(),
         })
+    }
+
+    /// `kernel … | preemption: … | N CPUs | load before B, after A | wall
+    /// W s`: the second line of the soak's and deadpeer's reports.
+    pub fn load_line(&self, wall: f64) -> String {
+        let (head, before, after) = (self.host.head(), &self.host.load, loadavg());
+        format!("{head} | load before {before}, after {after} | wall {wall:.0} s")
+    }
+
+    /// What the soak's and deadpeer's JSON start with: the cycle, the
+    /// kernel, the load before and after, the wall time.
+    pub fn json_head(&self, cy: &Cycle, wall: f64) -> Value {
+        json!({
+            "period_us": cy.period_us,
+            "cpu": cy.cpu,
+            "priority": cy.priority,
+            "kernel": self.host.kernel,
+            "preemption": self.host.preemption,
+            "load_before": self.host.load,
+            "load_after": loadavg(),
+            "wall_s": wall,
+        })
+    }
+
+    /// `WARNING: other real-time threads WHEN: …` in `t`, if there were any.
+    pub fn other_rt_warning(&self, t: &mut Text, when: &str) {
+        if !self.other_rt.is_empty() {
+            let list = self.other_rt.list().join("; ");
+            t.line(format!("WARNING: other real-time threads {when}: {list}"));
+        }
     }
 
     /// Nothing was measured: the failures on stderr, then 130 if
@@ -126,6 +158,28 @@ impl Drop for Bench {
 /// The temporary directory of bench `name` in this process.
 pub fn tmp_dir(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("motion-bench-{name}-{}", std::process::id()))
+}
+
+/// Cleans what the run of `prefix` left in /dev/shm; if it left anything:
+/// the files and `(then cleaned by the bench[, NOT all]): FILES`.
+pub fn cleaned(prefix: &str) -> Option<(Vec<String>, String)> {
+    let (found, remaining) = crate::drive::clean_leftovers(prefix);
+    let all = if remaining.is_empty() {
+        ""
+    } else {
+        ", NOT all"
+    };
+    let note = format!("(then cleaned by the bench{all}): {}", found.join(", "));
+    (!found.is_empty()).then_some((found, note))
+}
+
+/// The `status` object of a report's JSON: ok, interrupted, the failures.
+pub fn status(interrupted: bool, failures: &[String]) -> Value {
+    json!({
+        "ok": failures.is_empty() && !interrupted,
+        "interrupted": interrupted,
+        "failures": failures,
+    })
 }
 
 /// The object `v` with the members of `more` added.

@@ -1,106 +1,24 @@
-//! One `motion-supervisor run --json --hlog` slice as the slice benches
-//! (jitter, cpcost) start and read it, and the slices of one variant merged.
-//! The supervisor measures its own cycle; a bench only starts it and reads,
-//! every bench the same way.
+//! The slices of one variant merged: the slice benches (jitter, cpcost)
+//! run `motion-supervisor run --duration --json --hlog` in slices
+//! (`motion_harness::runs` starts one and reads it back) and report each
+//! variant as one.
 
-use crate::drive;
-use crate::hist::{self, new_hist, pct_of, Pct};
-use crate::proc::Ended;
+use crate::drive::Measured;
+use crate::{histogram, hlog, percentiles};
 use hdrhistogram::Histogram;
-use motion_report::Latency;
+use motion_report::{Latency, Percentiles};
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Duration;
 
 /// Share of missed deadlines above which a bench fails.
 pub const MAX_MISS_RATIO: f64 = 0.01;
 
-/// Writes `toml` to `tmp/TAG.toml` and returns `motion-supervisor run
-/// --config it --duration LEN --json --hlog tmp/TAG.hlog --service-prefix
-/// PREFIX` with the interval log's path.
-pub fn command(
-    supervisor: &Path,
-    tmp: &Path,
-    tag: &str,
-    toml: &str,
-    prefix: &str,
-    len: f64,
-) -> Result<(Command, PathBuf), String> {
-    let cfg = tmp.join(format!("{tag}.toml"));
-    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
-    let hlog = tmp.join(format!("{tag}.hlog"));
-    let mut cmd = Command::new(supervisor);
-    cmd.args(["run", "--config"]).arg(&cfg);
-    cmd.args(["--duration", &len.to_string(), "--json", "--hlog"])
-        .arg(&hlog);
-    cmd.args(["--service-prefix", prefix]);
-    Ok((cmd, hlog))
-}
-
-/// What one slice measured.
+/// One slice: when it started (from the bench's start), how many seconds
+/// it ran, what it measured.
 pub struct Slice {
-    /// When it started, from the bench's start.
     pub start: Duration,
-    /// Seconds it ran.
     pub len: f64,
-    /// Wake-up, compute and I/O round trip of every cycle (its interval log).
-    pub wakeup: Histogram<u64>,
-    pub compute: Histogram<u64>,
-    pub roundtrip: Histogram<u64>,
-    /// Its report's exact figures: counts, min and max.
-    pub lat: Latency,
-    /// The supervisor process (all its threads) and its motion-io processes
-    /// (summed), share of one core over `wall_s`.
-    pub cpu: Option<f64>,
-    pub io_cpu: Option<f64>,
-    pub wall_s: f64,
-}
-
-/// Reads a finished run: it must have succeeded, printed its report and
-/// measured cycles; errors carry the end of its stderr. Returns the slice
-/// and the warnings of the run and of its real-time set-up (one more if the
-/// cycle did not run SCHED_FIFO).
-pub fn read(
-    ended: &Ended,
-    hlog: &Path,
-    start: Duration,
-    len: f64,
-) -> Result<(Slice, Vec<String>), String> {
-    let stderr = ended.stderr.trim();
-    let tail = match stderr.is_empty() {
-        true => String::new(),
-        false => format!("; its stderr: {}", drive::tail(stderr, 8)),
-    };
-    if !ended.success() {
-        return Err(format!("{}{tail}", ended.describe()));
-    }
-    let report: motion_report::RunReport = (ended.stdout.lines().rev())
-        .find_map(|l| serde_json::from_str(l.trim()).ok())
-        .ok_or_else(|| format!("no run report on its stdout{tail}"))?;
-    if report.latency.cycles == 0 {
-        return Err(format!("it measured no cycles{tail}"));
-    }
-    let mut warnings = report.warnings.clone();
-    let rt = &report.rt;
-    warnings.extend(rt.iter().flat_map(|r| r.warnings.iter().cloned()));
-    if rt.as_ref().map(|r| r.policy.as_str()) != Some("SCHED_FIFO") {
-        warnings.push(format!("the cycle did not run SCHED_FIFO (rt: {rt:?})"));
-    }
-    let iv = hist::read_interval_log(hlog)?;
-    let io: Vec<f64> = report.cpu.io.iter().filter_map(|(_, c)| *c).collect();
-    let slice = Slice {
-        start,
-        len,
-        wakeup: hist::sum_tag(&iv, "wakeup"),
-        compute: hist::sum_tag(&iv, "compute"),
-        roundtrip: hist::sum_tag(&iv, "roundtrip"),
-        lat: report.latency,
-        cpu: report.cpu.supervisor,
-        io_cpu: (!io.is_empty()).then(|| io.iter().sum()),
-        wall_s: report.cpu.wall_s,
-    };
-    Ok((slice, warnings))
+    pub m: Measured,
 }
 
 /// The slices of one variant merged: percentiles of the merged interval
@@ -110,9 +28,9 @@ pub struct Group {
     /// Wake-up latency of every slice (the plot's curve).
     pub wake: Histogram<u64>,
     /// Wake-up, compute and I/O round trip, µs.
-    pub w: Pct,
-    pub c: Pct,
-    pub r: Pct,
+    pub w: Percentiles,
+    pub c: Percentiles,
+    pub r: Percentiles,
     pub cycles: u64,
     pub misses: u64,
     pub late: u64,
@@ -126,31 +44,32 @@ pub struct Group {
 
 impl Group {
     pub fn of(slices: &[&Slice]) -> Self {
-        let merged = |f: fn(&Slice) -> &Histogram<u64>| {
-            let mut h = new_hist();
-            slices.iter().for_each(|s| hist::merge(&mut h, f(s)));
+        let merged = |f: fn(&Measured) -> &Histogram<u64>| {
+            let mut h = histogram();
+            slices.iter().for_each(|s| hlog::merge(&mut h, f(&s.m)));
             h
         };
         // percentiles of the merged logs, min and max exact from the JSON
-        let exact = |h: &Histogram<u64>, f: fn(&Latency) -> Pct| {
-            let v = slices.iter().map(|s| f(&s.lat)).filter(|p| p.count > 0);
-            let v: Vec<Pct> = v.collect();
-            let mut p = pct_of(h);
+        let exact = |h: &Histogram<u64>, f: fn(&Latency) -> Percentiles| {
+            let v = slices.iter().map(|s| f(&s.m.report.latency));
+            let v = v.filter(|p| p.count > 0);
+            let v: Vec<Percentiles> = v.collect();
+            let mut p = percentiles(h);
             if !v.is_empty() {
                 p.min = v.iter().map(|p| p.min).fold(f64::INFINITY, f64::min);
                 p.max = v.iter().map(|p| p.max).fold(0.0, f64::max);
             }
             p
         };
-        let weighted = |f: fn(&Slice) -> Option<f64>| {
-            let (mut sum, mut wall) = (0.0, 0.0);
-            for (x, s) in slices.iter().filter_map(|s| Some((f(s)?, s))) {
-                sum += x * s.wall_s;
-                wall += s.wall_s;
-            }
+        let weighted = |f: fn(&Measured) -> Option<f64>| {
+            let v = slices
+                .iter()
+                .filter_map(|s| Some((f(&s.m)?, s.m.report.cpu.wall_s)));
+            let (sum, wall) = v.fold((0.0, 0.0), |(a, w), (x, t)| (a + x * t, w + t));
             (wall > 0.0).then(|| sum / wall)
         };
-        let sum = |f: fn(&Latency) -> u64| slices.iter().map(|s| f(&s.lat)).sum::<u64>();
+        let sum =
+            |f: fn(&Latency) -> u64| slices.iter().map(|s| f(&s.m.report.latency)).sum::<u64>();
         let wake = merged(|s| &s.wakeup);
         let (cycles, misses) = (sum(|l| l.cycles), sum(|l| l.deadline_misses));
         Group {
@@ -162,8 +81,8 @@ impl Group {
             misses,
             late: sum(|l| l.late_replies),
             miss_ratio: misses as f64 / cycles.max(1) as f64,
-            cpu: weighted(|s| s.cpu),
-            io_cpu: weighted(|s| s.io_cpu),
+            cpu: weighted(Measured::cpu),
+            io_cpu: weighted(Measured::io_cpu),
             secs: slices.iter().map(|s| s.len).sum(),
             slices: slices.len(),
         }
@@ -208,9 +127,9 @@ impl Group {
     }
 }
 
-/// `a / b` per column of [`Pct::values`] in a report's JSON, two decimals;
-/// null where `b` is 0.
-pub fn ratio_json(a: &Pct, b: &Pct) -> Value {
+/// `a / b` per column of [`Percentiles::values`] in a report's JSON, two
+/// decimals; null where `b` is 0.
+pub fn ratio_json(a: &Percentiles, b: &Percentiles) -> Value {
     let keys = ["min", "p50", "p99", "p999", "p9999", "max"];
     let r = a.ratio(b).map(|x| x.map(|x| motion_report::round(x, 2)));
     Value::Object(

@@ -4,7 +4,6 @@
 
 use motionctl::cli;
 mod commands;
-mod plot;
 
 use clap::Parser;
 

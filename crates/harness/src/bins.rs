@@ -77,7 +77,8 @@ pub fn find_in_path(name: &str) -> Option<PathBuf> {
     })
 }
 
-fn beside_this_exe(name: &str) -> Option<PathBuf> {
+/// `name` next to the running executable, if it is an executable file.
+pub fn beside_this_exe(name: &str) -> Option<PathBuf> {
     let p = std::env::current_exe().ok()?.with_file_name(name);
     is_executable(&p).then_some(p)
 }

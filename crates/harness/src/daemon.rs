@@ -91,29 +91,39 @@ pub fn wait_until_ready(
     wait_ready(motionctl, prefix, sup, Attached::All, timeout).map(|_| ())
 }
 
-/// `motion-supervisor run --config CFG --json --service-prefix P [--duration S] [--hlog F]`,
-/// output captured, not waited for.
-pub fn spawn_run(
+/// `motion-supervisor run --config CFG --json --service-prefix P`: a
+/// bench's daemon, to which it adds what it measures (`--duration`,
+/// `--hlog`, ...).
+pub fn run_command(b: &Binaries, cfg: &Path, prefix: &str) -> Command {
+    let mut cmd = Command::new(&b.supervisor);
+    cmd.arg("run").arg("--config").arg(cfg);
+    cmd.args(["--json", "--service-prefix", prefix]);
+    cmd
+}
+
+/// [`run_command`] started and ready within `timeout` (every I/O process
+/// attached); else stopped, and the error says how it ended with the end of
+/// its stderr.
+pub fn start_run(
     b: &Binaries,
     cfg: &Path,
     prefix: &str,
-    duration: Option<f64>,
-    hlog: Option<&Path>,
+    timeout: Duration,
 ) -> Result<Running, String> {
-    let mut cmd = Command::new(&b.supervisor);
-    cmd.arg("run")
-        .arg("--config")
-        .arg(cfg)
-        .arg("--json")
-        .arg("--service-prefix")
-        .arg(prefix);
-    if let Some(d) = duration {
-        cmd.arg("--duration").arg(format!("{d}"));
+    let mut run = Running::spawn(
+        &mut run_command(b, cfg, prefix),
+        "motion-supervisor run",
+        true,
+        false,
+    )?;
+    match wait_until_ready(&b.motionctl, prefix, &mut run, timeout) {
+        Ok(()) => Ok(run),
+        Err(e) => {
+            let ended = stop_run(run, Duration::from_secs(20));
+            let tail = crate::process::tail(&ended.stderr, 5);
+            Err(format!("{e} ({}; {tail})", ended.describe()))
+        }
     }
-    if let Some(h) = hlog {
-        cmd.arg("--hlog").arg(h);
-    }
-    Running::spawn(&mut cmd, "motion-supervisor run", true, false)
 }
 
 /// Asks a running supervisor to stop (SIGTERM) and collects its output.

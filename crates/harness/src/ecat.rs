@@ -217,6 +217,23 @@ pub struct BusRun {
     pub lost: u64,
 }
 
+impl BusRun {
+    /// Two runs as one row: cycles and lost frames summed, min and max over
+    /// both, the percentiles the higher of the two (motion-io reports
+    /// percentiles per run, not its histogram).
+    pub fn merge(&self, o: &BusRun) -> BusRun {
+        BusRun {
+            cycles: self.cycles + o.cycles,
+            min: self.min.min(o.min),
+            p50: self.p50.max(o.p50),
+            p99: self.p99.max(o.p99),
+            p999: self.p999.max(o.p999),
+            max: self.max.max(o.max),
+            lost: self.lost + o.lost,
+        }
+    }
+}
+
 /// Finds the bus summary in `stderr`.
 pub fn bus_run(stderr: &str) -> Option<BusRun> {
     let line = stderr
@@ -292,5 +309,15 @@ mod tests {
             }
         );
         assert_eq!(bus_run("nothing"), None);
+        let other = BusRun {
+            cycles: 3,
+            min: 30.0,
+            p99: 100.0,
+            lost: 1,
+            ..b
+        };
+        let m = b.merge(&other);
+        assert_eq!((m.cycles, m.lost, m.min, m.p50), (5000, 4, 30.0, 55.5));
+        assert_eq!((m.p99, m.p999, m.max), (100.0, 150.5, 900.2));
     }
 }

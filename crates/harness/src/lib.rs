@@ -8,7 +8,8 @@
 //! * [`bins`] — where `motion-supervisor`, `motion-io` and `motionctl` are;
 //!   [`commands`] runs them as a test does.
 //! * [`daemon`] — `motion-supervisor run`: ready when `status --json`, read
-//!   as the typed report, shows its I/O attached; status; stop.
+//!   as the typed report, shows its I/O attached; started and ready in one
+//!   call (the benches); status; stop.
 //! * [`machines`] — the fixture machines (`tests/machines/*.toml`) with
 //!   stated overrides, written as a test's temporary config;
 //!   [`generated`] — the machines the benches generate.
@@ -16,9 +17,14 @@
 //!   [`temp`] — a test's scratch directory.
 //! * [`check`] — rows by name, positions within a tolerance, homed axes.
 //! * [`peer`] — the supervisor's side of a `motion-io`, played by a test.
-//! * [`homing`] — homing runs and their tally (the benches).
+//! * [`homing`] — homing runs, their tally, homings repeated while a
+//!   daemon is measured, a traced homing (the benches); [`runs`] — a
+//!   timed daemon run and what it measured, read back (the slice benches);
+//!   [`clients`] — a deployed machine's motionctl clients as a load.
 //! * [`procs`] — processes found in `/proc`; stress-ng.
-//! * [`spy`] — the frame spy on one I/O process's topics.
+//! * [`spy`] — the frame spy on one I/O process's topics; [`bare`] — plain
+//!   iceoryx2 ports of the frames' sizes and their echo (the IPC bench's floor).
+//! * [`cyclictest`] — the jitter bench's reference: its command and histogram.
 //! * [`ecat`] — the EtherCAT veth rig with emulated drives.
 //!
 //! Invariants: every process it starts ends (SIGTERM, then SIGKILL) when
@@ -28,9 +34,12 @@
 //! read through `motion-report`'s typed structs, the same definitions the
 //! binaries write.
 
+pub mod bare;
 pub mod bins;
 pub mod check;
+pub mod clients;
 pub mod commands;
+pub mod cyclictest;
 pub mod daemon;
 pub mod ecat;
 pub mod generated;
@@ -41,6 +50,7 @@ pub mod peer;
 mod placement;
 pub mod process;
 pub mod procs;
+pub mod runs;
 pub mod spy;
 pub mod temp;
 

@@ -37,6 +37,12 @@ pub fn stop_signal() -> i32 {
     motion_rt::termination::received().unwrap_or(0)
 }
 
+/// The last `n` lines of `s` (a child's output), joined with " | ".
+pub fn tail(s: &str, n: usize) -> String {
+    let lines: Vec<&str> = s.trim().lines().collect();
+    lines[lines.len().saturating_sub(n)..].join(" | ")
+}
+
 /// How a child ended, with everything it printed.
 #[derive(Debug)]
 pub struct Ended {

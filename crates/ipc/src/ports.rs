@@ -36,6 +36,7 @@ use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::{ipc, BackpressureStrategy, PlacementDefault, ServiceName, ZeroCopySend};
 use iceoryx2::sample::Sample;
 use iceoryx2::service::builder::publish_subscribe::PublishSubscribeOpenError;
+use iceoryx2::service::builder::{event, publish_subscribe};
 
 use motion_frames::{CommandFrame, FeedbackFrame, Frame, LAYOUT_VERSION};
 
@@ -90,21 +91,43 @@ type TopicFactory<T> =
     iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>;
 type EventFactory = iceoryx2::service::port_factory::event::PortFactory<ipc::Service>;
 
-fn topic<T: ShmFrame>(
+/// A topic of payload `T` with the frames' settings (see the QoS above),
+/// not yet created or opened. The frame ports are built from it; so is the
+/// IPC bench's bare echo, whose byte-array topics must differ from the
+/// frames' in nothing but the payload.
+pub fn topic_builder<T: fmt::Debug + ZeroCopySend>(
     node: &Node<ipc::Service>,
-    name: &Named,
-    access: Access,
-) -> Result<TopicFactory<T>, IpcError> {
-    let service = name.label.clone();
-    let b = node
-        .service_builder(&name.service)
+    name: &ServiceName,
+) -> publish_subscribe::Builder<T, (), ipc::Service> {
+    node.service_builder(name)
         .publish_subscribe::<T>()
         .enable_safe_overflow(true)
         .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
         .subscriber_max_borrowed_samples(SUBSCRIBER_MAX_BORROWED)
         .history_size(0)
         .max_publishers(1)
-        .max_subscribers(MAX_SUBSCRIBERS);
+        .max_subscribers(MAX_SUBSCRIBERS)
+}
+
+/// An event service with the frames' settings (one notifier,
+/// [`MAX_LISTENERS`] listeners), not yet created or opened.
+pub fn event_builder(
+    node: &Node<ipc::Service>,
+    name: &ServiceName,
+) -> event::Builder<ipc::Service> {
+    node.service_builder(name)
+        .event()
+        .max_notifiers(1)
+        .max_listeners(MAX_LISTENERS)
+}
+
+fn topic<T: ShmFrame>(
+    node: &Node<ipc::Service>,
+    name: &Named,
+    access: Access,
+) -> Result<TopicFactory<T>, IpcError> {
+    let service = name.label.clone();
+    let b = topic_builder::<T>(node, &name.service);
     match access {
         Access::Create => b
             .create()
@@ -135,11 +158,7 @@ fn event(
     access: Access,
 ) -> Result<EventFactory, IpcError> {
     let service = name.label.clone();
-    let b = node
-        .service_builder(&name.service)
-        .event()
-        .max_notifiers(1)
-        .max_listeners(MAX_LISTENERS);
+    let b = event_builder(node, &name.service);
     match access {
         Access::Create => b
             .create()

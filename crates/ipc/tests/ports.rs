@@ -328,3 +328,40 @@ fn the_node_counter_is_private_and_a_truncated_one_is_refused() {
     assert!(err.to_string().contains("truncated"), "{err}");
     std::fs::remove_file(&path).unwrap();
 }
+
+#[test]
+fn the_builders_carry_the_frames_settings_for_any_payload() {
+    let env = TestEnv::new("bld");
+    let node = env.domain.create_node("motion-supervisor").unwrap();
+    let _sup = SupervisorPorts::create(&node, &env.domain, "io").unwrap();
+    let names = IoServiceNames::new(&env.domain.prefix, "io");
+    let name = |s: &str| ServiceName::new(s).unwrap();
+    // the frame services open with the builders' settings (iceoryx2 checks
+    // them against the ones they were created with)
+    let command = ports::topic_builder::<CommandFrame>(&node, &name(&names.command));
+    let ready = ports::event_builder(&node, &name(&names.command_ready));
+    assert!(command.open().is_ok() && ready.open().is_ok());
+    // a byte-array topic gets the same settings
+    let bare = name(&format!("{}/bare", env.domain.prefix));
+    let t = ports::topic_builder::<[u8; 64]>(&node, &bare)
+        .open_or_create()
+        .unwrap();
+    let c = t.static_config();
+    assert!(c.has_safe_overflow());
+    assert_eq!(
+        (c.history_size(), c.subscriber_max_buffer_size()),
+        (0, ports::SUBSCRIBER_BUFFER)
+    );
+    assert_eq!(
+        (c.max_publishers(), c.max_subscribers()),
+        (1, ports::MAX_SUBSCRIBERS)
+    );
+    let e = ports::event_builder(&node, &name(&format!("{}/bare_ready", env.domain.prefix)))
+        .open_or_create()
+        .unwrap();
+    let c = e.static_config();
+    assert_eq!(
+        (c.max_notifiers(), c.max_listeners()),
+        (1, ports::MAX_LISTENERS)
+    );
+}

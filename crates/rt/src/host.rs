@@ -105,6 +105,44 @@ pub fn loadavg() -> String {
         .unwrap_or_else(|| "?".into())
 }
 
+/// The host as a report shows it, read once (at the start of a run).
+#[derive(Clone, Debug)]
+pub struct Host {
+    /// [`kernel`].
+    pub kernel: String,
+    /// [`preemption`]: the model in words ...
+    pub preemption: String,
+    /// ... and whether it is PREEMPT_RT.
+    pub is_rt: bool,
+    /// [`cpus`].
+    pub cpus: usize,
+    /// [`rt_throttling`].
+    pub throttling: String,
+    /// [`loadavg`] when it was read.
+    pub load: String,
+}
+
+impl Host {
+    /// Reads every fact now.
+    pub fn read() -> Self {
+        let (preemption, is_rt) = preemption();
+        Host {
+            kernel: kernel(),
+            preemption,
+            is_rt,
+            cpus: cpus(),
+            throttling: rt_throttling(),
+            load: loadavg(),
+        }
+    }
+
+    /// `kernel K | preemption: P | N CPUs`: how a report's host line starts.
+    pub fn head(&self) -> String {
+        let (k, p, n) = (&self.kernel, &self.preemption, self.cpus);
+        format!("kernel {k} | preemption: {p} | {n} CPUs")
+    }
+}
+
 /// A real-time thread somewhere on the machine.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct RtTask {
@@ -216,5 +254,10 @@ mod tests {
         assert!(!kernel().is_empty() && cpus() >= 1 && !loadavg().is_empty());
         assert!(!preemption().0.is_empty() && !rt_throttling().is_empty());
         assert!(other_rt_tasks().iter().all(|t| t.pid != std::process::id()));
+        let h = Host::read();
+        assert_eq!(h.cpus, cpus());
+        assert!(h
+            .head()
+            .starts_with(&format!("kernel {} | preemption: ", h.kernel)));
     }
 }

@@ -78,7 +78,9 @@ pub use allocator::RtAllocator;
 pub use clock::now_ns;
 pub use environment::check_environment;
 pub use pm_qos::{hold_cpu_dma_latency, DmaLatencyGuard};
-pub use thread::{enter_realtime, keep_off_cpu, pin_to_cpu, RtConfig, RtReport, SchedPolicy};
+pub use thread::{
+    enter_realtime, fifo_allowed, keep_off_cpu, pin_to_cpu, RtConfig, RtReport, SchedPolicy,
+};
 pub use timer::{PeriodicTimer, Wakeup};
 
 /// Per-thread real-time memory pools (see [`RtAllocator`]).

@@ -213,6 +213,26 @@ pub fn enter_realtime(cfg: &RtConfig) -> RtReport {
     }
 }
 
+/// Whether this process may run a thread `SCHED_FIFO` at `priority`: tried
+/// on a throw-away thread (nothing pinned or locked); the error says why not.
+pub fn fifo_allowed(priority: i32) -> Result<(), String> {
+    let probe = move || {
+        let cfg = RtConfig {
+            priority,
+            lock_memory: false,
+            prefault_stack: 0,
+            ..RtConfig::default()
+        };
+        let r = enter_realtime(&cfg);
+        match r.policy {
+            SchedPolicy::Fifo => Ok(()),
+            _ => Err(r.warnings.join("; ")),
+        }
+    };
+    let joined = std::thread::spawn(probe).join();
+    joined.unwrap_or_else(|_| Err("the probe thread panicked".into()))
+}
+
 /// Pins the calling thread to `cpu` (no other setting changed); the error
 /// names the CPUs there are or the allowed set, as a warning to print.
 pub fn pin_to_cpu(cpu: usize) -> Result<(), String> {
@@ -528,6 +548,16 @@ mod tests {
             r.warnings.iter().any(|w| w.starts_with("stack prefault")),
             "{r}"
         );
+    }
+
+    #[test]
+    fn fifo_is_probed_on_a_thread_of_its_own() {
+        let err = fifo_allowed(0).unwrap_err();
+        assert!(err.contains("priority 0: out of range"), "{err}");
+        // as root or with RLIMIT_RTPRIO it is allowed; either way this
+        // thread is left as it was
+        let _ = fifo_allowed(1);
+        assert_ne!(current_sched().0, SchedPolicy::Fifo);
     }
 
     #[test]

@@ -11,10 +11,9 @@ mod trial;
 use clap::{Parser, ValueEnum};
 use motion_bench::drive::Binaries;
 use motion_bench::flags::{Cycle, Files};
-use motion_bench::host::loadavg;
-use motion_bench::outcome::{self, write_json, Bench};
+use motion_bench::outcome::{self, with, write_json, Bench};
 use motion_bench::proc;
-use motion_bench::table::Text;
+use motion_bench::table::{line, Text};
 use serde::Serialize;
 use serde_json::{json, Value};
 use trial::Trial;
@@ -94,13 +93,13 @@ fn run(o: &Opts) -> Result<i32, String> {
     let bins = Binaries::find(o.files.supervisor.as_deref())?;
     let out = o.files.out("");
     let b = Bench::start("deadpeer", Some(&out))?;
-    let (cy, env) = (&o.cycle, &b.env);
+    let (cy, env) = (&o.cycle, &b.host);
     let signals: Vec<&str> = o.signals.iter().map(|s| s.name()).collect();
     eprintln!(
         "deadpeer: {} trial(s) per signal ({}), {} µs cycle, SCHED_FIFO {} on CPU {} (motion-io there too), \
          spy on CPU {}; feedback_timeout_ms 10 (default); kernel {} ({}); load {}",
         o.trials, signals.join(", "), cy.period_us, cy.priority, cy.cpu, o.spy_cpu(), env.kernel,
-        env.preemption, env.load_before
+        env.preemption, env.load
     );
     let (mut trials, mut leftovers, mut interrupted) = (Vec::new(), Vec::new(), false);
     'all: for &sig in &o.signals {
@@ -117,26 +116,18 @@ fn run(o: &Opts) -> Result<i32, String> {
     let wall = b.t0.elapsed().as_secs_f64();
     let (text, summary) = report(o, &b, &trials, &leftovers, wall);
     print!("{text}");
-    let report = json!({
-        "period_us": cy.period_us,
-        "cpu": cy.cpu,
-        "priority": cy.priority,
+    let more = json!({
         "spy_cpu": o.spy_cpu(),
         "spy_priority": o.spy_priority,
         "speed": o.speed,
         "feedback_timeout_ms": 10,
-        "kernel": env.kernel,
-        "preemption": env.preemption,
-        "load_before": env.load_before,
-        "load_after": loadavg(),
-        "wall_s": wall,
         "summary": summary,
         "trials": trials,
         "leftovers": leftovers,
         "interrupted": interrupted,
     });
     let path = out.join(format!("deadpeer-{}us.json", cy.period_us));
-    write_json(&path, &report)?;
+    write_json(&path, &with(b.json_head(cy, wall), more))?;
     Ok(b.end(&[&path], interrupted, &[], false))
 }
 
@@ -172,6 +163,9 @@ fn pct(v: &[f64], p: f64) -> Option<f64> {
     v.get(k - 1).copied()
 }
 
+/// The columns of the report's table.
+const WIDTHS: [i32; 10] = [-10, 7, 9, 9, 9, 9, 9, 3, -28, 12];
+
 /// The printed report and the JSON summary per signal.
 fn report(
     o: &Opts,
@@ -180,27 +174,20 @@ fn report(
     leftovers: &[String],
     wall: f64,
 ) -> (String, Vec<Value>) {
-    let (mut t, cy, env) = (Text::default(), &o.cycle, &b.env);
+    let (mut t, cy) = (Text::default(), &o.cycle);
     t.line(format!(
         "== deadpeer: signal to motion-io while X seeks at {} units/s → first stopping command, {} µs cycle, SCHED_FIFO {} on CPU {}",
         o.speed, cy.period_us, cy.priority, cy.cpu
     ));
-    let (before, after) = (&env.load_before, loadavg());
-    t.line(format!(
-        "{} | load before {before}, after {after} | wall {wall:.0} s",
-        env.head()
-    ));
+    t.line(b.load_line(wall));
     t.line(format!(
         "configured bound: feedback_timeout_ms = 10 (default) → the rule trips after > 10 ms of missing answers, + 1 cycle ({} ms) to the first slower command; goal ≤ 20 ms",
         f64::from(cy.period_us) / 1000.0
     ));
     t.line("");
-    let head = ["min ms", "p50 ms", "p90 ms", "max ms", "mean"].map(|h| format!("{h:>9}"));
-    let head = format!("{:<10}{:>7}{}", "signal", "trials", head.concat());
-    t.line(format!(
-        "{head}   {:<28}{:>12}",
-        "from last feedback p50/max", "12/40 result"
-    ));
+    let head =
+        "signal|trials|min ms|p50 ms|p90 ms|max ms|mean||from last feedback p50/max|12/40 result";
+    t.line(line(&WIDTHS, head.split('|')));
     let mut summary = Vec::new();
     for &sig in &o.signals {
         let ts: Vec<&Trial> = trials.iter().filter(|t| t.signal == sig).collect();
@@ -225,14 +212,14 @@ fn report(
             r.last().copied(),
             mean,
         ];
-        t.line(format!(
-            "{:<10}{:>7}{}   {:<28}{:>12}",
-            sig.name(),
-            format!("{}/{}", r.len(), ts.len()),
-            cells.map(|x| format!("{:>9}", ms(x))).concat(),
+        let (n, m) = (r.len(), ts.len());
+        let first = [sig.name().to_string(), format!("{n}/{m}")];
+        let last = [
+            String::new(),
             format!("{} / {}", ms(pct(&f, 0.5)), ms(f.last().copied())),
-            format!("{lost} of {}", ts.len())
-        ));
+        ];
+        let cells = first.into_iter().chain(cells.map(ms)).chain(last);
+        t.line(line(&WIDTHS, cells.chain([format!("{lost} of {m}")])));
         summary.push(json!({
             "signal": sig,
             "trials": ts.len(),

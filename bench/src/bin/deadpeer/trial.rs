@@ -13,12 +13,14 @@
 
 use crate::{Opts, Sig};
 use motion_bench::drive::{self, Binaries};
+use motion_bench::machine;
+use motion_bench::outcome::{self, Bench};
 use motion_bench::proc::{self, Running};
 use motion_bench::spy::{Cmd, Recording, Spy};
-use motion_bench::{machine, outcome::Bench};
 use motion_frames::CW_ENABLE;
 use motion_ipc::monotonic_ns;
 use serde::Serialize;
+use std::path::Path;
 use std::process::Command;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -78,31 +80,13 @@ fn cruising(c: &Cmd, cruise: f64) -> bool {
 
 /// A supervisor of the long-seek axis under `prefix`, ready, and the pid of
 /// the one motion-io it spawned.
-fn daemon(
-    o: &Opts,
-    b: &Binaries,
-    tmp: &std::path::Path,
-    prefix: &str,
-) -> Result<(Running, u32), String> {
-    let (toml, _) = machine::long_seek_axis_with(
-        &o.cycle.supervisor(prefix),
-        tmp.to_str(),
-        o.speed,
-        o.speed * 60.0,
-    )?;
+fn daemon(o: &Opts, b: &Binaries, tmp: &Path, prefix: &str) -> Result<(Running, u32), String> {
+    let s = o.cycle.supervisor(prefix);
+    let (toml, _) = machine::long_seek_axis_with(&s, tmp.to_str(), o.speed, o.speed * 60.0)?;
     let cfg = tmp.join(format!("{prefix}.toml"));
     std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
-    let mut daemon = drive::spawn_run(b, &cfg, prefix, None, None)?;
-    if let Err(e) =
-        drive::wait_until_ready(&b.motionctl, prefix, &mut daemon, Duration::from_secs(20))
-    {
-        let ended = drive::stop_run(daemon, Duration::from_secs(20));
-        return Err(format!(
-            "{prefix}: {e} ({}; {})",
-            ended.describe(),
-            drive::tail(&ended.stderr, 5)
-        ));
-    }
+    let daemon = drive::start_run(b, &cfg, prefix, Duration::from_secs(20))
+        .map_err(|e| format!("{prefix}: {e}"))?;
     match drive::io_children(daemon.pid()).as_slice() {
         [p] => Ok((daemon, *p)),
         io => {
@@ -152,15 +136,8 @@ pub fn run(
     let mut home = None;
     let result = spy.as_ref().map_err(String::clone).and_then(|_| {
         let mut cmd = Command::new(&b.motionctl);
-        cmd.args([
-            "--service-prefix",
-            &prefix,
-            "home",
-            "X",
-            "--json",
-            "--timeout",
-            "120",
-        ]);
+        cmd.args(["--service-prefix", &prefix]);
+        cmd.args(["home", "X", "--json", "--timeout", "120"]);
         home = Some(Running::spawn(&mut cmd, "motionctl home", true, false)?);
         signal(o, &shared, io_pid, sig, &mut t)
     });
@@ -182,17 +159,8 @@ pub fn run(
         t.problems
             .push(format!("the supervisor ended with {how} ({tail})"));
     }
-    let (found, remaining) = drive::clean_leftovers(&prefix);
-    if !found.is_empty() {
-        let all = if remaining.is_empty() {
-            ""
-        } else {
-            ", NOT all"
-        };
-        t.problems.push(format!(
-            "left behind (then cleaned by the bench{all}): {}",
-            found.join(", ")
-        ));
+    if let Some((found, note)) = outcome::cleaned(&prefix) {
+        t.problems.push(format!("left behind {note}"));
         leftovers.extend(found);
     }
     let _ = std::fs::remove_file(bench.tmp.join(format!("{prefix}.toml")));

@@ -96,47 +96,34 @@ impl Opts {
 mod tests {
     use super::*;
 
-    fn parse(args: &[&str]) -> Result<Opts, clap::Error> {
-        Opts::try_parse_from(std::iter::once("ipc").chain(args.iter().copied()))
+    fn parse(args: &str) -> Result<Opts, clap::Error> {
+        Opts::try_parse_from(std::iter::once("ipc").chain(args.split_whitespace()))
     }
 
     #[test]
     fn flags_and_checks() {
         Opts::command().debug_assert();
-        let o = parse(&["--cpu", "0"]).unwrap();
+        let o = parse("--cpu 0").unwrap();
         assert_eq!(
             (o.count, o.warmup, o.peer_cpu(), o.cpu_dma_latency),
             (10_000, 200, 1, 0)
         );
         assert_eq!((o.modes, o.io), (Mode::ALL.to_vec(), None));
-        let o = parse(&[
-            "--cpu=0",
-            "--count=5",
-            "--modes",
-            "bare-spin, io-event",
-            "--io",
-            "/x",
-        ])
-        .unwrap();
+        let o = parse("--cpu=0 --count=5 --modes bare-spin,io-event --io /x").unwrap();
         assert_eq!((o.count, o.modes), (5, vec![Mode::BareSpin, Mode::IoEvent]));
-        assert!(parse(&["--cpu=0", "--peer-cpu", "0", "--cpu-dma-latency", "-1"]).is_ok());
-        for args in [
-            &["--priority", "10"][..],
-            &["--period-us", "19"],
-            &["--period-us", "100001"],
-        ] {
-            let o = parse(&[args, &["--cpu", "0"]].concat()).unwrap();
-            assert!(o.check().unwrap_err().contains(args[0]), "{args:?}");
+        assert_eq!(mode::parse(" io-spin "), Ok(Mode::IoSpin));
+        assert!(parse("--cpu=0 --peer-cpu 0 --cpu-dma-latency -1").is_ok());
+        for args in ["--priority 10", "--period-us 19", "--period-us 100001"] {
+            let o = parse(&format!("{args} --cpu 0")).unwrap();
+            let flag = args.split(' ').next().unwrap();
+            assert!(o.check().unwrap_err().contains(flag), "{args}");
         }
-        for args in [
-            &["--count", "0"][..],
-            &["--modes", "io-event,nope"],
-            &["--modes", ""],
-        ] {
-            let e = parse(&[args, &["--cpu", "0"]].concat()).unwrap_err();
-            assert!(e.to_string().contains(args[0]), "{args:?}: {e}");
+        for args in ["--count 0", "--modes io-event,nope", "--modes="] {
+            let e = parse(&format!("{args} --cpu 0")).unwrap_err();
+            let flag = args.split([' ', '=']).next().unwrap();
+            assert!(e.to_string().contains(flag), "{args}: {e}");
         }
-        assert!(parse(&["--cpu=0", "--role", "echo"]).is_err());
-        assert!(parse(&["--cpu=0", "--modes", "io-event", "--modes", "bare-spin"]).is_err());
+        assert!(parse("--cpu=0 --role echo").is_err());
+        assert!(parse("--cpu=0 --modes io-event --modes bare-spin").is_err());
     }
 }

@@ -4,17 +4,14 @@
 //! round trip from what iceoryx2 itself costs.
 //!
 //! Its command line is its own parser, not a subcommand of the bench's:
-//! the bench spawns it as `ipc --role echo --prefix P --cpu N` plus
-//! `--spin` or `--priority P` (see `run_mode`), and its flags mean other
-//! things than the bench's flags of the same name.
+//! its flags mean other things than the bench's flags of the same name.
 
-use crate::bare::{BareSide, PING, PONG};
 use clap::{Parser, ValueEnum};
+use motion_bench::bare::{self, BareSide, PING, PONG};
 use motion_bench::host;
 use motion_bench::proc;
 use motion_ipc::{cleanup_domain, Domain};
-use motion_rt::now_ns;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// The peer's role (`echo`, the only one).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -50,15 +47,20 @@ pub struct EchoOpts {
 /// The echo's arguments as the bench spawns it: under `prefix` on `cpu`,
 /// SCHED_FIFO at `priority`, or spinning if None.
 pub fn args(prefix: &str, cpu: usize, priority: Option<i32>) -> Vec<String> {
-    let cpu = cpu.to_string();
-    let mut a: Vec<String> = ["--role", "echo", "--prefix", prefix, "--cpu", &cpu]
-        .map(String::from)
-        .to_vec();
-    match priority {
-        None => a.push("--spin".into()),
-        Some(p) => a.extend(["--priority".into(), p.to_string()]),
-    }
-    a
+    let a = [
+        "--role",
+        "echo",
+        "--prefix",
+        prefix,
+        "--cpu",
+        &cpu.to_string(),
+    ]
+    .map(String::from);
+    let how = match priority {
+        None => vec!["--spin".to_string()],
+        Some(p) => vec!["--priority".into(), p.to_string()],
+    };
+    a.into_iter().chain(how).collect()
 }
 
 /// The command line is the echo's: `--role` comes first.
@@ -70,16 +72,13 @@ pub fn wanted(args: &[String]) -> bool {
 /// The echo peer's `main`: its exit code.
 pub fn main() -> i32 {
     let o = EchoOpts::parse();
-    let (prefix, cpu, prio, spin) = (o.prefix, o.cpu, o.priority, o.spin);
-    // SAFETY: prctl with integer arguments only.
-    unsafe {
-        libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
-    }
+    // gone with the bench, however it ends
+    let _ = nix::sys::prctl::set_pdeathsig(nix::sys::signal::Signal::SIGTERM);
     proc::install_stop_handler();
-    for w in host::enter_rt(Some(cpu), prio) {
+    for w in host::enter_rt(Some(o.cpu), o.priority) {
         eprintln!("ipc echo: warning: {w}");
     }
-    match echo(&prefix, spin) {
+    match echo(&o.prefix, o.spin) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("ipc echo: {e}");
@@ -92,11 +91,11 @@ pub fn main() -> i32 {
 /// SIGTERM/SIGINT. Event mode sleeps in `ppoll` on the listener's
 /// descriptor; spin mode polls the subscriber.
 fn echo(prefix: &str, spin: bool) -> Result<(), String> {
-    let until = std::time::Instant::now() + Duration::from_secs(10);
+    let until = Instant::now() + Duration::from_secs(10);
     let domain = loop {
         match Domain::join(prefix, None) {
             Ok(d) => break d,
-            Err(e) if std::time::Instant::now() > until => return Err(e.to_string()),
+            Err(e) if Instant::now() > until => return Err(e.to_string()),
             Err(_) => std::thread::sleep(Duration::from_millis(20)),
         }
     };
@@ -104,34 +103,10 @@ fn echo(prefix: &str, spin: bool) -> Result<(), String> {
         .create_node("bench-echo")
         .map_err(|e| e.to_string())?;
     let mut x = BareSide::<PONG, PING>::create(&node, prefix, "pong", "ping")?;
-    let r = echo_loop(&mut x, spin);
-    drop(x);
-    drop(node);
+    let r = bare::echo(&mut x, spin, proc::stop_requested);
+    drop((x, node));
     let _ = cleanup_domain(&domain);
     r
-}
-
-/// Echoes until stopped: the newest ping only (older ones are dropped, as
-/// motion-io answers only the newest command).
-fn echo_loop(x: &mut BareSide<PONG, PING>, spin: bool) -> Result<(), String> {
-    while !proc::stop_requested() {
-        if !spin {
-            // bounded, so that the stop flag is seen even without pings
-            x.wait_fd_until(now_ns() + 100_000_000);
-        }
-        match x.receive_latest() {
-            Some(seq) => {
-                x.pending = None;
-                x.publish(seq)?;
-            }
-            None => {
-                if spin {
-                    std::hint::spin_loop();
-                }
-            }
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -142,23 +117,16 @@ mod tests {
     #[test]
     fn the_spawned_command_lines_are_the_echos_and_parse() {
         EchoOpts::command().debug_assert();
-        let argv = |a: Vec<String>| {
-            std::iter::once("ipc".to_string())
-                .chain(a)
-                .collect::<Vec<_>>()
-        };
+        let argv = |a: Vec<String>| [vec!["ipc".to_string()], a].concat();
         let event = argv(args("mbi7m1", 0, Some(70)));
         let shown = "--role echo --prefix mbi7m1 --cpu 0 --priority 70";
-        assert_eq!(event[1..].join(" "), shown);
-        assert!(wanted(&event));
+        assert!(event[1..].join(" ") == shown && wanted(&event));
         let o = EchoOpts::try_parse_from(&event).unwrap();
         assert_eq!((o.role, o.prefix.as_str()), (Role::Echo, "mbi7m1"));
         assert_eq!((o.cpu, o.priority, o.spin), (0, Some(70), false));
         let spin = argv(args("mbi7m3", 1, None));
-        assert_eq!(
-            spin[1..].join(" "),
-            "--role echo --prefix mbi7m3 --cpu 1 --spin"
-        );
+        let shown = "--role echo --prefix mbi7m3 --cpu 1 --spin";
+        assert_eq!(spin[1..].join(" "), shown);
         let o = EchoOpts::try_parse_from(&spin).unwrap();
         assert_eq!((o.cpu, o.priority, o.spin), (1, None, true));
         let v = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();

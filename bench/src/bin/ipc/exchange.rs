@@ -1,11 +1,12 @@
 //! What the measuring thread does with a peer, whatever the peer is: the
 //! [`Exchange`] of one message and its answer. [`FrameSide`] is the
 //! supervisor's own ports with real frames (the motion-io modes); the bare
-//! modes' side is [`crate::bare::BareSide`]. One trait, so that both are
-//! measured by the very same loop.
+//! modes' side is `motion_harness::bare::BareSide`. One trait, so that both
+//! are measured by the very same loop.
 
 use iceoryx2::prelude::ipc;
 use iceoryx2::sample::Sample;
+use motion_bench::bare::BareSide;
 use motion_frames::FeedbackFrame;
 use motion_ipc::SupervisorPorts;
 
@@ -61,5 +62,20 @@ impl Exchange for FrameSide {
         let a = s.payload().answers_sequence;
         self.pending = Some(s); // kept until the next answer, as the cycle does
         Some(a)
+    }
+}
+
+impl<const TX: usize, const RX: usize> Exchange for BareSide<TX, RX> {
+    fn clear(&mut self) {
+        let _ = self.try_wait();
+    }
+    fn send(&mut self) -> Result<u64, String> {
+        self.send_next()
+    }
+    fn wait_until(&mut self, deadline_ns: u64) -> bool {
+        self.wait_fd_until(deadline_ns)
+    }
+    fn answer(&mut self) -> Option<u64> {
+        self.receive_latest()
     }
 }

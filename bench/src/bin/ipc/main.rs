@@ -4,18 +4,12 @@
 //! * (a) a real `motion-io --backend sim` waiting on the event,
 //! * (b) the same with `--spin` (busy-polling on its own CPU),
 //! * (c) a bare iceoryx2 echo of the same payload sizes (this binary re-run
-//!   with `--role echo`), event-waiting and spinning.
+//!   with `--role echo`, see [`echo`]), event-waiting and spinning.
 //!
-//! One message per period, not back to back. See `bench/README.md`.
-//!
-//! This file is the sequence — the process's role, the stage (motion-io,
-//! real-time settings), one [`run_mode`] per mode, the report — and the
-//! modules are its steps: [`cli`] and [`mode`] what to run, [`run_mode`] one
-//! mode, measured by [`measure`] through an [`exchange`] ([`bare`] for the
-//! bare modes), [`report`] the table, and [`echo`] the peer this binary
-//! also is.
+//! One message per period, not back to back. See `bench/README.md`. The
+//! sequence: the stage (motion-io, real-time settings), one [`run_mode`] per
+//! mode, the [`report`].
 
-mod bare;
 mod cli;
 mod echo;
 mod exchange;
@@ -43,7 +37,7 @@ fn main() {
 fn run(o: &Opts) -> Result<i32, String> {
     let io_bin = (o.io.clone())
         .or_else(|| std::env::var_os("MOTION_IO_BIN").map(PathBuf::from))
-        .or_else(|| host::sibling_exe("motion-io"));
+        .or_else(|| host::beside_this_exe("motion-io"));
     if o.modes.iter().any(|m| !m.bare()) && !io_bin.as_deref().is_some_and(host::is_executable) {
         return Err(
             "motion-io not found next to this binary; build it first: `cargo build \

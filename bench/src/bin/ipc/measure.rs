@@ -5,7 +5,7 @@
 
 use crate::exchange::Exchange;
 use hdrhistogram::Histogram;
-use motion_bench::hist::new_hist;
+use motion_bench::histogram;
 use motion_bench::proc;
 use motion_rt::{now_ns, PeriodicTimer};
 use std::time::{Duration, Instant};
@@ -65,7 +65,7 @@ pub fn measure<X: Exchange>(
         };
     }
     let mut m = Measured {
-        hist: new_hist(),
+        hist: histogram(),
         sent: 0,
         late: 0,
     };

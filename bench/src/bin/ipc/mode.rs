@@ -17,22 +17,17 @@ impl Mode {
 
     /// Its name in `--modes`.
     pub fn key(self) -> &'static str {
-        match self {
-            Mode::IoEvent => "io-event",
-            Mode::BareEvent => "bare-event",
-            Mode::IoSpin => "io-spin",
-            Mode::BareSpin => "bare-spin",
-        }
+        ["io-event", "bare-event", "io-spin", "bare-spin"][self as usize]
     }
 
     /// Its row in the table.
     pub fn label(self) -> &'static str {
-        match self {
-            Mode::IoEvent => "(a) motion-io, event",
-            Mode::BareEvent => "(c) bare echo, event",
-            Mode::IoSpin => "(b) motion-io --spin",
-            Mode::BareSpin => "(c) bare echo, spin",
-        }
+        [
+            "(a) motion-io, event",
+            "(c) bare echo, event",
+            "(b) motion-io --spin",
+            "(c) bare echo, spin",
+        ][self as usize]
     }
 
     /// The peer busy-polls (SCHED_OTHER) instead of waiting on the event.
@@ -48,10 +43,7 @@ impl Mode {
 
 /// `--modes` item: a mode's key, blanks around it ignored.
 pub fn parse(s: &str) -> Result<Mode, String> {
-    Mode::ALL
-        .into_iter()
-        .find(|x| x.key() == s.trim())
-        .ok_or_else(|| {
-            format!("unknown mode {s:?} (one of io-event, bare-event, io-spin, bare-spin)")
-        })
+    let known = Mode::ALL.map(Mode::key).join(", ");
+    let mode = Mode::ALL.into_iter().find(|x| x.key() == s.trim());
+    mode.ok_or_else(|| format!("unknown mode {s:?} (one of {known})"))
 }

@@ -3,28 +3,16 @@
 //! their ratio per percentile, and what could make the numbers wrong (other
 //! real-time threads, shared memory left behind).
 
-use crate::bare::{PING, PONG};
 use crate::cli::Opts;
 use crate::measure::Measured;
 use crate::mode::Mode;
-use hdrhistogram::Histogram;
+use motion_bench::bare::{PING, PONG};
 use motion_bench::outcome::Bench;
-use motion_bench::table::{ratio, row, thousands, us, Text};
+use motion_bench::percentiles;
+use motion_bench::table::{ratio_cells, row, thousands, us_cells, Text};
 
-/// min, p50, p99, p99.9, max of `h`, µs.
-fn values(h: &Histogram<u64>) -> [f64; 5] {
-    if h.is_empty() {
-        return [0.0; 5];
-    }
-    let q = |x: f64| h.value_at_quantile(x) as f64 / 1000.0;
-    [
-        h.min() as f64 / 1000.0,
-        q(0.5),
-        q(0.99),
-        q(0.999),
-        h.max() as f64 / 1000.0,
-    ]
-}
+/// The columns: min, p50, p99, p99.9, max.
+const COLS: [usize; 5] = [0, 1, 2, 3, 5];
 
 /// Prints the report of `results`; `leftovers` are what the modes left in
 /// /dev/shm.
@@ -38,7 +26,7 @@ pub fn print(o: &Opts, b: &Bench, results: &[(Mode, Measured)], leftovers: &[Str
         cy.priority,
         cy.cpu
     ));
-    let env = &b.env;
+    let env = &b.host;
     t.line(format!(
         "kernel {} | {} | {} CPUs | payload {PING} B → {PONG} B (CommandFrame → FeedbackFrame; bare: [u8; {PING}] → [u8; {PONG}])",
         env.kernel, env.preemption, env.cpus
@@ -57,20 +45,26 @@ pub fn print(o: &Opts, b: &Bench, results: &[(Mode, Measured)], leftovers: &[Str
         26,
         ["min", "p50", "p99", "p99.9", "max", "late"],
     ));
-    let find = |m: Mode| results.iter().find(|r| r.0 == m).map(|r| &r.1);
+    let find = |m: Mode| {
+        let r = results.iter().find(|r| r.0 == m)?;
+        Some((percentiles(&r.1.hist), r.1.late))
+    };
     for (ours, bare) in [
         (Mode::IoEvent, Mode::BareEvent),
         (Mode::IoSpin, Mode::BareSpin),
     ] {
-        for (mode, m) in [(ours, find(ours)), (bare, find(bare))] {
-            if let Some(m) = m {
-                t.line(row(mode.label(), 26, values(&m.hist).map(us)) + &format!("{:>9}", m.late));
+        let (a, b) = (find(ours), find(bare));
+        for (mode, m) in [(ours, &a), (bare, &b)] {
+            if let Some((p, late)) = m {
+                t.line(row(mode.label(), 26, us_cells(p, &COLS)) + &format!("{late:>9}"));
             }
         }
-        if let (Some(a), Some(b)) = (find(ours), find(bare)) {
-            let (va, vb) = (values(&a.hist), values(&b.hist));
-            let r = std::array::from_fn::<_, 5, _>(|i| ratio((vb[i] > 0.0).then(|| va[i] / vb[i])));
-            t.line(row("  ratio motion-io / bare", 26, r));
+        if let (Some((a, _)), Some((b, _))) = (&a, &b) {
+            t.line(row(
+                "  ratio motion-io / bare",
+                26,
+                ratio_cells(a, b, &COLS),
+            ));
         }
     }
     let sent: Vec<String> = results
@@ -81,12 +75,7 @@ pub fn print(o: &Opts, b: &Bench, results: &[(Mode, Measured)], leftovers: &[Str
         "late = no answer within half a period (not in the percentiles); sent per mode: {}",
         sent.join(", ")
     ));
-    if !b.other_rt.is_empty() {
-        let list = b.other_rt.list().join("; ");
-        t.line(format!(
-            "WARNING: other real-time threads were running: {list}"
-        ));
-    }
+    b.other_rt_warning(&mut t, "were running");
     t.line(match leftovers.is_empty() {
         true => "/dev/shm: nothing left behind".into(),
         false => format!("/dev/shm: LEFT BEHIND: {}", leftovers.join("; ")),

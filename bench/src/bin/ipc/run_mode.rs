@@ -3,12 +3,12 @@
 //! a pinned SCHED_FIFO thread that plays the supervisor, the peer stopped
 //! and the prefix cleaned up. A peer that ended early fails the mode.
 
-use crate::bare::{BareSide, PING, PONG};
 use crate::cli::Opts;
 use crate::echo;
 use crate::exchange::FrameSide;
 use crate::measure::{measure, Measured};
 use crate::mode::Mode;
+use motion_bench::bare::{BareSide, PING, PONG};
 use motion_bench::host;
 use motion_bench::machine;
 use motion_bench::proc::Running;

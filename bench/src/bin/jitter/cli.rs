@@ -56,52 +56,31 @@ mod tests {
     use super::*;
     use clap::CommandFactory;
 
-    fn parse(args: &[&str]) -> Result<Opts, clap::Error> {
-        Opts::try_parse_from(std::iter::once("jitter").chain(args.iter().copied()))
+    fn parse(args: &str) -> Result<Opts, clap::Error> {
+        Opts::try_parse_from(std::iter::once("jitter").chain(args.split_whitespace()))
     }
 
     #[test]
     fn the_ci_command_line_and_every_flag() {
         Opts::command().debug_assert();
-        let ci = [
-            "--duration",
-            "10",
-            "--slice",
-            "2.5",
-            "--period-us",
-            "1000",
-            "--cpu",
-            "0",
-        ];
-        let o = parse(&[&ci[..], &["--out", "bench/out/ci", "--no-cyclictest"]].concat()).unwrap();
-        assert_eq!(
-            (o.slicing.duration, o.slicing.slice, o.cycle.period_us),
-            (10.0, 2.5, 1000)
-        );
+        let ci = "--duration 10 --slice 2.5 --period-us 1000 --out bench/out/ci --no-cyclictest";
+        let o = parse(&format!("{ci} --cpu 0")).unwrap();
+        let (s, c) = (&o.slicing, &o.cycle);
+        assert_eq!((s.duration, s.slice, c.period_us), (10.0, 2.5, 1000));
         assert_eq!(o.files.out(""), PathBuf::from("bench/out/ci"));
         assert!(o.no_cyclictest && o.axes64 && !o.stress && !o.ethercat);
         assert_eq!((o.hist_max_us, o.cyclictest), (20_000, None));
-        let o = parse(&[
-            "--cpu=0",
-            "--stress",
-            "--cyclictest=/c",
-            "--hist-max-us",
-            "10",
-        ])
-        .unwrap();
+        let o = parse("--cpu=0 --stress --cyclictest=/c --hist-max-us 10").unwrap();
         assert!(o.stress && o.cyclictest == Some("/c".into()) && o.hist_max_us == 10);
-        assert!(
-            parse(&["--cpu=0", "--ethercat", "--no-axes64"]).is_ok_and(|o| o.ethercat && !o.axes64)
-        );
-        for (args, flag) in [
-            (&["--duration", "0"][..], "--duration"),
-            (&["--duration", "-1"], "--duration"),
-            (&["--slice", "0.4"], "--slice"),
-            (&["--hist-max-us", "9"], "--hist-max-us"),
-        ] {
-            let e = parse(&[args, &["--cpu", "0"]].concat()).unwrap_err();
-            assert!(e.to_string().contains(flag), "{args:?}: {e}");
+        let o = parse("--cpu=0 --ethercat --no-axes64").unwrap();
+        assert!(o.ethercat && !o.axes64);
+        for args in ["--duration 0", "--slice 0.4", "--hist-max-us 9"] {
+            let e = parse(&format!("{args} --cpu 0")).unwrap_err();
+            assert!(
+                e.to_string().contains(args.split(' ').next().unwrap()),
+                "{args}: {e}"
+            );
         }
-        assert!(parse(&["--cpu", "0", "--duration", "1", "--duration", "2"]).is_err());
+        assert!(parse("--cpu 0 --duration 1 --duration 2").is_err());
     }
 }

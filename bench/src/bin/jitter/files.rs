@@ -7,11 +7,10 @@
 use crate::cli::Opts;
 use crate::report::Summary;
 use crate::slices::{Collected, Variant};
-use motion_bench::hist;
-use motion_bench::outcome::{with, write_json, Bench};
-use motion_bench::plot::{self, Series};
+use motion_bench::hlog;
+use motion_bench::outcome::{status, with, write_json, Bench};
+use motion_bench::plot::{latency::Series, RGBColor};
 use motion_bench::slice::{ratio_json, Group};
-use plotters::style::RGBColor;
 use serde_json::{json, Value};
 use std::path::Path;
 use std::time::{Duration, SystemTime};
@@ -25,30 +24,30 @@ pub fn hlog(
     t0_wall: SystemTime,
     c: &Collected,
 ) -> Result<(), String> {
-    let variants = [Variant::Demo, Variant::Axes64, Variant::Ethercat];
-    let ours = variants
-        .iter()
-        .flat_map(|&v| c.ours[v as usize].iter().map(move |s| (v.tag(), s)));
-    let mut iv: Vec<hist::Written> = ours
-        .map(|(tag, s)| (tag, s.start, Duration::from_secs_f64(s.len), &s.wakeup))
-        .collect();
+    let ours = Variant::ALL.iter().flat_map(|&v| {
+        let tag = v.names().tag;
+        c.ours[v as usize]
+            .iter()
+            .map(move |s| (tag, s.start, Duration::from_secs_f64(s.len), &s.m.wakeup))
+    });
+    let mut iv: Vec<hlog::Interval> = ours.collect();
     iv.extend(c.ct.iter().map(|s| ("cyclictest", s.start, s.len, &s.hdr)));
     iv.sort_by_key(|i| i.1);
     let cy = &o.cycle;
     let comments = [
-        format!(
+        &format!(
             "motion-bench jitter: wake-up latency, ns; period {} us, SCHED_FIFO {} on CPU {}",
             cy.period_us, cy.priority, cy.cpu
         ),
-        "tags: ours = motion-supervisor run (wake-up), demo machine idle; ours_axes64 = the same with 64 axes homing in parallel again and again; ours_ethercat = the same with motion-io --backend ethercat (--ethercat), cyclictest = cyclictest (1 us bins, recorded at the bin's lower edge)".into(),
-        format!("kernel {} ({})", b.env.kernel, b.env.preemption),
+        "tags: ours = motion-supervisor run (wake-up), demo machine idle; ours_axes64 = the same with 64 axes homing in parallel again and again; ours_ethercat = the same with motion-io --backend ethercat (--ethercat), cyclictest = cyclictest (1 us bins, recorded at the bin's lower edge)",
+        &format!("kernel {} ({})", b.host.kernel, b.host.preemption),
     ];
-    hist::write_interval_log(path, &comments, t0_wall, &iv)
+    hlog::write(path, &comments, t0_wall, &iv)
 }
 
 /// The plot of `m` in `path`.
 pub fn svg(path: &Path, o: &Opts, b: &Bench, m: &Summary) -> Result<(), String> {
-    let (cy, env) = (&o.cycle, &b.env);
+    let (cy, env) = (&o.cycle, &b.host);
     let title = format!(
         "Wake-up latency, period {} µs: motion-supervisor vs cyclictest, {:.0} s each",
         cy.period_us,
@@ -72,16 +71,11 @@ pub fn svg(path: &Path, o: &Opts, b: &Bench, m: &Summary) -> Result<(), String> 
         "both SCHED_FIFO {} on CPU {} · {load} · {ct}",
         cy.priority, cy.cpu
     );
-    let ours = [
-        ("ours, demo machine (idle)", RGBColor(31, 111, 209)),
-        ("ours, 64 axes homing", RGBColor(148, 103, 189)),
-        ("ours, EtherCAT backend", RGBColor(44, 160, 44)),
-    ];
-    let mut series: Vec<Series> = (m.ours.iter().zip(ours))
+    let mut series: Vec<Series> = (m.ours.iter().zip(Variant::ALL))
         .filter(|(g, _)| g.ran())
-        .map(|(g, (name, colour))| Series {
-            name,
-            colour,
+        .map(|(g, v)| Series {
+            name: v.names().curve,
+            colour: v.names().colour,
             hist: &g.wake,
         })
         .collect();
@@ -93,13 +87,8 @@ pub fn svg(path: &Path, o: &Opts, b: &Bench, m: &Summary) -> Result<(), String> 
             hist: &m.ct.hdr,
         });
     }
-    plot::latency_plot(
-        path,
-        &title,
-        &[&sub1, &sub2],
-        &series,
-        f64::from(cy.period_us),
-    )
+    let period = f64::from(cy.period_us);
+    motion_bench::plot::latency::draw(path, &title, &[&sub1, &sub2], &series, period)
 }
 
 /// The JSON report in `path`; `files` are the other two, `failures` the
@@ -117,7 +106,7 @@ pub fn json(
         m.group(Variant::Axes64),
         m.group(Variant::Ethercat),
     );
-    let ct_ran = m.ct.ran();
+    let (ct_ran, h) = (m.ct.ran(), &c.homing64);
     let bus: Vec<Value> = (c.bus_runs.iter())
         .map(|b| json!({"cycles": b.cycles, "min": b.min, "p50": b.p50, "p99": b.p99, "p999": b.p999, "max": b.max, "lost_frames": b.lost}))
         .collect();
@@ -138,7 +127,14 @@ pub fn json(
         "ours_axes64": if a64.ran() { with(Group::json(a64), json!({
             "machine": "64 axes (motion_bench::machine::axes64_with), motionctl home --parallel again and again",
             "hlog_samples": a64.wake.len(),
-            "homing": c.homing64.json(),
+            "homing": {
+                "started": h.started,
+                "all_homed": h.ok,
+                "with_failed_axis": h.failed,
+                "cut_off_by_slice_end": h.cut_off,
+                "axes": h.tally,
+                "mean_duration_s": h.mean_s(),
+            },
         })) } else { skipped() },
         "ours_ethercat": if ecat.ran() {
             with(Group::json(ecat), json!({ "bus_roundtrip_us_per_slice": bus }))
@@ -156,11 +152,7 @@ pub fn json(
         "ratio_ours_over_cyclictest": if ct_ran { ratio_json(&demo.w, &m.ct.w) } else { Value::Null },
         "ratio_axes64_over_cyclictest": if ct_ran && a64.ran() { ratio_json(&a64.w, &m.ct.w) } else { Value::Null },
         "files": { "hlog": files[0], "svg": files[1] },
-        "status": {
-            "ok": failures.is_empty() && !c.interrupted,
-            "interrupted": c.interrupted,
-            "failures": failures,
-        },
+        "status": status(c.interrupted, failures),
     });
     write_json(path, &report)
 }

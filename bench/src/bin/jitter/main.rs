@@ -4,15 +4,12 @@
 //! supervisor with the EtherCAT backend (over a veth pair to emulated
 //! drives) in the same slices. See `bench/README.md`.
 //!
-//! This file is the sequence — find the tools, set the stage (EtherCAT rig,
-//! stress-ng), run the slices, merge, judge, report — and the modules are
-//! its steps: [`cli`] the command line, [`slices`] the alternating slices
-//! (with [`homing64`] for the 64-axis machine), [`report`] the merge, the
-//! verdict and the printed report, [`files`] the files written.
+//! The sequence: find the tools, set the stage (EtherCAT rig, stress-ng),
+//! run the [`slices`], merge and judge them ([`report`]), print, write the
+//! [`files`].
 
 mod cli;
 mod files;
-mod homing64;
 mod report;
 mod slices;
 
@@ -61,8 +58,7 @@ fn run(o: &Opts) -> Result<i32, String> {
         slices,
         tmp: &b.tmp,
         t0,
-        supervisor: &bins.supervisor,
-        motionctl: &bins.motionctl,
+        bins: &bins,
         rig: rig.as_ref(),
         cyclictest: cyclictest.as_deref(),
     };
@@ -98,18 +94,18 @@ fn cyclictest(o: &Opts) -> Option<PathBuf> {
         eprintln!("jitter: --no-cyclictest: running the supervisor half only");
         return None;
     }
-    let Some(bin) = o
+    let found = o
         .cyclictest
         .clone()
-        .or_else(|| host::find_in_path("cyclictest"))
-    else {
+        .or_else(|| host::find_in_path("cyclictest"));
+    let Some(bin) = found else {
         eprintln!(
             "jitter: WARNING: cyclictest not found (install rt-tests: `apt-get install -y \
              rt-tests`); SKIPPING the cyclictest half, the supervisor is measured alone"
         );
         return None;
     };
-    if let Err(e) = host::can_use_fifo(o.cycle.priority) {
+    if let Err(e) = motion_rt::fifo_allowed(o.cycle.priority) {
         eprintln!(
             "jitter: WARNING: no real-time scheduling for this user ({e}); cyclictest cannot run \
              like that: SKIPPING the cyclictest half (the supervisor warns and runs SCHED_OTHER)"
@@ -126,10 +122,8 @@ fn start_stress(o: &Opts, slices: usize) -> Result<Running, String> {
     let bound = (3.0 * o.slicing.duration + 20.0 * slices as f64 + 60.0).ceil() as u64;
     let cpu = o.cycle.other_cpu();
     let r = drive::stress(cpu, Duration::from_secs(bound)).map_err(|e| format!("--stress: {e}"))?;
-    eprintln!(
-        "jitter: stress-ng --cpu 1 --taskset {cpu} --timeout {bound}s (pid {})",
-        r.pid()
-    );
+    let pid = r.pid();
+    eprintln!("jitter: stress-ng --cpu 1 --taskset {cpu} --timeout {bound}s (pid {pid})");
     Ok(r)
 }
 

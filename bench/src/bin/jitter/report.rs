@@ -6,22 +6,23 @@
 //! less than representative. Same numbers as the JSON, laid out for a CI log.
 
 use crate::cli::Opts;
-use crate::slices::{Collected, Variant};
+use crate::slices::{Collected, Names, Variant};
 use hdrhistogram::Histogram;
 use motion_bench::ecat::BusRun;
-use motion_bench::hist::{self, new_hist, pct_of, Pct};
 use motion_bench::outcome::Bench;
 use motion_bench::slice::{Group, MAX_MISS_RATIO};
 use motion_bench::table::{ratio_cells, row, thousands, us, us_cells, Text, COLUMNS};
+use motion_bench::{histogram, hlog, percentiles};
+use motion_report::Percentiles;
 
-/// Every column of [`Pct::values`].
+/// Every column of [`Percentiles::values`].
 const ALL: [usize; 6] = [0, 1, 2, 3, 4, 5];
 
 /// cyclictest's slices, merged.
 pub struct CtGroup {
     /// Its 1 µs bins as one HdrHistogram.
     pub hdr: Histogram<u64>,
-    pub w: Pct,
+    pub w: Percentiles,
     pub overflows: u64,
     /// Samples at or above one period (cyclictest does not count misses).
     pub ge_period: u64,
@@ -39,49 +40,26 @@ impl CtGroup {
 pub struct Summary {
     /// Per variant (`Variant as usize`).
     pub ours: [Group; 3],
-    /// The EtherCAT slices' bus round trips in one row: min and max over
-    /// all, p50 / p99 / p99.9 the highest of the slices (motion-io reports
-    /// percentiles per run, not its histogram).
+    /// The EtherCAT slices' bus round trips in one row (`BusRun::merge`).
     pub bus: Option<BusRun>,
     pub ct: CtGroup,
 }
 
 impl Summary {
     pub fn of(c: &Collected, period_us: u32) -> Self {
-        let mut hdr = new_hist();
-        c.ct.iter().for_each(|s| hist::merge(&mut hdr, &s.hdr));
+        let mut hdr = histogram();
+        c.ct.iter().for_each(|s| hlog::merge(&mut hdr, &s.hdr));
+        let ge = |s: &crate::slices::CtSlice| s.hist.at_or_above(u64::from(period_us));
         let ct = CtGroup {
-            w: pct_of(&hdr),
+            w: percentiles(&hdr),
             hdr,
             overflows: c.ct.iter().map(|s| s.hist.overflows).sum(),
-            ge_period: c
-                .ct
-                .iter()
-                .map(|s| s.hist.at_or_above(u64::from(period_us)))
-                .sum(),
+            ge_period: c.ct.iter().map(ge).sum(),
             secs: c.ct.iter().map(|s| s.len.as_secs_f64()).sum(),
             slices: c.ct.len(),
         };
-        let bus = c.bus_runs.first().map(|first| {
-            let zero = BusRun {
-                cycles: 0,
-                lost: 0,
-                ..*first
-            };
-            c.bus_runs.iter().fold(zero, |a, b| BusRun {
-                cycles: a.cycles + b.cycles,
-                min: a.min.min(b.min),
-                p50: a.p50.max(b.p50),
-                p99: a.p99.max(b.p99),
-                p999: a.p999.max(b.p999),
-                max: a.max.max(b.max),
-                lost: a.lost + b.lost,
-            })
-        });
-        let ours = c
-            .ours
-            .each_ref()
-            .map(|v| Group::of(&v.iter().collect::<Vec<_>>()));
+        let bus = c.bus_runs.iter().copied().reduce(|a, b| a.merge(&b));
+        let ours = (c.ours.each_ref()).map(|v| Group::of(&v.iter().collect::<Vec<_>>()));
         Summary { ours, bus, ct }
     }
 
@@ -94,31 +72,27 @@ impl Summary {
     /// asked for but produced nothing.
     pub fn judge(&self, o: &Opts, cyclictest: bool, interrupted: bool, failures: &mut Vec<String>) {
         for v in [Variant::Demo, Variant::Ethercat, Variant::Axes64] {
-            let g = self.group(v);
+            let (g, who) = (self.group(v), v.names().who);
             if let Some(r) = g.too_many_misses() {
-                let who = NAMES[v as usize].who;
-                failures.push(format!(
-                    "{who} missed {} of {} deadlines {r}",
-                    g.misses, g.cycles
-                ));
+                let (m, c) = (g.misses, g.cycles);
+                failures.push(format!("{who} missed {m} of {c} deadlines {r}"));
             }
         }
         let nothing = [
             (
-                o.axes64 && !self.group(Variant::Axes64).ran(),
+                o.axes64,
+                self.group(Variant::Axes64).ran(),
                 "the 64-axis machine produced no slice",
             ),
             (
-                o.ethercat && !self.group(Variant::Ethercat).ran(),
+                o.ethercat,
+                self.group(Variant::Ethercat).ran(),
                 "the EtherCAT backend produced no slice",
             ),
-            (
-                cyclictest && !self.ct.ran(),
-                "cyclictest produced no samples",
-            ),
+            (cyclictest, self.ct.ran(), "cyclictest produced no samples"),
         ];
-        for (none, what) in nothing {
-            if none && failures.is_empty() && !interrupted {
+        for (asked, ran, what) in nothing {
+            if asked && !ran && failures.is_empty() && !interrupted {
                 failures.push(what.into());
             }
         }
@@ -126,54 +100,15 @@ impl Summary {
 
     /// The variants that produced slices, with their names.
     fn ran(&self) -> impl Iterator<Item = (&Group, &'static Names)> {
-        self.ours.iter().zip(&NAMES).filter(|(g, _)| g.ran())
+        (self.ours.iter().zip(Variant::ALL))
+            .filter(|(g, _)| g.ran())
+            .map(|(g, v)| (g, v.names()))
     }
 }
 
-/// A variant's names in the report.
-struct Names {
-    row: &'static str,
-    ratio: &'static str,
-    misses: &'static str,
-    compute: &'static str,
-    roundtrip: &'static str,
-    late: &'static str,
-    who: &'static str,
-}
-
-const NAMES: [Names; 3] = [
-    Names {
-        row: "ours, demo (idle)",
-        ratio: "ratio demo/cyclictest",
-        misses: "ours, demo",
-        compute: "compute, demo",
-        roundtrip: "I/O round trip, demo",
-        late: "demo",
-        who: "the supervisor",
-    },
-    Names {
-        row: "ours, 64 axes homing",
-        ratio: "ratio 64 axes/cyclic.",
-        misses: "ours, 64 axes homing",
-        compute: "compute, 64 axes",
-        roundtrip: "round trip, 64 axes",
-        late: "64 axes:",
-        who: "the supervisor (64 axes homing)",
-    },
-    Names {
-        row: "ours, EtherCAT backend",
-        ratio: "ratio EtherCAT/cyclic.",
-        misses: "EtherCAT backend",
-        compute: "compute, EtherCAT",
-        roundtrip: "round trip, EtherCAT",
-        late: "EtherCAT backend:",
-        who: "the supervisor (EtherCAT backend)",
-    },
-];
-
 /// The report's text.
 pub fn text(o: &Opts, b: &Bench, m: &Summary, c: &Collected) -> String {
-    let (cy, demo) = (&o.cycle, m.group(Variant::Demo));
+    let (cy, demo, env) = (&o.cycle, m.group(Variant::Demo), &b.host);
     let mut t = Text::default();
     let load = match o.stress {
         true => format!(", stress-ng --cpu 1 on CPU {}", cy.other_cpu()),
@@ -183,12 +118,8 @@ pub fn text(o: &Opts, b: &Bench, m: &Summary, c: &Collected) -> String {
         "== jitter: period {} µs ({:.0} Hz), SCHED_FIFO {} on CPU {}, {:.1} s per tool in {} slice(s){load}",
         cy.period_us, 1e6 / f64::from(cy.period_us), cy.priority, cy.cpu, demo.secs, demo.slices
     ));
-    let env = &b.env;
-    let (throttling, load) = (&env.throttling, motion_bench::host::loadavg());
-    t.line(format!(
-        "{} | RT throttling {throttling} | load {load}",
-        env.head()
-    ));
+    let (head, throttling, load) = (env.head(), &env.throttling, motion_bench::host::loadavg());
+    t.line(format!("{head} | RT throttling {throttling} | load {load}"));
     if !env.is_rt {
         t.line("not a PREEMPT_RT kernel: latencies are upper bounds, compare the two rows (same run, same noise)");
     }
@@ -204,7 +135,7 @@ pub fn text(o: &Opts, b: &Bench, m: &Summary, c: &Collected) -> String {
 
 /// Wake-up latency per variant and cyclictest, and their ratios.
 fn wakeups(t: &mut Text, m: &Summary) {
-    let samples = |p: &Pct| format!("   {} samples", thousands(p.count));
+    let samples = |p: &Percentiles| format!("   {} samples", thousands(p.count));
     t.line(row("wake-up latency (µs)", 22, COLUMNS));
     for (g, n) in m.ran() {
         t.line(row(n.row, 22, us_cells(&g.w, &ALL)) + &samples(&g.w));
@@ -222,15 +153,13 @@ fn wakeups(t: &mut Text, m: &Summary) {
 fn misses(t: &mut Text, o: &Opts, m: &Summary) {
     let period = o.cycle.period_us;
     for (k, (g, n)) in m.ran().enumerate() {
-        let head = if k == 0 {
-            "deadline misses   "
-        } else {
-            "                  "
-        };
-        let (max, slices) = (MAX_MISS_RATIO * 100.0, g.slices);
-        let more = match k {
-            0 => format!(", summed over {slices} slices; limit {max:.0} %"),
-            _ => String::new(),
+        let (head, more) = match k {
+            0 => {
+                let (slices, max) = (g.slices, MAX_MISS_RATIO * 100.0);
+                let more = format!(", summed over {slices} slices; limit {max:.0} %");
+                ("deadline misses   ", more)
+            }
+            _ => ("                  ", String::new()),
         };
         t.line(format!(
             "{head}{}: {} of {} cycles ({:.3} %{more}); wake-ups ≥ period: {}",
@@ -259,10 +188,14 @@ fn others(t: &mut Text, m: &Summary, c: &Collected) {
     match (m.group(Variant::Ethercat).ran(), &m.bus) {
         (false, _) => {}
         (true, Some(b)) => {
-            let cells = [b.min, b.p50, b.p99, b.p999]
-                .map(us)
-                .into_iter()
-                .chain(["-".into(), us(b.max)]);
+            let cells = [
+                us(b.min),
+                us(b.p50),
+                us(b.p99),
+                us(b.p999),
+                "-".into(),
+                us(b.max),
+            ];
             t.line(row("EtherCAT bus round trip", 22, cells));
             t.line(format!(
                 "  (motion-io's bus thread: frame out → inputs back over veth, {} bus cycles, {} lost frame(s); \
@@ -275,12 +208,18 @@ fn others(t: &mut Text, m: &Summary, c: &Collected) {
     let late: Vec<String> = (m.ran())
         .map(|(g, n)| format!("{} {} of {}", n.late, g.late, thousands(g.cycles)))
         .collect();
+    let late = late.join("; ");
     t.line(format!(
-        "late I/O replies (no answer within half a period): {}",
-        late.join("; ")
+        "late I/O replies (no answer within half a period): {late}"
     ));
-    if m.group(Variant::Axes64).ran() {
-        t.line(c.homing64.line(m.group(Variant::Axes64).secs));
+    let a64 = m.group(Variant::Axes64);
+    if a64.ran() {
+        let (h, y) = (&c.homing64, &c.homing64.tally);
+        t.line(format!(
+            "64 axes: {} parallel homing(s) in {:.0} s ({:.1} s each): {} all homed, {} with a failed axis, {} cut off by a slice's end; \
+             axis homings {}: {} ok, {} ERR 12/40 (feedback lost), {} other error(s), {} not homed",
+            h.started, a64.secs, h.mean_s(), h.ok, h.failed, h.cut_off, y.axis_homings, y.ok, y.feedback_lost, y.other_errors, y.not_homed
+        ));
         for d in c.homing64.tally.details.iter().take(10) {
             t.line(format!("  {d}"));
         }
@@ -301,12 +240,7 @@ fn notes(t: &mut Text, o: &Opts, b: &Bench, m: &Summary, c: &Collected) {
             c.ct_command, m.ct.overflows, o.hist_max_us
         ));
     }
-    if !b.other_rt.is_empty() {
-        let list = b.other_rt.list().join("; ");
-        t.line(format!(
-            "WARNING: other real-time threads ran during the bench: {list}"
-        ));
-    }
+    b.other_rt_warning(t, "ran during the bench");
     for w in &c.warnings {
         t.line(format!("supervisor warning: {w}"));
     }

@@ -8,17 +8,18 @@
 //! reported); so does SIGINT/SIGTERM.
 
 use crate::cli::Opts;
-use crate::homing64::{self, Homing64};
 use motion_bench::cyclictest::{self, CtHistogram};
+use motion_bench::drive::{self, runs, Binaries, Repeated};
 use motion_bench::ecat::{self, BusRun, EcatRig};
 use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine};
+use motion_bench::outcome;
 use motion_bench::proc::{self, Running};
-use motion_bench::slice::{self, Slice};
+use motion_bench::slice::Slice;
 use motion_bench::table::us;
+use motion_bench::{histogram, plot::RGBColor};
 use std::collections::BTreeSet;
 use std::path::Path;
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// A supervisor variant measured in every slice.
@@ -32,22 +33,85 @@ pub enum Variant {
     Ethercat,
 }
 
-impl Variant {
+/// What a variant is called wherever it shows.
+pub struct Names {
     /// Letter of its service prefixes and temporary files.
-    fn letter(self) -> char {
-        ['s', 'a', 'e'][self as usize]
-    }
-
-    /// Its name in the progress lines and failures.
-    fn label(self) -> &'static str {
-        ["ours", "64 axes", "EtherCAT"][self as usize]
-    }
-
+    pub letter: char,
+    /// In the progress lines and failures.
+    pub label: &'static str,
     /// Its tag in the interval log.
-    pub fn tag(self) -> &'static str {
-        ["ours", "ours_axes64", "ours_ethercat"][self as usize]
+    pub tag: &'static str,
+    /// Before its warnings.
+    pub warn: &'static str,
+    /// Its rows in the report: wake-up, ratio to cyclictest, deadline
+    /// misses, compute, round trip, late replies; who failed.
+    pub row: &'static str,
+    pub ratio: &'static str,
+    pub misses: &'static str,
+    pub compute: &'static str,
+    pub roundtrip: &'static str,
+    pub late: &'static str,
+    pub who: &'static str,
+    /// Its curve in the plot.
+    pub curve: &'static str,
+    pub colour: RGBColor,
+}
+
+impl Variant {
+    pub const ALL: [Variant; 3] = [Variant::Demo, Variant::Axes64, Variant::Ethercat];
+
+    pub fn names(self) -> &'static Names {
+        &NAMES[self as usize]
     }
 }
+
+const NAMES: [Names; 3] = [
+    Names {
+        letter: 's',
+        label: "ours",
+        tag: "ours",
+        warn: "",
+        row: "ours, demo (idle)",
+        ratio: "ratio demo/cyclictest",
+        misses: "ours, demo",
+        compute: "compute, demo",
+        roundtrip: "I/O round trip, demo",
+        late: "demo",
+        who: "the supervisor",
+        curve: "ours, demo machine (idle)",
+        colour: RGBColor(31, 111, 209),
+    },
+    Names {
+        letter: 'a',
+        label: "64 axes",
+        tag: "ours_axes64",
+        warn: "64 axes: ",
+        row: "ours, 64 axes homing",
+        ratio: "ratio 64 axes/cyclic.",
+        misses: "ours, 64 axes homing",
+        compute: "compute, 64 axes",
+        roundtrip: "round trip, 64 axes",
+        late: "64 axes:",
+        who: "the supervisor (64 axes homing)",
+        curve: "ours, 64 axes homing",
+        colour: RGBColor(148, 103, 189),
+    },
+    Names {
+        letter: 'e',
+        label: "EtherCAT",
+        tag: "ours_ethercat",
+        warn: "EtherCAT: ",
+        row: "ours, EtherCAT backend",
+        ratio: "ratio EtherCAT/cyclic.",
+        misses: "EtherCAT backend",
+        compute: "compute, EtherCAT",
+        roundtrip: "round trip, EtherCAT",
+        late: "EtherCAT backend:",
+        who: "the supervisor (EtherCAT backend)",
+        curve: "ours, EtherCAT backend",
+        colour: RGBColor(44, 160, 44),
+    },
+];
 
 /// What the slices run with.
 pub struct Plan<'a> {
@@ -57,8 +121,7 @@ pub struct Plan<'a> {
     pub tmp: &'a Path,
     /// Start of the bench: slices are timed from here.
     pub t0: Instant,
-    pub supervisor: &'a Path,
-    pub motionctl: &'a Path,
+    pub bins: &'a Binaries,
     /// The veth pair and emulated drives (`--ethercat`).
     pub rig: Option<&'a EcatRig>,
     /// None: the cyclictest half is skipped.
@@ -78,7 +141,8 @@ pub struct CtSlice {
 pub struct Collected {
     /// Per variant (`Variant as usize`), its slices.
     pub ours: [Vec<Slice>; 3],
-    pub homing64: Homing64,
+    /// The 64-axis machine's homings (`motionctl home --parallel`).
+    pub homing64: Repeated,
     /// motion-io's bus round trips, one per EtherCAT slice that reported it.
     pub bus_runs: Vec<BusRun>,
     pub ct: Vec<CtSlice>,
@@ -90,15 +154,22 @@ pub struct Collected {
     pub interrupted: bool,
 }
 
+impl Collected {
+    /// A stop was requested (noted): the slices end.
+    fn stopped(&mut self) -> bool {
+        self.interrupted |= proc::stop_requested();
+        self.interrupted
+    }
+}
+
 /// Runs the slices. An `Err` is a bench that could not go on (a config or
 /// a process that could not be made), not a tool that failed.
 pub fn run(p: &Plan, other_rt: &mut OtherRt) -> Result<Collected, String> {
     let mut c = Collected::default();
     let on = [true, p.o.axes64, p.rig.is_some()];
-    let variants = [Variant::Demo, Variant::Axes64, Variant::Ethercat];
     'slices: for i in 0..p.slices {
         let len = p.o.slicing.len(i);
-        for v in variants.into_iter().filter(|&v| on[v as usize]) {
+        for v in Variant::ALL.into_iter().filter(|&v| on[v as usize]) {
             if !our_slice(p, v, i, len, &mut c)? {
                 break 'slices;
             }
@@ -110,39 +181,31 @@ pub fn run(p: &Plan, other_rt: &mut OtherRt) -> Result<Collected, String> {
         }
         other_rt.note("during the bench");
     }
-    c.interrupted |= proc::stop_requested();
+    c.stopped();
     Ok(c)
 }
 
 /// One supervisor slice of `v`; false: the slices end (interrupted, or the
 /// run failed, recorded in `c`).
 fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Result<bool, String> {
-    if proc::stop_requested() {
-        c.interrupted = true;
+    if c.stopped() {
         return Ok(false);
     }
-    let prefix = format!("mbj{}{}{i}", std::process::id(), v.letter());
+    let n = v.names();
+    let prefix = format!("mbj{}{}{i}", std::process::id(), n.letter);
     let sup = p.o.cycle.supervisor(&prefix);
-    let (toml, _) = match v {
-        Variant::Axes64 => Machine::Axes64.with(&sup)?,
+    let (toml, _) = match (v, p.rig) {
+        (Variant::Axes64, _) => Machine::Axes64.with(&sup)?,
+        (Variant::Ethercat, Some(rig)) => {
+            ecat::on_ethercat(&machine::demo_with(&sup)?.0, rig.interface())?
+        }
         _ => machine::demo_with(&sup)?,
     };
-    let toml = match (v, p.rig) {
-        (Variant::Ethercat, Some(rig)) => ecat::on_ethercat(&toml, rig.interface())?.0,
-        _ => toml,
-    };
-    let tag = format!("{}{i}", v.letter());
-    let (mut cmd, hlog) = slice::command(p.supervisor, p.tmp, &tag, &toml, &prefix, len)?;
     let (start, t) = (p.t0.elapsed(), Instant::now());
-    let mut run = Running::spawn(&mut cmd, "motion-supervisor", true, false)?;
+    let tag = format!("{}{i}", n.letter);
+    let (mut run, log) = runs::start(p.bins, p.tmp, (&tag, &toml, &prefix), len, &[])?;
     let homing = match v {
-        Variant::Axes64 => Some(homing64::home_while(
-            p.motionctl,
-            &prefix,
-            &mut run,
-            t,
-            len,
-        )?),
+        Variant::Axes64 => Some(home_while(p, &prefix, &mut run, t, len)?),
         _ => None,
     };
     let left = Duration::from_secs_f64(len + 60.0).saturating_sub(t.elapsed());
@@ -151,118 +214,115 @@ fn our_slice(p: &Plan, v: Variant, i: usize, len: f64, c: &mut Collected) -> Res
         c.interrupted = true;
         return Ok(false);
     }
-    let (s, warnings) = match slice::read(&ended, &hlog, start, len) {
+    let (m, warnings) = match runs::read(&ended, &log) {
         Ok(x) => x,
         Err(e) => {
-            let (n, label) = (i + 1, v.label());
+            let (k, label) = (i + 1, n.label);
             c.failures
-                .push(format!("slice {n}: motion-supervisor ({label}): {e}"));
+                .push(format!("slice {k}: motion-supervisor ({label}): {e}"));
             return Ok(false);
         }
     };
-    let (l, w) = (&s.lat, &s.lat.wakeup_us);
+    let (l, w) = (&m.report.latency, &m.report.latency.wakeup_us);
     let mut line = format!(
         "jitter: slice {}/{} {:<11} {:>6} cycles, wake-up p99 {:>7} µs, max {:>7} µs, {} deadline miss(es), {} late repl(ies)",
-        i + 1, p.slices, format!("{}:", v.label()), l.cycles, us(w.p99), us(w.max), l.deadline_misses, l.late_replies
+        i + 1, p.slices, format!("{}:", n.label), l.cycles, us(w.p99), us(w.max), l.deadline_misses, l.late_replies
     );
     if let Some(h) = homing {
-        line += &h.progress();
+        let (n, ok, failed, cut) = (h.started, h.ok, h.failed, h.cut_off);
+        line += &format!("; {n} homing(s) of 64 axes: {ok} ok, {failed} failed, {cut} cut off by the slice's end");
         c.homing64.merge(h);
     }
     if v == Variant::Ethercat {
-        let bus = ecat::bus_run(&ended.stderr);
-        line += &format!(
-            "; bus round trip {}",
-            match bus {
-                Some(b) => format!(
-                    "p50 {} / p99 {} / max {} µs, {} lost frame(s)",
-                    us(b.p50),
-                    us(b.p99),
-                    us(b.max),
-                    b.lost
-                ),
-                None => "not reported".into(),
-            }
-        );
-        match bus {
-            Some(b) => c.bus_runs.push(b),
-            None => {
-                c.warnings
-                    .insert("EtherCAT: motion-io reported no bus summary in a slice".into());
-            }
-        }
+        line += &bus(c, &ended.stderr);
     }
     eprintln!("{line}");
-    let shown = ["", "64 axes: ", "EtherCAT: "][v as usize];
     c.warnings
-        .extend(warnings.into_iter().map(|w| format!("{shown}{w}")));
-    c.ours[v as usize].push(s);
-    let (found, remaining) = motion_bench::drive::clean_leftovers(&prefix);
-    if !found.is_empty() {
-        let all = if remaining.is_empty() {
-            ""
-        } else {
-            ", NOT all"
-        };
-        c.warnings.insert(format!(
-            "left in /dev/shm after a run (then cleaned by the bench{all}): {}",
-            found.join(", ")
-        ));
+        .extend(warnings.into_iter().map(|w| format!("{}{w}", n.warn)));
+    c.ours[v as usize].push(Slice { start, len, m });
+    if let Some((_, note)) = outcome::cleaned(&prefix) {
+        c.warnings
+            .insert(format!("left in /dev/shm after a run {note}"));
     }
     Ok(true)
 }
 
-/// cyclictest for as many periods as fit in the slice (`-l`, since `-D`
-/// takes whole seconds only), its histogram written to a file and read
-/// back; false: the slices end.
+/// The 64-axis machine homed again and again, once it is ready, while it
+/// is measured (so that the cycle computes every axis moving).
+fn home_while(
+    p: &Plan,
+    prefix: &str,
+    run: &mut Running,
+    t: Instant,
+    len: f64,
+) -> Result<Repeated, String> {
+    let m = &p.bins.motionctl;
+    match drive::wait_until_ready(m, prefix, run, Duration::from_secs_f64(len)) {
+        Ok(()) => Repeated::run(m, prefix, run, t, len),
+        Err(_) => Ok(Repeated::default()),
+    }
+}
+
+/// motion-io's bus round trip from the summary it logged (kept in `c`),
+/// as the progress line shows it.
+fn bus(c: &mut Collected, stderr: &str) -> String {
+    let Some(b) = ecat::bus_run(stderr) else {
+        let w = "EtherCAT: motion-io reported no bus summary in a slice";
+        c.warnings.insert(w.into());
+        return "; bus round trip not reported".into();
+    };
+    c.bus_runs.push(b);
+    let (p50, p99, max) = (us(b.p50), us(b.p99), us(b.max));
+    format!(
+        "; bus round trip p50 {p50} / p99 {p99} / max {max} µs, {} lost frame(s)",
+        b.lost
+    )
+}
+
+/// cyclictest for as many periods as fit in the slice, its histogram
+/// written to a file and read back; false: the slices end.
 fn cyclictest(p: &Plan, bin: &Path, i: usize, len: f64, c: &mut Collected) -> Result<bool, String> {
-    if proc::stop_requested() {
-        c.interrupted = true;
+    if c.stopped() {
         return Ok(false);
     }
     let cy = &p.o.cycle;
     let period_s = f64::from(cy.period_us) * 1e-6;
     let loops = ((len / period_s).round() as u64).max(1);
-    let hist_path = p.tmp.join(format!("ct{i}.hist"));
-    let args = format!(
-        "-m -p {} -t 1 -a {} -i {} -l {loops} -q -h {}",
-        cy.priority, cy.cpu, cy.period_us, p.o.hist_max_us
-    );
+    let file = p.tmp.join(format!("ct{i}.hist"));
+    let args = cyclictest::args(cy.priority, cy.cpu, cy.period_us, loops, p.o.hist_max_us);
     // the file's name left out: it is a temporary one
     c.ct_command = format!("cyclictest {args} --histfile=FILE");
-    let mut cmd = Command::new(bin);
-    cmd.args(args.split(' '))
-        .arg(format!("--histfile={}", hist_path.display()));
     let start = p.t0.elapsed();
+    let mut cmd = cyclictest::command(bin, &args, &file);
     let ended = Running::spawn(&mut cmd, "cyclictest", true, false)?
         .wait(Duration::from_secs_f64(len + 30.0), Duration::from_secs(3));
     if ended.interrupted {
         c.interrupted = true;
         return Ok(false);
     }
-    match cyclictest::read_run(&ended, &hist_path) {
-        Ok(hist) => {
-            let hdr = hist.to_hdr();
-            eprintln!(
-                "jitter: slice {}/{} cyclictest: {:>6} samples, wake-up p99 {:>7} µs, max {:>7} µs",
-                i + 1,
-                p.slices,
-                hist.samples(),
-                us(hdr.value_at_quantile(0.99) as f64 / 1000.0),
-                us(hist.max_us as f64)
-            );
-            let len = Duration::from_secs_f64(loops as f64 * period_s);
-            c.ct.push(CtSlice {
-                start,
-                len,
-                hist,
-                hdr,
-            });
-            Ok(true)
-        }
+    let hist = match cyclictest::read_run(&ended, &file) {
+        Ok(h) => h,
         Err(e) => {
             c.failures.push(format!("slice {}: cyclictest: {e}", i + 1));
-            Ok(false)
+            return Ok(false);
         }
-    }
+    };
+    let mut hdr = histogram();
+    hist.record_into(&mut hdr);
+    eprintln!(
+        "jitter: slice {}/{} cyclictest: {:>6} samples, wake-up p99 {:>7} µs, max {:>7} µs",
+        i + 1,
+        p.slices,
+        hist.samples(),
+        us(hdr.value_at_quantile(0.99) as f64 / 1000.0),
+        us(hist.max_us as f64)
+    );
+    let len = Duration::from_secs_f64(loops as f64 * period_s);
+    c.ct.push(CtSlice {
+        start,
+        len,
+        hist,
+        hdr,
+    });
+    Ok(true)
 }

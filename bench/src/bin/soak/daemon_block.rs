@@ -11,9 +11,10 @@ use crate::cli::Opts;
 use crate::report::Part;
 use crate::Ctx;
 use motion_bench::drive::{self, HomeRun};
-use motion_bench::spy::Spy;
+use motion_bench::proc::Ended;
+use motion_bench::spy::{Recording, Spy};
 use motion_bench::{host, machine, proc};
-use motion_report::{AxisResult, AxisStatus};
+use motion_report::RunReport;
 use serde_json::{json, Value};
 use std::path::Path;
 use std::process::Command;
@@ -24,34 +25,18 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
     let prefix = ctx.prefix("d");
     let (text, _) = machine::one_switch_axis_with(&o.cycle.supervisor(&prefix), ctx.tmp.to_str())?;
     let cfg = ctx.config(&prefix, &text)?;
-    let mut daemon = drive::spawn_run(&ctx.b, &cfg, &prefix, None, None)?;
-    let ready = drive::wait_until_ready(
-        &ctx.b.motionctl,
-        &prefix,
-        &mut daemon,
-        Duration::from_secs(20),
-    );
-    if let Err(e) = ready {
-        let ended = drive::stop_run(daemon, Duration::from_secs(20));
-        if ended.interrupted || proc::stop_requested() {
-            return Ok(true);
-        }
-        return Err(format!(
-            "{e} ({}; {})",
-            ended.describe(),
-            drive::tail(&ended.stderr, 5)
-        ));
-    }
-    let mut spy = match o
-        .spy
-        .then(|| Spy::start(&prefix, "io", ctx.other_cpu, 70, 400_000, |_| {}))
-    {
-        Some(Err(e)) => {
-            part.tally.note(format!("{prefix}: {e}"));
-            None
-        }
-        s => s.and_then(Result::ok),
+    let mut daemon = match drive::start_run(&ctx.b, &cfg, &prefix, Duration::from_secs(20)) {
+        Ok(d) => d,
+        Err(_) if proc::stop_requested() => return Ok(true),
+        Err(e) => return Err(e),
     };
+    let mut spy = None;
+    if o.spy {
+        match Spy::start(&prefix, "io", ctx.other_cpu, 70, 400_000, |_| {}) {
+            Ok(s) => spy = Some(s),
+            Err(e) => part.tally.note(format!("{prefix}: {e}")),
+        }
+    }
     let (mut interrupted, mut failed_in_block, t_block) = (false, false, Instant::now());
     for i in 1..=n {
         if proc::stop_requested() {
@@ -63,7 +48,7 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
         }
         let csv = ctx.tmp.join(format!("{prefix}-{i}.csv"));
         let run = match o.trace {
-            true => traced_home(&ctx.b.motionctl, &prefix, &csv, o.timeout)?,
+            true => drive::traced_home(&ctx.b.motionctl, &prefix, "X", &csv, o.timeout)?,
             false => drive::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?,
         };
         if run.ended.interrupted {
@@ -72,7 +57,7 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
         }
         if !part.tally.add(&format!("{prefix} homing {i}"), &run) {
             failed_in_block = true;
-            keep_evidence(o, ctx, &prefix, i, t_block, &run, &csv);
+            keep_evidence(ctx, &prefix, i, t_block, &run, &csv);
             if !daemon.running() {
                 part.tally.note(format!("{prefix}: the daemon ended"));
                 break;
@@ -84,18 +69,12 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
     drop(spy);
     let ended = drive::stop_run(daemon, Duration::from_secs(30));
     if failed_in_block {
-        let dir = o.files.out("").join("soak-evidence");
-        if let Some(r) = &frames {
-            let _ = std::fs::create_dir_all(&dir);
-            if let Err(e) = r.write_csv(&dir.join(format!("{prefix}.frames.csv"))) {
-                eprintln!("soak: cannot write the spy's frames: {e}");
-            }
-        }
-        let _ = std::fs::write(dir.join(format!("{prefix}.stderr")), &ended.stderr);
-        let _ = std::fs::write(dir.join(format!("{prefix}.run.json")), &ended.stdout);
+        keep_block(ctx, &prefix, frames.as_ref(), &ended);
     }
-    match drive::last_json(&ended.stdout) {
-        Some(v) => part.figures.add(&v, true),
+    let report =
+        drive::last_json(&ended.stdout).and_then(|v| serde_json::from_value::<RunReport>(v).ok());
+    match report {
+        Some(r) => part.figures.add(&r),
         None => part.tally.note(format!(
             "{prefix}: the daemon printed no report ({}; {})",
             ended.describe(),
@@ -125,64 +104,10 @@ fn still_homed(ctx: &Ctx, prefix: &str, i: u32, part: &mut Part) {
     }
 }
 
-/// One homing of X recorded by `motionctl trace X --home --out CSV`; its
-/// result row from `motionctl status` once the trace has ended.
-fn traced_home(
-    motionctl: &Path,
-    prefix: &str,
-    csv: &Path,
-    timeout: f64,
-) -> Result<HomeRun, String> {
-    let mut cmd = Command::new(motionctl);
-    cmd.args([
-        "--service-prefix",
-        prefix,
-        "trace",
-        "X",
-        "--home",
-        "--json",
-        "--out",
-    ])
-    .arg(csv);
-    cmd.args(["--timeout", &timeout.to_string()]);
-    let limit = Duration::from_secs_f64(timeout + 30.0);
-    let mut run = drive::home_run(&mut cmd, "motionctl trace", limit)?;
-    let status = drive::status(motionctl, prefix);
-    let row = |a: &AxisStatus| AxisResult {
-        name: a.name.clone(),
-        pc: a.pc,
-        er: a.er,
-        err: a.err,
-        exerr: a.exerr,
-        homed: a.homed,
-        error: a.error.clone(),
-        duration_s: Some(a.elapsed_s),
-        ..AxisResult::default()
-    };
-    run.rows = status
-        .iter()
-        .flat_map(|s| s.axes.first())
-        .map(row)
-        .collect();
-    if let Some(st) = status {
-        run.json = Some(json!({"trace": run.json.take(), "status": st}));
-    }
-    Ok(run)
-}
-
 /// Keeps what tells why homing `i` of `prefix` failed: its row, when it
 /// happened, `motionctl status` and `stats` right after, and its trace.
-fn keep_evidence(
-    o: &Opts,
-    ctx: &Ctx,
-    prefix: &str,
-    i: u32,
-    t_block: Instant,
-    run: &HomeRun,
-    csv: &Path,
-) {
-    let dir = o.files.out("").join("soak-evidence");
-    if std::fs::create_dir_all(&dir).is_err() {
+fn keep_evidence(ctx: &Ctx, prefix: &str, i: u32, t_block: Instant, run: &HomeRun, csv: &Path) {
+    if std::fs::create_dir_all(&ctx.evidence).is_err() {
         return;
     }
     let stats = Command::new(&ctx.b.motionctl)
@@ -203,8 +128,23 @@ fn keep_evidence(
         "stats_after": stats,
         "loadavg": host::loadavg(),
     });
-    let _ = motion_bench::outcome::write_json(&dir.join(format!("{prefix}-h{i}.json")), &v);
+    let _ =
+        motion_bench::outcome::write_json(&ctx.evidence.join(format!("{prefix}-h{i}.json")), &v);
     if csv.exists() {
-        let _ = std::fs::copy(csv, dir.join(format!("{prefix}-h{i}.csv")));
+        let _ = std::fs::copy(csv, ctx.evidence.join(format!("{prefix}-h{i}.csv")));
     }
+}
+
+/// Keeps the block's frames (`--spy`) and the daemon's output, after a
+/// homing of the block failed.
+fn keep_block(ctx: &Ctx, prefix: &str, frames: Option<&Recording>, ended: &Ended) {
+    let file = |ext: &str| ctx.evidence.join(format!("{prefix}.{ext}"));
+    if let Some(r) = frames {
+        let _ = std::fs::create_dir_all(&ctx.evidence);
+        if let Err(e) = r.write_csv(&file("frames.csv")) {
+            eprintln!("soak: cannot write the spy's frames: {e}");
+        }
+    }
+    let _ = std::fs::write(file("stderr"), &ended.stderr);
+    let _ = std::fs::write(file("run.json"), &ended.stdout);
 }

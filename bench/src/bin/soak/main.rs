@@ -4,11 +4,9 @@
 //! that failed with ERR 12 / EXERR 40 (feedback lost) or anything else, and
 //! every axis that ended not homed. See `bench/README.md`.
 //!
-//! This file is the sequence — checks, stage, the one-axis part, the
-//! 64-axis part, the report — and what every homing shares ([`Ctx`]); the
-//! modules are its steps: [`cli`] the command line, [`parts`] the two parts
-//! (with [`daemon_block`] for a block through one daemon), [`report`] what a
-//! part counts, the table and soak.json.
+//! The sequence: checks, stage, the one-axis and the 64-axis [`parts`]
+//! (a block through one daemon: [`daemon_block`]), the [`report`]; [`Ctx`]
+//! is what every homing shares.
 
 mod cli;
 mod daemon_block;
@@ -45,30 +43,27 @@ fn run(o: &Opts) -> Result<i32, String> {
     let bins = Binaries::find(o.files.supervisor.as_deref())?;
     let stress = o.stress_share > 0.0 || o.stress64;
     if stress && (host::cpus() < 2 || host::find_in_path("stress-ng").is_none()) {
-        return Err(
-            "stress-ng (apt-get install -y stress-ng) and a second CPU are needed \
-                    (or --stress-share 0)"
-                .into(),
-        );
+        let needed = "stress-ng (apt-get install -y stress-ng) and a second CPU are needed";
+        return Err(format!("{needed} (or --stress-share 0)"));
     }
     let out = o.files.out("");
     let b = Bench::start("soak", Some(&out))?;
-    let (tmp, other_cpu) = (b.tmp.clone(), o.cycle.other_cpu());
     let mut ctx = Ctx {
         b: bins,
-        tmp,
-        other_cpu,
+        tmp: b.tmp.clone(),
+        evidence: out.join("soak-evidence"),
+        other_cpu: o.cycle.other_cpu(),
         leftovers: vec![],
         not_cleaned: vec![],
         seq: 0,
     };
-    let (cy, env, other) = (&o.cycle, &b.env, ctx.other_cpu);
+    let (cy, h, other) = (&o.cycle, &b.host, ctx.other_cpu);
+    let with = if o.stress64 { " with stress-ng" } else { "" };
     eprintln!(
         "soak: {} one-axis homings via {:?} in blocks of {} ({:.0} % with stress-ng on CPU {other}), \
-         {} parallel homings of 64 axes{}; {} µs cycle, SCHED_FIFO {} on CPU {}; kernel {} ({}); load {}",
+         {} parallel homings of 64 axes{with}; {} µs cycle, SCHED_FIFO {} on CPU {}; kernel {} ({}); load {}",
         o.homings, o.via, o.block, o.stress_share * 100.0, o.runs64,
-        if o.stress64 { " with stress-ng" } else { "" },
-        cy.period_us, cy.priority, cy.cpu, env.kernel, env.preemption, env.load_before
+        cy.period_us, cy.priority, cy.cpu, h.kernel, h.preemption, h.load
     );
     let one = parts::one_axis(o, &mut ctx)?;
     let mut axes64 = Part::default();
@@ -93,6 +88,8 @@ pub struct Ctx {
     pub b: Binaries,
     /// Configs and traces of the runs.
     pub tmp: PathBuf,
+    /// Where what tells why a homing failed is kept.
+    pub evidence: PathBuf,
     /// Not the cycle's CPU: stress-ng and the spy go there.
     pub other_cpu: usize,
     /// What runs left in /dev/shm (cleaned by the bench).
@@ -121,10 +118,9 @@ impl Ctx {
     pub fn check_leftovers(&mut self, prefix: &str) {
         let (found, remaining) = drive::clean_leftovers(prefix);
         if !found.is_empty() {
-            let all = if remaining.is_empty() {
-                "cleaned"
-            } else {
-                "NOT all cleaned"
+            let all = match remaining.is_empty() {
+                true => "cleaned",
+                false => "NOT all cleaned",
             };
             eprintln!("soak: WARNING: {prefix} left {} ({all})", found.join(", "));
             self.leftovers.extend(found);

@@ -13,6 +13,7 @@ use crate::report::{count_home_run, Part};
 use crate::Ctx;
 use motion_bench::drive::{self, HomeRun};
 use motion_bench::{machine, proc};
+use motion_report::AxisResult;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -106,18 +107,14 @@ pub fn axes64(o: &Opts, ctx: &mut Ctx, axes64: &mut Part) -> Result<bool, String
             interrupted = true;
             break;
         };
-        let count =
-            |f: fn(&motion_report::AxisResult) -> bool| run.rows.iter().filter(|r| f(r)).count();
+        let count = |f: fn(&AxisResult) -> bool| run.rows.iter().filter(|r| f(r)).count();
+        fn lost(r: &AxisResult) -> bool {
+            r.er && r.err == 12 && r.exerr == 40
+        }
         eprintln!(
             "soak: 64 axes, run {}/{}: {} of {} axes ok, {} feedback lost, {} other errors, {} not homed; {:.1} s",
-            i + 1,
-            o.runs64,
-            count(|r| r.succeeded()),
-            run.rows.len(),
-            count(|r| r.er && r.err == 12 && r.exerr == 40),
-            count(|r| r.er && !(r.err == 12 && r.exerr == 40)),
-            count(|r| !r.homed),
-            run.seconds
+            i + 1, o.runs64, count(AxisResult::succeeded), run.rows.len(), count(lost),
+            count(|r| r.er && !lost(r)), count(|r| !r.homed), run.seconds
         );
     }
     axes64.seconds = t.elapsed().as_secs_f64();
@@ -138,16 +135,9 @@ fn fresh_home(
     let cfg = ctx.config(prefix, text)?;
     let mut cmd = Command::new(&ctx.b.supervisor);
     cmd.args(["home", "--config"]).arg(&cfg);
-    if parallel {
-        cmd.arg("--parallel");
-    }
-    cmd.args([
-        "--json",
-        "--timeout",
-        &o.timeout.to_string(),
-        "--service-prefix",
-        prefix,
-    ]);
+    cmd.args(parallel.then_some("--parallel"));
+    cmd.args(["--json", "--timeout", &o.timeout.to_string()]);
+    cmd.args(["--service-prefix", prefix]);
     let limit = Duration::from_secs_f64(o.timeout + 60.0);
     let run = drive::home_run(&mut cmd, "motion-supervisor home", limit)?;
     if run.ended.interrupted {

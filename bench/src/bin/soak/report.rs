@@ -8,10 +8,9 @@
 use crate::cli::{Opts, Via};
 use crate::Ctx;
 use motion_bench::drive::{HomeRun, Tally};
-use motion_bench::host::loadavg;
 use motion_bench::outcome::Bench;
-use motion_bench::table::Text;
-use motion_report::GapCounts;
+use motion_bench::table::{line, Text};
+use motion_report::{GapCounts, RunReport};
 use serde_json::{json, Value};
 
 /// Latency and I/O figures of the supervisors of one part, summed.
@@ -28,32 +27,22 @@ pub struct RunFigures {
 }
 
 impl RunFigures {
-    /// Adds a `run --json` / `home --json` object: its latency and I/O
-    /// figures (if it has them, or `always`) and its warnings (each once).
-    pub fn add(&mut self, v: &Value, always: bool) {
-        if always || v.get("latency").is_some() {
-            let (lat, n) = (&v["latency"], |v: &Value| v.as_u64().unwrap_or(0));
-            self.runs += 1;
-            self.cycles += n(&lat["cycles"]);
-            self.deadline_misses += n(&lat["deadline_misses"]);
-            self.late_replies += n(&lat["late_replies"]);
-            let max = lat["wakeup_us"]["max"].as_f64().unwrap_or(0.0);
-            self.wakeup_max_us = self.wakeup_max_us.max(max);
-            for io in v["io"].as_array().into_iter().flatten() {
-                self.frames_missing += n(&io["frames_missing"]);
-                if let Ok(g) = serde_json::from_value::<GapCounts>(io["gaps"].clone()) {
-                    self.gaps.merge(&g);
-                }
-            }
+    /// Adds the report of a `run --json` or `home --json`: its latency and
+    /// I/O figures and its warnings (each once).
+    pub fn add(&mut self, r: &RunReport) {
+        let l = &r.latency;
+        self.runs += 1;
+        self.cycles += l.cycles;
+        self.deadline_misses += l.deadline_misses;
+        self.late_replies += l.late_replies;
+        self.wakeup_max_us = self.wakeup_max_us.max(l.wakeup_us.max);
+        for io in &r.io {
+            self.frames_missing += io.frames_missing;
+            self.gaps.merge(&io.gaps);
         }
-        for w in v["warnings"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(Value::as_str)
-        {
-            if !self.warnings.iter().any(|x| x == w) {
-                self.warnings.push(w.to_string());
+        for w in &r.warnings {
+            if !self.warnings.contains(w) {
+                self.warnings.push(w.clone());
             }
         }
     }
@@ -90,8 +79,12 @@ impl Part {
 /// Counts one `home --json` run (rows, latency, gaps) into `p`.
 pub fn count_home_run(p: &mut Part, what: &str, run: &HomeRun) {
     p.tally.add(what, run);
-    if let Some(j) = &run.json {
-        p.figures.add(j, false);
+    let report = run
+        .json
+        .clone()
+        .and_then(|j| serde_json::from_value(j).ok());
+    if let Some(r) = report {
+        p.figures.add(&r);
     }
 }
 
@@ -104,6 +97,14 @@ pub struct Outcome {
     pub wall: f64,
 }
 
+/// The columns of the homings' table and of the supervisors' one: their
+/// widths (negative: left-aligned) and headings.
+const HOMINGS: [i32; 9] = [-34, 9, 7, 10, 8, 10, 9, 10, 8];
+const HOMINGS_HEAD: &str = "part|homings|ok|12/40|other|not homed|no rows|lost betw|time s";
+const SUPERVISORS: [i32; 11] = [-34, 8, 11, 8, 9, 7, 7, 7, 7, 9, 12];
+const SUPERVISORS_HEAD: &str =
+    "supervisors (sum)|runs|cycles|misses|late rep|gap 1|2-3|4-10|>10|longest|wake max µs";
+
 /// The printed report.
 pub fn text(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> String {
     let ([unloaded, stressed, axes64], cy, mut t) = (&out.parts, &o.cycle, Text::default());
@@ -111,38 +112,32 @@ pub fn text(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> String {
         "== soak: spurious homing failures, {} µs cycle, SCHED_FIFO {} on CPU {} (motion-io on the same CPU, the default), default settings (feedback_timeout_ms 10)",
         cy.period_us, cy.priority, cy.cpu
     ));
-    let (before, after, wall) = (&b.env.load_before, loadavg(), out.wall);
-    t.line(format!(
-        "{} | load before {before}, after {after} | wall {wall:.0} s",
-        b.env.head()
-    ));
+    t.line(b.load_line(out.wall));
     t.line("");
-    t.line(format!(
-        "{:<34}{:>9}{:>7}{:>10}{:>8}{:>10}{:>9}{:>10}{:>8}",
-        "part", "homings", "ok", "12/40", "other", "not homed", "no rows", "lost betw", "time s"
-    ));
+    t.line(line(&HOMINGS, HOMINGS_HEAD.split('|')));
     let row = |name: &str, p: &Part, between: bool| {
         let y = &p.tally;
         let lost = match between && o.via == Via::Daemon {
             true => y.lost_between.to_string(),
             false => "-".into(),
         };
-        format!(
-            "{:<34}{:>9}{:>7}{:>10}{:>8}{:>10}{:>9}{:>10}{:>8.0}",
-            name,
+        let n = [
             y.axis_homings + y.run_failures,
             y.ok,
             y.feedback_lost,
             y.other_errors,
             y.not_homed,
             y.run_failures,
-            lost,
-            p.seconds
-        )
+        ];
+        let cells = [name.to_string()]
+            .into_iter()
+            .chain(n.map(|n| n.to_string()));
+        line(&HOMINGS, cells.chain([lost, format!("{:.0}", p.seconds)]))
     };
     t.line(row("1 axis, no load", unloaded, true));
+    let other = ctx.other_cpu;
     t.line(row(
-        &format!("1 axis, stress-ng on CPU {}", ctx.other_cpu),
+        &format!("1 axis, stress-ng on CPU {other}"),
         stressed,
         true,
     ));
@@ -154,8 +149,9 @@ pub fn text(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> String {
     both.tally.merge(&stressed.tally);
     t.line(row("1 axis, all", &both, true));
     let stress = if o.stress64 { ", stress-ng" } else { "" };
+    let runs = axes64.tally.requests;
     t.line(row(
-        &format!("64 axes parallel, {} runs{stress}", axes64.tally.requests),
+        &format!("64 axes parallel, {runs} runs{stress}"),
         axes64,
         false,
     ));
@@ -177,28 +173,13 @@ pub fn text(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> String {
 
 /// The supervisors' own figures per part.
 fn supervisors(t: &mut Text, parts: &[Part; 3]) {
-    t.line(format!(
-        "{:<34}{:>8}{:>11}{:>8}{:>9}{:>7}{:>7}{:>7}{:>7}{:>9}{:>12}",
-        "supervisors (sum)",
-        "runs",
-        "cycles",
-        "misses",
-        "late rep",
-        "gap 1",
-        "2-3",
-        "4-10",
-        ">10",
-        "longest",
-        "wake max µs"
-    ));
+    t.line(line(&SUPERVISORS, SUPERVISORS_HEAD.split('|')));
     for (name, p) in ["1 axis, no load", "1 axis, stress-ng", "64 axes"]
         .iter()
         .zip(parts)
     {
         let (f, g) = (&p.figures, &p.figures.gaps);
-        t.line(format!(
-            "{:<34}{:>8}{:>11}{:>8}{:>9}{:>7}{:>7}{:>7}{:>7}{:>9}{:>12.0}",
-            name,
+        let n = [
             f.runs,
             f.cycles,
             f.deadline_misses,
@@ -208,7 +189,13 @@ fn supervisors(t: &mut Text, parts: &[Part; 3]) {
             g.four_to_ten,
             g.over_ten,
             g.longest_cycles,
-            f.wakeup_max_us
+        ];
+        let cells = [name.to_string()]
+            .into_iter()
+            .chain(n.map(|n| n.to_string()));
+        t.line(line(
+            &SUPERVISORS,
+            cells.chain([format!("{:.0}", f.wakeup_max_us)]),
         ));
     }
 }
@@ -226,10 +213,9 @@ fn problems(t: &mut Text, ctx: &Ctx, parts: &[Part; 3]) {
     if ctx.leftovers.is_empty() {
         return t.line("shared memory and session files: nothing left behind");
     }
-    let not = if ctx.not_cleaned.is_empty() {
-        ""
-    } else {
-        "; NOT cleaned: see soak.json"
+    let not = match ctx.not_cleaned.is_empty() {
+        true => "",
+        false => "; NOT cleaned: see soak.json",
     };
     t.line(format!(
         "left behind by {} run(s) (then cleaned by the bench{not}): {}",
@@ -240,20 +226,12 @@ fn problems(t: &mut Text, ctx: &Ctx, parts: &[Part; 3]) {
 
 /// soak.json.
 pub fn json(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> Value {
-    let ([unloaded, stressed, axes64], cy) = (&out.parts, &o.cycle);
-    json!({
-        "period_us": cy.period_us,
-        "cpu": cy.cpu,
-        "priority": cy.priority,
+    let [unloaded, stressed, axes64] = &out.parts;
+    let more = json!({
         "via": format!("{:?}", o.via).to_lowercase(),
         "block": o.block,
         "stress_share": o.stress_share,
         "stress_cpu": ctx.other_cpu,
-        "kernel": b.env.kernel,
-        "preemption": b.env.preemption,
-        "load_before": b.env.load_before,
-        "load_after": loadavg(),
-        "wall_s": out.wall,
         "one_axis_no_load": unloaded.json(),
         "one_axis_stress": stressed.json(),
         "axes64": axes64.json(),
@@ -261,5 +239,6 @@ pub fn json(o: &Opts, b: &Bench, ctx: &Ctx, out: &Outcome) -> Value {
         "leftovers": ctx.leftovers,
         "leftovers_not_cleaned": ctx.not_cleaned,
         "interrupted": out.interrupted,
-    })
+    });
+    motion_bench::outcome::with(b.json_head(&o.cycle, out.wall), more)
 }

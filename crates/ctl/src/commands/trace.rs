@@ -1,7 +1,7 @@
 use super::{client_error, fail, signal_code, EXIT_FAILED, EXIT_OK};
 use crate::cli::TraceArgs;
-use crate::plot;
 use motion_control::*;
+use motion_plot::trace as plot;
 use motion_report::{print_json, ErrorEntry, TraceReport};
 use std::time::{Duration, Instant};
 

@@ -5,8 +5,9 @@
 //! hiccups of milliseconds stretch the x axis, a second panel zooms in on
 //! the body of the distributions (to ~1.5 × the highest p99.9).
 
-use crate::table::thousands;
+use crate::{canvas, failed};
 use hdrhistogram::Histogram;
+use motion_report::table::thousands;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -64,14 +65,14 @@ impl Bins {
 
 /// Draws the plot into `path`: `subtitle` lines under the title, the
 /// period (`marker_us`) dashed where it lies in range.
-pub fn latency_plot(
+pub fn draw(
     path: &Path,
     title: &str,
     subtitle: &[&str],
     series: &[Series],
     marker_us: f64,
 ) -> Result<(), String> {
-    let e = |x: &dyn std::fmt::Display| format!("cannot draw {}: {x}", path.display());
+    let e = |x: &dyn std::fmt::Display| failed(path, x);
     let q = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q) as f64 / 1000.0;
     let nonempty = || series.iter().filter(|s| !s.hist.is_empty());
     let max_us = nonempty()
@@ -86,8 +87,7 @@ pub fn latency_plot(
     });
     let head = 50 + 20 * (subtitle.len() + series.len()) as u32;
     let size = (W, head + PANEL_H * (1 + u32::from(zoom.is_some())));
-    let root = SVGBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let root = canvas(path, size)?;
     let (centre, font) = (Pos::new(HPos::Center, VPos::Top), |n| {
         ("sans-serif", n).into_font()
     });
@@ -197,7 +197,10 @@ fn panel<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hist::new_hist;
+
+    fn new_hist() -> Histogram<u64> {
+        Histogram::new_with_bounds(1, 10_000_000_000, 3).unwrap()
+    }
 
     #[test]
     fn plots_two_series_and_zooms_on_a_far_outlier() {
@@ -208,7 +211,7 @@ mod tests {
         }
         let red = RGBColor(214, 39, 40);
         let p = std::env::temp_dir().join(format!("mb-plot-{}.svg", std::process::id()));
-        let draw = |a: &Histogram<u64>| {
+        let plot = |a: &Histogram<u64>| {
             let s = [
                 Series {
                     name: "ours",
@@ -221,16 +224,16 @@ mod tests {
                     hist: &b,
                 },
             ];
-            latency_plot(&p, "t <1>", &["s & s"], &s, 1000.0).unwrap();
+            draw(&p, "t <1>", &["s & s"], &s, 1000.0).unwrap();
             std::fs::read_to_string(&p).unwrap()
         };
-        let svg = draw(&a);
+        let svg = plot(&a);
         assert!(
             svg.starts_with("<svg") && svg.contains("t &lt;1&gt;") && svg.contains("s &amp; s")
         );
         assert!(svg.contains("every sample") && !svg.contains("zoom"));
         a.record(15_000_000).unwrap();
-        let svg = draw(&a);
+        let svg = plot(&a);
         let _ = std::fs::remove_file(&p);
         assert!(
             svg.contains("full range (every sample)")

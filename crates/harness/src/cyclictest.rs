@@ -1,13 +1,31 @@
-//! cyclictest's histogram file (`-h MAXUS --histfile=FILE`, one thread):
-//! one line per 1 µs bin `NNNNNN CCCCCC`, then `# Total:`, `# Min Latencies:`,
-//! `# Avg Latencies:`, `# Max Latencies:`, `# Histogram Overflows:` (samples
-//! at or above MAXUS, not in any bin).
+//! cyclictest, the reference the jitter bench measures the cycle against:
+//! its command line for one thread, and its histogram file (`-h MAXUS
+//! --histfile=FILE`): one line per 1 µs bin `NNNNNN CCCCCC`, then `# Total:`,
+//! `# Min Latencies:`, `# Avg Latencies:`, `# Max Latencies:`, `# Histogram
+//! Overflows:` (samples at or above MAXUS, not in any bin).
 
-use crate::hist::new_hist;
-use crate::proc::Ended;
+use crate::process::{tail, Ended};
 use hdrhistogram::Histogram;
 use std::path::Path;
+use std::process::Command;
 
+/// One thread, `loops` periods of `period_us` (`-l`, since `-D` takes whole
+/// seconds only), SCHED_FIFO `priority` on `cpu`, memory locked, quiet, a
+/// histogram of `hist_max_us` 1 µs bins: the arguments as the report shows
+/// them (the histogram file's name left out, see [`command`]).
+pub fn args(priority: i32, cpu: usize, period_us: u32, loops: u64, hist_max_us: u64) -> String {
+    format!("-m -p {priority} -t 1 -a {cpu} -i {period_us} -l {loops} -q -h {hist_max_us}")
+}
+
+/// `BIN ARGS --histfile=HIST`.
+pub fn command(bin: &Path, args: &str, hist: &Path) -> Command {
+    let mut cmd = Command::new(bin);
+    cmd.args(args.split(' '))
+        .arg(format!("--histfile={}", hist.display()));
+    cmd
+}
+
+/// A histogram file, read.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CtHistogram {
     /// (latency µs, samples) of every non-empty bin.
@@ -73,7 +91,7 @@ pub fn read_run(ended: &Ended, hist_path: &Path) -> Result<CtHistogram, String> 
     let out = format!("{}\n{}", ended.stdout.trim(), ended.stderr.trim());
     let out = match out.trim() {
         "" => String::new(),
-        e => format!("; its output: {}", crate::drive::tail(e, 8)),
+        e => format!("; its output: {}", tail(e, 8)),
     };
     if !ended.success() {
         return Err(format!("{}{out}", ended.describe()));
@@ -109,18 +127,17 @@ impl CtHistogram {
             }
     }
 
-    /// As an HdrHistogram in ns. A bin `v` holds latencies in [v, v+1) µs
-    /// (cyclictest truncates); it is recorded at v µs, as cyclictest reports
-    /// it. Overflows are recorded at the run's max (an upper bound).
-    pub fn to_hdr(&self) -> Histogram<u64> {
-        let mut h = new_hist();
+    /// Records its samples into `h` (ns). A bin `v` holds latencies in
+    /// [v, v+1) µs (cyclictest truncates); it is recorded at v µs, as
+    /// cyclictest reports it. Overflows are recorded at the run's max (an
+    /// upper bound).
+    pub fn record_into(&self, h: &mut Histogram<u64>) {
         for &(us, n) in &self.bins {
             h.saturating_record_n(us * 1000, n);
         }
         if self.overflows > 0 {
             h.saturating_record_n(self.max_us * 1000, self.overflows);
         }
-        h
     }
 }
 
@@ -141,10 +158,16 @@ mod tests {
         assert_eq!(h.samples(), 7);
         assert_eq!(h.at_or_above(1000), 1);
         assert_eq!(h.at_or_above(999), 2);
-        let hdr = h.to_hdr();
+        let mut hdr = Histogram::new_with_bounds(1, 10_000_000_000, 3).unwrap();
+        h.record_into(&mut hdr);
         assert_eq!(hdr.len(), 7);
         assert_eq!(hdr.min(), 12_000);
         assert!(hdr.max() >= 1_500_000);
         assert!(parse("000001 000002\n").is_err());
+        let a = args(80, 1, 1000, 2500, 20000);
+        assert_eq!(a, "-m -p 80 -t 1 -a 1 -i 1000 -l 2500 -q -h 20000");
+        let c = command(Path::new("/c"), &a, Path::new("/t/h"));
+        let argv: Vec<_> = c.get_args().map(|a| a.to_str().unwrap()).collect();
+        assert_eq!((argv.len(), argv[14]), (15, "--histfile=/t/h"));
     }
 }

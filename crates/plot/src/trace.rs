@@ -1,7 +1,8 @@
-//! The plot of a traced homing: velocity against position, the way the seed
-//! documents draw homing sequences — each leg a line, the home event and the
-//! switch and marker edges marked — drawn with `plotters` into an SVG.
+//! The plot of a traced homing (`motionctl trace --plot`): velocity against
+//! position, the way the seed documents draw homing sequences — each leg a
+//! line, the home event and the switch and marker edges marked.
 
+use crate::{canvas, failed};
 use motion_report::TraceRow;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -86,9 +87,8 @@ impl Area {
 /// Draws `rows` of axis `axis` into `path` (SVG).
 pub fn draw(rows: &[TraceRow], axis: &str, path: &Path) -> Result<(), String> {
     let area = Area::of(rows).ok_or("the trace has no feedback to plot")?;
-    let e = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
-    let root = SVGBackend::new(path, (1000, 500)).into_drawing_area();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let e = |x: &dyn std::fmt::Display| failed(path, x);
+    let root = canvas(path, (1000, 500))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!("{axis}: velocity against position during homing"),
