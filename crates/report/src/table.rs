@@ -164,3 +164,35 @@ pub fn status(r: &crate::StatusReport) -> String {
     }
     s
 }
+
+/// One row per axis, as `move`, `jog` and `stream` print how they ended.
+pub fn motion_rows(rows: &[crate::MotionRow]) -> String {
+    let w = rows
+        .iter()
+        .map(|r| r.name.chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4)
+        + 2;
+    let mut s = format!(
+        "{:<w$}{:>4}{:>4}{:>10}{:>12}{:>14}{:>12}\n",
+        "axis", "PC", "ER", "ERR/EXERR", "position", "follow err max", "final err"
+    );
+    for r in rows {
+        let b = |x: bool| if x { "1" } else { "0" };
+        s += &format!(
+            "{:<w$}{:>4}{:>4}{:>10}{}{}{}\n",
+            r.name,
+            b(r.pc),
+            b(r.er),
+            format!("{}/{}", r.err, r.exerr),
+            opt(r.position, 12),
+            opt(r.following_error_max, 14),
+            opt(r.final_error, 12),
+        );
+        if let Some(e) = &r.error {
+            s += &format!("  └ {e}\n");
+        }
+    }
+    s
+}
