@@ -41,6 +41,7 @@ mod intake;
 mod latches;
 mod legs;
 pub mod loss;
+mod ops;
 mod plausible;
 mod reference;
 mod state;
@@ -297,6 +298,9 @@ impl Axis {
         }
         if req.home && !prev.home {
             self.start(now, req.shutdown);
+        }
+        if let Some(op) = req.op {
+            self.operation(now, op);
         }
         if !req.home && (self.status.dn || self.status.er) {
             self.status.en = false;
@@ -568,6 +572,7 @@ impl Axis {
                 id: self.latches.switch_id,
                 edge: self.latches.switch_edge,
             },
+            fault_reset: false,
         };
         self.last_command = cmd;
         self.plausible.commanded(cmd.position);
