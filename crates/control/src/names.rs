@@ -1,20 +1,15 @@
-//! The numbers of the status frame's operation fields in words (the
-//! engine's spellings).
+//! The numbers of the status frame's operation fields in words: the
+//! engine's spellings (`motion_homing::operation`), "?" for a number no
+//! spelling has (a frame of a newer supervisor).
+
+use motion_homing::{OpKind, StopCause};
 
 /// `AxisStatusEntry::op_kind` in words.
 pub fn op_kind(n: u8) -> &'static str {
-    // FIXME(ops): the engine's OpKind spellings
-    match n {
-        0 => "none",
-        _ => "?",
-    }
+    OpKind::from_number(n).map_or("?", OpKind::name)
 }
 
 /// `AxisStatusEntry::last_stop` in words.
 pub fn stop_cause(n: u8) -> &'static str {
-    // FIXME(ops): the engine's StopCause spellings
-    match n {
-        0 => "none",
-        _ => "?",
-    }
+    StopCause::from_number(n).map_or("?", StopCause::name)
 }

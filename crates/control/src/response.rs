@@ -59,7 +59,7 @@ impl Reason {
             Reason::Instruction { err, exerr } | Reason::Operation { err, exerr } => {
                 Some((err, exerr))
             }
-            Reason::Owned => Some((3, 0)), // FIXME(ops): codes::ERR_EXECUTION_COLLISION
+            Reason::Owned => Some((motion_homing::codes::ERR_EXECUTION_COLLISION, 0)),
             _ => None,
         }
     }

@@ -17,35 +17,19 @@
 use motion_frames::{SetpointFrame, SetpointRefusal, MAX_AXES};
 use motion_homing::Setpoint;
 
-/// The intake's counters (since start).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct StreamCounts {
-    /// Frames that reached the checks.
-    pub frames: u64,
-    /// Setpoints handed to engines (a gantry's counts once).
-    pub setpoints: u64,
-    pub refused_layout: u64,
-    pub refused_key: u64,
-    pub refused_count: u64,
-    pub refused_token: u64,
-    pub refused_sequence: u64,
-    pub refused_axis: u64,
-    /// Streams granted since start.
-    pub acquired: u32,
-}
+use crate::shared::StreamCounts;
 
-impl StreamCounts {
-    fn refused(&mut self, r: SetpointRefusal) {
-        let c = match r {
-            SetpointRefusal::Layout => &mut self.refused_layout,
-            SetpointRefusal::Key => &mut self.refused_key,
-            SetpointRefusal::Count => &mut self.refused_count,
-            SetpointRefusal::Token => &mut self.refused_token,
-            SetpointRefusal::Sequence => &mut self.refused_sequence,
-            SetpointRefusal::Axis => &mut self.refused_axis,
-        };
-        *c += 1;
-    }
+/// Counts a refusal by kind.
+fn count(c: &mut StreamCounts, r: SetpointRefusal) {
+    let n = match r {
+        SetpointRefusal::Layout => &mut c.refused_layout,
+        SetpointRefusal::Key => &mut c.refused_key,
+        SetpointRefusal::Count => &mut c.refused_count,
+        SetpointRefusal::Token => &mut c.refused_token,
+        SetpointRefusal::Sequence => &mut c.refused_sequence,
+        SetpointRefusal::Axis => &mut c.refused_axis,
+    };
+    *n += 1;
 }
 
 /// One owner: its token, its axes, the last sequence number taken.
@@ -60,7 +44,8 @@ struct Owner {
 /// Owners and this cycle's setpoints.
 #[derive(Clone, Debug)]
 pub struct StreamIntake {
-    key: [u64; 2],
+    /// This session's key (`None`: not known yet, every frame is refused).
+    key: Option<[u64; 2]>,
     /// Per axis, the axis whose setpoints move it (itself, or its gantry's
     /// first side).
     lead: [u8; MAX_AXES],
@@ -73,8 +58,9 @@ pub struct StreamIntake {
 
 impl StreamIntake {
     /// `lead[i]`: the axis whose setpoints move axis `i` (itself, or its
-    /// gantry's first side); `key`: this session's.
-    pub fn new(key: [u64; 2], lead: &[usize]) -> Self {
+    /// gantry's first side); `key`: this session's (`None`: every frame is
+    /// refused until [`StreamIntake::set_key`]).
+    pub fn new(key: Option<[u64; 2]>, lead: &[usize]) -> Self {
         let mut l = [0u8; MAX_AXES];
         let n = lead.len().min(MAX_AXES);
         for (i, (dst, &src)) in l.iter_mut().zip(lead).enumerate().take(n) {
@@ -88,6 +74,11 @@ impl StreamIntake {
             newest: [None; MAX_AXES],
             counts: StreamCounts::default(),
         }
+    }
+
+    /// Frames must carry `key` from now on.
+    pub fn set_key(&mut self, key: [u64; 2]) {
+        self.key = Some(key);
     }
 
     /// The token that owns axis `i` (0: none).
@@ -158,25 +149,28 @@ impl StreamIntake {
     /// owned axes become their newest setpoint of this cycle.
     pub fn take(&mut self, f: &SetpointFrame) {
         self.counts.frames += 1;
-        if let Err(r) = f.check(self.key) {
-            return self.counts.refused(r);
+        let Some(key) = self.key else {
+            return count(&mut self.counts, SetpointRefusal::Key);
+        };
+        if let Err(r) = f.check(key) {
+            return count(&mut self.counts, r);
         }
         let Some(o) = self
             .owners
             .iter_mut()
             .find(|o| o.token != 0 && o.token == f.token)
         else {
-            return self.counts.refused(SetpointRefusal::Token);
+            return count(&mut self.counts, SetpointRefusal::Token);
         };
         if f.seq <= o.last_seq {
-            return self.counts.refused(SetpointRefusal::Sequence);
+            return count(&mut self.counts, SetpointRefusal::Sequence);
         }
         o.last_seq = f.seq;
         let mask = o.mask;
         for e in f.entries() {
             let i = e.axis as usize;
             if i >= self.axis_count || mask & bit(i) == 0 || self.lead[i] as usize != i {
-                self.counts.refused(SetpointRefusal::Axis);
+                count(&mut self.counts, SetpointRefusal::Axis);
                 continue;
             }
             let sp = Setpoint {
@@ -237,7 +231,7 @@ mod tests {
 
     /// X (0), gantry Y1 (1) + Y2 (2), Z (3).
     fn intake() -> StreamIntake {
-        StreamIntake::new(KEY, &[0, 1, 1, 3])
+        StreamIntake::new(Some(KEY), &[0, 1, 1, 3])
     }
 
     #[test]
