@@ -77,11 +77,12 @@ pub fn status(r: &crate::StatusReport) -> String {
         + 2;
     let b = |x: bool, c: &'static str| if x { c } else { "." };
     let mut s = format!(
-        "{:<w$}{:<8}{:<13}{:<12}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17} {:>19}\n",
+        "{:<w$}{:<8}{:<13}{:<15}{:<9}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17} {:>19}\n",
         "axis",
         "io",
         "phase",
         "EN DN ER IP PC",
+        "SJMTxF-+",
         "homed",
         "ERR/EXERR",
         "position",
@@ -97,7 +98,7 @@ pub fn status(r: &crate::StatusReport) -> String {
             x.map_or(format!("{:>width$}", "-"), |v| format!("{v:>width$.p$}"))
         };
         s += &format!(
-            "{:<w$}{:<8}{:<13}{} {} {} {} {} {:>7}{:>10}{}{}{}{} {}{}{:>17} {:>19}\n",
+            "{:<w$}{:<8}{:<13}{} {} {} {} {}  {:<9}{:>7}{:>10}{}{}{}{} {}{}{:>17} {:>19}\n",
             a.name,
             a.io,
             a.phase,
@@ -106,6 +107,7 @@ pub fn status(r: &crate::StatusReport) -> String {
             b(a.er, "ER"),
             b(a.ip, "IP"),
             b(a.pc, "PC"),
+            motion_flags(a),
             match (a.homed, a.restored) {
                 (true, true) => "stored",
                 (true, false) => "yes",
@@ -139,6 +141,17 @@ pub fn status(r: &crate::StatusReport) -> String {
         }
         for wrn in &a.warnings {
             s += &format!("  └ warning: {wrn}\n");
+        }
+        if let Some(o) = &a.owner {
+            s += &format!("  └ owned by {o} (setpoint stream)\n");
+        }
+        if a.op.err != 0 {
+            s += &format!(
+                "  └ last operation refused: ERR {} EXERR {}: {}\n",
+                a.op.err,
+                a.op.exerr,
+                crate::codes::explain(a.op.err, a.op.exerr)
+            );
         }
     }
     for io in &r.io {
@@ -195,4 +208,23 @@ pub fn motion_rows(rows: &[crate::MotionRow]) -> String {
         }
     }
     s
+}
+
+/// The operation bits of an axis in eight characters (`.` = off):
+/// ServoActionStatus `S`, jogging `J`, moving `M`, streaming `T`, stopping
+/// `x`, faulted `F`, negative / positive limit switch `-` / `+`.
+fn motion_flags(a: &crate::AxisStatus) -> String {
+    [
+        (a.servo_action, 'S'),
+        (a.jogging, 'J'),
+        (a.moving, 'M'),
+        (a.streaming, 'T'),
+        (a.stopping, 'x'),
+        (a.faulted, 'F'),
+        (a.limit_negative, '-'),
+        (a.limit_positive, '+'),
+    ]
+    .iter()
+    .map(|&(on, c)| if on { c } else { '.' })
+    .collect()
 }
