@@ -231,6 +231,30 @@ impl SetpointPublisher {
         Ok(self.seq)
     }
 
+    /// Publishes a frame exactly as `fill` writes it (on an all-zero frame;
+    /// nothing stamped): for tests and tools that must send what a broken or
+    /// hostile program would (replayed sequence numbers, another key).
+    pub fn publish_raw(&mut self, fill: impl FnOnce(&mut SetpointFrame)) -> Result<(), IpcError> {
+        let mut uninit = self
+            .publisher
+            .loan_uninit()
+            .map_err(|error| IpcError::Loan {
+                service: self.label.clone(),
+                error,
+            })?;
+        // SAFETY: as in `publish`.
+        let mut sample = unsafe {
+            SetpointFrame::placement_default(uninit.payload_mut().as_mut_ptr());
+            uninit.assume_init()
+        };
+        fill(sample.payload_mut());
+        sample.send().map_err(|error| IpcError::Send {
+            service: self.label.clone(),
+            error,
+        })?;
+        Ok(())
+    }
+
     /// The service's name.
     pub fn service(&self) -> &str {
         &self.label
