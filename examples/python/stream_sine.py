@@ -170,8 +170,10 @@ def main() -> int:
                 ok = False
                 break
     time.sleep(0.05)
-    sup.request(REQ_STREAM_RELEASE, [], token=token)
-    for e, _ in follow(sup, r, 30.0):
+    # Released: follow the stream ends' operations (their ids are in the
+    # answer) to rest; refused: the stream was over already (an error).
+    rel = sup.request(REQ_STREAM_RELEASE, [], token=token)
+    for e, _ in follow(sup, rel if rel.result == RESULT_ACCEPTED else r, 30.0):
         ok = ok and not e.bits & ST_ER
         print(
             f"{text(e.name)}: ER {int(bool(e.bits & ST_ER))} ERR {e.err}/{e.exerr} "

@@ -86,8 +86,8 @@ pub const FLAG_SINCE_RESET: u32 = 1 << 1;
 pub const FLAG_PARALLEL: u32 = 1 << 2;
 /// `REQ_MOVE`: `position` is a distance from where the move starts.
 pub const FLAG_RELATIVE: u32 = 1 << 3;
-/// `REQ_JOG`, `REQ_MOVE`: replace a running jog or move (without it, ERR 3
-/// Execution Collision).
+/// `REQ_MOVE`: replace a running jog or move (without it, ERR 3 Execution
+/// Collision). (A jog replaces a running jog by itself and never a move.)
 pub const FLAG_SUPERSEDE: u32 = 1 << 4;
 /// `REQ_JOG_RENEW`: end the jog now instead (a stop of this jog only: if
 /// it no longer runs, nothing is stopped).

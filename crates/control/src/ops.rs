@@ -69,8 +69,6 @@ pub struct JogSpec {
     pub lease: Duration,
     /// How often the handle renews (well inside the lease).
     pub renew_every: Duration,
-    /// Replace a running jog or move (else ERR 3).
-    pub supersede: bool,
 }
 
 impl JogSpec {
@@ -83,7 +81,6 @@ impl JogSpec {
             decel: None,
             lease: Duration::from_millis(500),
             renew_every: Duration::from_millis(100),
-            supersede: false,
         }
     }
 }
@@ -147,7 +144,6 @@ impl Client {
             accel: j.accel,
             decel: j.decel,
             lease_ms: j.lease.as_millis().min(u32::MAX as u128) as u32,
-            supersede: j.supersede,
         };
         let resp = accepted(self.send(&r, ANSWER)?)?;
         let domain = self.domain();

@@ -85,14 +85,14 @@ pub enum Request {
     Reset { axes: Axes },
     /// MAJ, hold to run: jog `axes` (one axis or one gantry) at `speed`
     /// (signed) while the lease is renewed; `accel`/`decel` `None`: the
-    /// axis's homing ones.
+    /// axis's homing ones. (A jog replaces a running jog; on a moving axis
+    /// it is refused, ERR 3: nothing supersedes a move but another move.)
     Jog {
         axes: Axes,
         speed: f64,
         accel: Option<f64>,
         decel: Option<f64>,
         lease_ms: u32,
-        supersede: bool,
     },
     /// Renew the lease of jog `token` (on `axes`; none: wherever it runs);
     /// `end`: end that jog now instead.
@@ -183,7 +183,6 @@ impl Request {
                 accel: param(m.accel),
                 decel: param(m.decel),
                 lease_ms: m.lease_ms,
-                supersede: m.flags & FLAG_SUPERSEDE != 0,
             },
             REQ_JOG_RENEW => Request::JogRenew {
                 axes: axes(),
@@ -318,10 +317,8 @@ impl Request {
                 accel,
                 decel,
                 lease_ms,
-                supersede: s,
             } => {
                 m.kind = REQ_JOG;
-                m.flags = supersede(*s);
                 (m.speed, m.accel, m.decel) = (*speed, wire(*accel), wire(*decel));
                 m.lease_ms = *lease_ms;
                 axes.names()
@@ -411,7 +408,6 @@ mod tests {
                 accel: None,
                 decel: Some(40.0),
                 lease_ms: 500,
-                supersede: true,
             },
             Request::JogRenew {
                 axes: Axes::All,

@@ -126,9 +126,6 @@ pub struct JogArgs {
     /// Stop after S seconds.
     #[arg(long = "for", value_name = "S", value_parser = seconds)]
     pub for_s: Option<f64>,
-    /// Replace a running jog or move of the axis (else refused, ERR 3).
-    #[arg(long)]
-    pub supersede: bool,
     #[arg(long)]
     pub json: bool,
 }

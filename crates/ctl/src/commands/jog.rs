@@ -22,7 +22,6 @@ pub fn jog(client: &mut Client, a: &JogArgs) -> i32 {
     let spec = JogSpec {
         accel: a.accel,
         decel: a.decel,
-        supersede: a.supersede,
         ..JogSpec::new(&a.axis, a.speed)
     };
     let handle = match client.jog(&spec) {
@@ -49,20 +48,8 @@ pub fn jog(client: &mut Client, a: &JogArgs) -> i32 {
         || false,
     ) {
         Err(e) => client_error(a.json, &e),
-        Ok((rows, _)) => report(
-            a.json,
-            MotionReport {
-                axes: rows.into_iter().map(jog_row).collect(),
-            },
-        ),
+        Ok((rows, _)) => report(a.json, MotionReport { axes: rows }),
     }
-}
-
-/// A jog has no target: it succeeded when it ended without an axis fault,
-/// however it was ended (`pc` says whether the engine ended it normally).
-fn jog_row(mut r: motion_report::MotionRow) -> motion_report::MotionRow {
-    r.pc = !r.er;
-    r
 }
 
 /// Holds the jog until Ctrl-C / SIGTERM, `for_s` elapsing, or the jog ending

@@ -50,11 +50,17 @@ pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
         drop(s);
         return client_error(a.json, &e);
     }
-    if let Err(e) = s.release() {
-        // Already over on the supervisor's side (an axis stopped with an
-        // error ends the stream): the rows say why.
-        log::debug!("release: {e}");
-    }
+    // Released: followed by the stream ends' operations (PC: at rest on the
+    // last setpoint). Not released: already over on the supervisor's side
+    // (an axis stopped with an error ends the stream): followed by the
+    // stream's own operations, whose rows say why.
+    let (axes, cycle) = match s.release() {
+        Ok(resp) => (followed(&resp), resp.cycle),
+        Err(e) => {
+            log::debug!("release: {e}");
+            (axes, cycle)
+        }
+    };
     let last = &rows[rows.len() - 1];
     match follow(
         client,
@@ -148,19 +154,16 @@ impl Play {
                 }
             }
         }
-        // The last segment takes its own length after it arrived; a cycle
-        // more, and the status's 10 ms.
+        // The last segment takes its own length to be reached: then the
+        // stream is released (the engine lands the axis on the last
+        // setpoint). Not longer: a stream silent longer than the axis's
+        // stream_timeout_ms (default 50) after its last setpoint stops the
+        // axis with an error.
         let last = points
             .len()
             .checked_sub(2)
             .map_or(0.0, |k| points[k + 1].t - points[k].t);
-        let until = motion_rt::now_ns() + ((last + 0.05) * 1e9) as u64;
-        while motion_rt::now_ns() < until {
-            std::thread::sleep(Duration::from_millis(10));
-            if !self.look(s, axes, progress)? {
-                return Ok(());
-            }
-        }
+        std::thread::sleep(Duration::from_secs_f64(last.min(csv::FILL_S)));
         Ok(())
     }
 

@@ -259,7 +259,6 @@ impl ControlThread {
                 accel,
                 decel,
                 lease_ms,
-                supersede: _,
             }) => {
                 let op = Operation::Jog {
                     speed,

@@ -51,6 +51,9 @@ impl ControlThread {
         let Some(mask) = self.axes_of(axes, 0, r) else {
             return;
         };
+        if !self.whole_gantries(mask, r) {
+            return;
+        }
         if !self.one_axis_or_gantry(mask) {
             return r.bad_request("jog takes one axis or one gantry");
         }
@@ -124,6 +127,7 @@ impl ControlThread {
             name: owner.to_string(),
             node_id,
             mask,
+            seen: false,
         });
         let map = self.stream_map(axes);
         r.page(map.as_bytes(), 0);

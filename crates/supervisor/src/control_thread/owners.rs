@@ -27,6 +27,9 @@ pub struct Owner {
     pub name: String,
     pub node_id: u128,
     pub mask: u64,
+    /// A snapshot has shown the token (snapshots trail the cycle by up to
+    /// 10 ms: one taken before the grant does not know it yet).
+    pub seen: bool,
 }
 
 /// Every owner, and when their nodes were last checked.
@@ -65,12 +68,16 @@ impl Owners {
             .map(|o| o.name.as_str())
     }
 
-    /// Owners whose stream the cycle has ended (no axis of the snapshot
-    /// names their token any more): forgotten, and returned for the log.
+    /// Owners whose stream the cycle has ended (a snapshot showed their
+    /// token, and no axis of the newest names it any more): forgotten, and
+    /// returned for the log.
     pub fn prune(&mut self, snap: &Snapshot) -> Vec<Owner> {
         let live = |t: u64| snap.axes[..snap.axis_count].iter().any(|a| a.owner == t);
+        for o in &mut self.list {
+            o.seen |= live(o.token);
+        }
         let (keep, gone): (Vec<Owner>, Vec<Owner>) =
-            self.list.drain(..).partition(|o| live(o.token));
+            (self.list.drain(..)).partition(|o| !o.seen || live(o.token));
         self.list = keep;
         gone
     }

@@ -4,7 +4,7 @@
 //! sides) were applied by the control thread before; these are the ones
 //! only the cycle can judge (in process, attached, busy, leaving).
 
-use motion_homing::codes::ERR_ILLEGAL_HOMING_CONFIG;
+use motion_homing::codes::{ERR_AXIS_FAULTED, ERR_EXECUTION_COLLISION, ERR_ILLEGAL_HOMING_CONFIG};
 
 use super::ops::Then;
 use super::Core;
@@ -61,7 +61,7 @@ impl Core {
                 motion_homing::Operation::StreamStart,
                 Then::Own(token),
             )?,
-            Control::StreamRelease { id, token } => self.stream_release(Ack::new(id), token),
+            Control::StreamRelease { id, token } => self.stream_release(Ack::new(id), token)?,
         };
         ack.cycle = self.cycle + 1;
         Some(ack)
@@ -78,6 +78,22 @@ impl Core {
         }
         if slot.status().ip || slot.rung.pending > 0 {
             return Some(Refusal::AlreadyHoming);
+        }
+        // The engine would refuse these too, by the Home instruction's ER —
+        // which would overwrite the axis fault's own ERR / EXERR: answered
+        // here instead, and the engine never sees the rung rise.
+        let s = slot.status();
+        if s.faulted {
+            return Some(Refusal::Instruction {
+                err: ERR_AXIS_FAULTED,
+                exerr: 0,
+            });
+        }
+        if s.jogging || s.moving || s.streaming {
+            return Some(Refusal::Instruction {
+                err: ERR_EXECUTION_COLLISION,
+                exerr: 0,
+            });
         }
         if self.seq.busy() & (1 << i) != 0 {
             return Some(Refusal::Busy);

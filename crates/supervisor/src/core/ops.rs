@@ -92,7 +92,11 @@ impl Core {
     /// Why axis `i` cannot be given `op` now, before its engine judges it.
     fn op_refusal(&self, i: usize, op: &Operation) -> Option<Refusal> {
         let slot = &self.slots[i];
-        if self.exiting && !matches!(op, Operation::Disable | Operation::Stop) {
+        let always = matches!(
+            op,
+            Operation::Disable | Operation::Stop | Operation::StreamEnd
+        );
+        if self.exiting && !always {
             return Some(Refusal::Exiting);
         }
         if slot.rung.request.op.is_some() {
@@ -161,7 +165,9 @@ impl Core {
                 continue;
             }
             if end {
-                slot.rung.request.op = Some(Operation::Stop);
+                // A stop of the jog itself (MAS), not a new operation: the
+                // jog's own id ends with it (PC once at rest).
+                slot.rung.request.stop = true;
             } else {
                 slot.rung.request.jog_renew = true;
             }
@@ -177,14 +183,15 @@ impl Core {
 
     /// Ends the stream of `token`: its axes stop (`StreamEnd`), their
     /// setpoints are no longer taken.
-    pub(super) fn stream_release(&mut self, mut ack: Ack, token: u64) -> Ack {
+    /// The answer (after the step) carries the `StreamEnd`s' operation ids:
+    /// a client follows those to see the axes at rest.
+    pub(super) fn stream_release(&mut self, ack: Ack, token: u64) -> Option<Ack> {
         let mask = self.stream.mask_of(token);
-        for i in named(mask, self.slots.len()) {
-            self.slots[i].rung.request.op = Some(Operation::StreamEnd);
-            ack.axes[i] = AxisAck::Accepted;
+        if mask == 0 {
+            return Some(ack);
         }
         self.stream.drop_axes(mask);
-        ack
+        self.op(ack, mask, Operation::StreamEnd, Then::Nothing)
     }
 
     /// After the step: every pending request's answer per axis (the
