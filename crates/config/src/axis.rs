@@ -22,7 +22,8 @@ pub(crate) fn parse(
         .has("home_order")
         .then(|| r.u32_in("home_order", 0, 0, 1000));
     let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
-    let engine = engine(&mut r, sup);
+    let mut engine = engine(&mut r, sup);
+    crate::operations::keys(&mut r, &mut engine);
     let ethercat = crate::ethercat::parse::axis_keys(&mut r, &engine, ios.get(io));
     let sim_table = r.table("sim");
     r.finish();

@@ -21,6 +21,7 @@ mod io;
 mod keys;
 pub mod limits;
 pub mod names;
+mod operations;
 mod problem;
 mod supervisor;
 

@@ -2,7 +2,7 @@
 //! configuration gives them: each key's "not set" (`0`) resolved to its
 //! default once, here, so the engine, `check` and the control plane agree.
 
-use crate::config::AxisConfig;
+use crate::config::{AxisConfig, AxisConfiguration, TravelMode};
 use crate::validate::effective_max_speed;
 
 /// `stream_timeout_ns` when not set: 50 ms (50 cycles at 1 kHz; a Python
@@ -78,6 +78,48 @@ impl OpLimits {
             stream_timeout_ns: effective_stream_timeout_ns(cfg),
         }
     }
+}
+
+/// What a controls engineer would want pointed out about the operations'
+/// bounds (legal, but probably not meant); `check` prints them beside
+/// [`advisories`](crate::validate::advisories).
+pub fn advisories(cfg: &AxisConfig) -> Vec<String> {
+    let l = OpLimits::new(cfg);
+    let mut out = Vec::new();
+    if cfg.configuration == AxisConfiguration::FeedbackOnly {
+        return out;
+    }
+    if l.max_speed.is_none() {
+        out.push(
+            "max_speed: none set and no homing speed to derive one: the setpoint stream is \
+             refused (ERR 13 / EXERR 1); jogs and moves are bounded by their own speed only"
+                .into(),
+        );
+    }
+    if l.max_deceleration == 0.0 {
+        out.push(
+            "max_deceleration: none set and no home_deceleration: jogs, moves and the stream \
+             are refused (ERR 13 / EXERR 3): nothing could stop them"
+                .into(),
+        );
+    }
+    if l.unhomed_speed == 0.0 {
+        out.push(
+            "unhomed_speed: none set and no home_speed: the axis cannot be jogged or moved \
+             before it is homed"
+                .into(),
+        );
+    } else if l.max_speed.is_some_and(|m| l.unhomed_speed > m) {
+        out.push(format!(
+            "unhomed_speed {} is above max_speed {}: max_speed applies",
+            l.unhomed_speed,
+            l.max_speed.unwrap_or(0.0)
+        ));
+    }
+    if cfg.travel == TravelMode::Cyclic && cfg.travel_limits.is_some() {
+        out.push("travel_limits: a cyclic axis has no software travel limits".into());
+    }
+    out
 }
 
 #[cfg(test)]

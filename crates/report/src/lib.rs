@@ -28,6 +28,7 @@ pub mod table;
 pub mod trace;
 
 pub use errors::{ErrorEntry, ErrorReport};
+pub use home::AxisOperationLimits;
 pub use home::{
     AcceptedReport, Allocations, AxisResult, CheckReport, CpuUse, CtlHomeReport, HomeReport,
     RtInfo, RunReport, StatsReport, TraceReport,
