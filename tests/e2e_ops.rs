@@ -224,7 +224,13 @@ fn ramp_csv(dir: &TempDir, name: &str, to: f64, secs: f64, hz: f64) -> String {
 #[test]
 fn a_stream_played_from_csv_ends_at_the_expected_position() {
     let _serial = serial();
-    let cfg = ops("ops_csv");
+    // A silence of the program longer than stream_timeout_ms stops the
+    // stream (its own test below); here, on a busy CI machine, motionctl
+    // may be descheduled for tens of ms: 500 ms keeps this test about the
+    // positions.
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_timeout_ms", 500)
+        .write("ops_csv");
     let d = Daemon::start(&cfg, &["io"]);
     // not homed: refused (ERR 1019 / EXERR 7 would be the engine's; the
     // acquire answers with the instruction's code)
@@ -355,7 +361,12 @@ fn stops_with(d: &Daemon, c: &mut Client, exerr: u16, bad: impl FnOnce(&mut Stre
 #[test]
 fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
     let _serial = serial();
-    let cfg = ops("ops_bad");
+    // stream_timeout_ms 300 (not 50): the test's own pauses (a status
+    // read, a descheduled thread) must not read as a silent program; the
+    // silence has its case below.
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_timeout_ms", 300)
+        .write("ops_bad");
     let d = Daemon::start(&cfg, &["io"]);
     ready(&d);
     let mut c = Client::connect(&cfg.prefix, None).expect("client");
@@ -369,7 +380,7 @@ fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
     stops_with(&d, &mut c, 3, |s, t, p| put(s, t + 1, p + 1.0));
     // silent: 1019 / 5
     stops_with(&d, &mut c, 5, |_, _, _| {
-        std::thread::sleep(Duration::from_millis(200))
+        std::thread::sleep(Duration::from_millis(600))
     });
     // out of order (a time not after the previous): 1019 / 6
     stops_with(&d, &mut c, 6, |s, t, p| put(s, t - 5, p));

@@ -21,13 +21,28 @@ use crate::request::{Axes, Request};
 const ANSWER: Duration = Duration::from_secs(3);
 
 /// A refused or failed operation.
-#[derive(Debug, thiserror::Error)]
+#[derive(thiserror::Error)]
 pub enum OpError {
     #[error(transparent)]
     Client(#[from] ClientError),
     /// The supervisor refused it (for at least one axis: see the answers).
     #[error("refused: {}", .0.message_text())]
     Refused(Box<ControlResponse>),
+}
+
+/// Short: the message and each refused axis, not the response's 36 KB.
+impl std::fmt::Debug for OpError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            OpError::Client(e) => write!(f, "Client({e:?})"),
+            OpError::Refused(r) => {
+                let axes: Vec<String> = (r.answers().iter())
+                    .map(|a| format!("{} {}/{}", get_str(&a.name), a.err, a.exerr))
+                    .collect();
+                write!(f, "Refused({:?}: {})", r.message_text(), axes.join(", "))
+            }
+        }
+    }
 }
 
 /// The response if accepted, else [`OpError::Refused`].
