@@ -20,8 +20,9 @@ What a program does to move axes (see README, "The setpoint stream"):
    time order, not older than stream_timeout_ms);
 5. give the axis back (REQ_STREAM_RELEASE): the stream ends, the axis stops.
 
-The sine starts and ends at the axis's position (p = p0 + A sin(2 pi f t)),
-so the first setpoint is where the axis stands. If this program dies, the
+The sine starts at the axis's position and at rest (p = p0 + A (1 - cos
+2 pi f t)): the first setpoint is where the axis stands, and no step of
+velocity exceeds the axis's stream_acceleration. If this program dies, the
 supervisor stops the axis: the setpoints stop (ERR 1019 / 5 after
 stream_timeout_ms) and the owner's node is gone (checked every 100 ms).
 
@@ -158,8 +159,8 @@ def main() -> int:
         seq += 1
         frame.seq = seq
         frame.t_ns = t0 + int(t * 1e9)
-        frame.axes[0].position = p0 + a.amplitude * math.sin(w * t)
-        frame.axes[0].velocity = a.amplitude * w * math.cos(w * t)
+        frame.axes[0].position = p0 + a.amplitude * (1.0 - math.cos(w * t))
+        frame.axes[0].velocity = a.amplitude * w * math.sin(w * t)
         publisher.send_copy(frame)
         if k % 10 == 0:
             st = sup.status().axes[index]

@@ -1,9 +1,12 @@
 //! The following error of the sim plant streaming a circle on two axes: a
-//! 1 kHz stream of `x = r (cos ωt − 1)`, `y = r sin ωt` (it starts where the
-//! axes stand, at rest), sampled from the 100 Hz status: per axis the
-//! following error (command − actual, the supervisor's own view: the
-//! actual position is the answer to the previous cycle's command), and the
-//! contour error (the actual point's distance from the circle − r).
+//! stream at the cycle rate of `x = r (cos θ − 1)`, `y = r sin θ` (it starts
+//! where the axes stand), θ run up from rest to ω over the first
+//! [`RAMP_S`] (a constant angular acceleration: the setpoints stay within
+//! the axes' stream_acceleration), sampled from the 100 Hz status once at
+//! speed: per axis the following error (command − actual, the supervisor's
+//! own view: the actual position is the answer to the previous cycle's
+//! command), and the contour error (the actual point's distance from the
+//! circle − r).
 
 use crate::latency::pct;
 use crate::rig::{self, Streamer};
@@ -13,6 +16,18 @@ use motion_bench::outcome::Bench;
 use motion_control::{Client, MS_COMMAND, MS_STREAMING, ST_FEEDBACK};
 use serde::Serialize;
 use std::time::{Duration, Instant};
+
+/// Seconds of the run-up to full angular speed (not measured).
+pub const RAMP_S: f64 = 1.0;
+
+/// θ at `t`: constant angular acceleration to `w` over [`RAMP_S`], then `w`.
+fn angle(t: f64, w: f64) -> f64 {
+    if t < RAMP_S {
+        w * t * t / (2.0 * RAMP_S)
+    } else {
+        w * (t - RAMP_S / 2.0)
+    }
+}
 
 /// What the circle measured.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -53,12 +68,13 @@ fn measure(o: &Opts, prefix: &str) -> Result<Circle, String> {
         period,
         (o.cycle.other_cpu(), o.client_priority),
         Box::new(move |k| {
-            let t = k as f64 * dt;
-            vec![r * ((w * t).cos() - 1.0), r * (w * t).sin()]
+            let a = angle(k as f64 * dt, w);
+            vec![r * (a.cos() - 1.0), r * a.sin()]
         }),
     );
     let mut c = Client::connect(prefix, None).map_err(|e| e.to_string())?;
     let (mut fe, mut contour) = ([Vec::new(), Vec::new()], Vec::new());
+    std::thread::sleep(Duration::from_secs_f64(RAMP_S + 0.1));
     let until = Instant::now() + Duration::from_secs_f64(o.seconds);
     let mut last = 0;
     while Instant::now() < until {
