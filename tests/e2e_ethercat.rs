@@ -352,6 +352,12 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
         .axis("S")
         .raw
         .is_some()));
+    // the axis faults (feedback lost in motion, the drives' own faults after
+    // their watchdog) need a reset before the next homing (issue 15)
+    d.ctl(&["reset", "S", "T"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || {
+        !d.axis("S").faulted && !d.axis("T").faulted
+    }));
     let v = home_again(&d, &["S", "T"]);
     let s = named(&v.axes, "S");
     // the first marker ahead of where the drive stopped, latched exactly
