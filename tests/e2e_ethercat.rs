@@ -280,7 +280,14 @@ fn drive_fault_mid_homing_aborts_with_the_drive_error_code_kept() {
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(d.axis("S").drive_error_code, 0x2310);
 
-    // homing again: the enable handshake resets the fault, and it homes
+    // a drive fault needs a reset before the next homing (issue 15, as
+    // Logix: MAH on a faulted axis is ERR 20): refused, then reset (MAFR:
+    // CiA 402 control word bit 7), then it homes
+    let r = d.ctl(&["home", "S", "--no-wait", "--json"]);
+    r.expect_code(1);
+    assert!(r.stdout.contains("\"err\":20"), "{}", r.stdout);
+    d.ctl(&["reset", "S"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || !d.axis("S").faulted));
     let r = home_again(&d, &["S"]);
     // sampled switch at 1 u/s: ± one cycle of travel
     assert_close!(named(&r.axes, "S"), event_raw, 0.0, 0.001 + COUNT);
@@ -345,6 +352,12 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
         .axis("S")
         .raw
         .is_some()));
+    // the axis faults (feedback lost in motion, the drives' own faults after
+    // their watchdog) need a reset before the next homing (issue 15)
+    d.ctl(&["reset", "S", "T"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || {
+        !d.axis("S").faulted && !d.axis("T").faulted
+    }));
     let v = home_again(&d, &["S", "T"]);
     let s = named(&v.axes, "S");
     // the first marker ahead of where the drive stopped, latched exactly

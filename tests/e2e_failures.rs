@@ -157,6 +157,21 @@ fn check_accepts_the_default_machine() {
         "{}",
         run.stdout
     );
+    // The operations' bounds of every axis, defaults resolved (issue 15).
+    assert!(
+        run.stdout.contains(
+            "axis X: operations: soft limits [-100, 100] while homed, max_speed 40, \
+             unhomed_speed 20, max_deceleration 500, limit switches"
+        ),
+        "{}",
+        run.stdout
+    );
+    let json = supervisor(&["check", "--json"]);
+    json.expect_code(0);
+    let v: motion_report::CheckReport = serde_json::from_str(&json.stdout).unwrap();
+    let z = v.operations.iter().find(|a| a.axis == "Z").unwrap();
+    assert_eq!((z.max_deceleration, z.stream_timeout_ms), (200.0, 50.0));
+    assert!(!v.operations.iter().find(|a| a.axis == "U").unwrap().movable);
 }
 
 #[test]

@@ -61,3 +61,17 @@ pub fn cpu(s: &str) -> Result<usize, String> {
 /// that leaves 19. Defined once, here, where the user's value is checked
 /// first; `motion-ipc` checks it again when it creates the directory.
 pub const RUNTIME_DIR_MAX: usize = 19;
+
+/// A position, distance, speed or acceleration of an operation (`motionctl
+/// jog`, `move`): a finite number of at most 1e9 in magnitude (the axis's
+/// own bounds — `max_speed`, `travel_limits`, ... — are the supervisor's to
+/// judge, with the instruction's error codes).
+pub fn number(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x.abs() <= 1e9 => Ok(x),
+        _ => Err(format!(
+            "{} is not a finite number in [-1e9, 1e9]",
+            names::shown(s)
+        )),
+    }
+}

@@ -79,6 +79,34 @@ impl<'a> Reader<'a> {
         x
     }
 
+    /// A number in `(0, hi]` when present; 0 when absent (the caller's
+    /// "default"). Zero given is a problem that says what leaving the key
+    /// out means (`default`); anything else outside is `f64_in`'s problem.
+    pub fn f64_positive(&mut self, key: &str, hi: f64, unit: &str, default: &str) -> f64 {
+        let present = self.table.contains_key(key);
+        let x = self.f64(key, 0.0);
+        if present && x == 0.0 {
+            self.problem(
+                key,
+                format!("must be above 0 {unit} (leave it out for the default: {default})"),
+            );
+            return 0.0;
+        }
+        if present && !(x.is_finite() && x > 0.0 && x <= hi) {
+            let what = if x.is_finite() {
+                "is outside"
+            } else {
+                "is not a finite number; allowed:"
+            };
+            self.problem(
+                key,
+                format!("{} {what} 0 (excluded)..={} {unit}", num(x), num(hi)),
+            );
+            return 0.0;
+        }
+        x
+    }
+
     /// `[lo, hi]` of two finite numbers within ±`bound`, `lo < hi`.
     pub fn interval(&mut self, key: &str, bound: f64) -> Option<(f64, f64)> {
         let (a, b) = self.pair(key)?;

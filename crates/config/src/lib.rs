@@ -22,6 +22,7 @@ mod keys;
 pub mod limits;
 pub mod names;
 pub mod opcua;
+mod operations;
 mod problem;
 mod supervisor;
 

@@ -33,6 +33,9 @@ pub const SHORT_TIME_S: f64 = 60.0;
 pub const FEEDBACK_TIMEOUT_MS: (f64, f64) = (1.0, 1000.0);
 /// The I/O process's command watchdog, ms of cycles: at most a second.
 pub const WATCHDOG_MS: f64 = 1000.0;
+/// A silent setpoint stream stops its axes after this long, ms: at least a
+/// millisecond, at most a second (longer is no supervision).
+pub const STREAM_TIMEOUT_MS: (f64, f64) = (1.0, 1000.0);
 
 /// EtherCAT: SM watchdog of the drives, ms (and at least 3 cycles).
 pub const SM_WATCHDOG_MS: (u32, u32) = (1, 1000);
@@ -117,4 +120,12 @@ pub const TABLE: &[Range] = &[
     ),
     ("ethercat_position", 0.0, 65_535.0, "bus position"),
     ("ethercat_index_pulse_bit", 16.0, 31.0, "bit of 0x60FD"),
+    ("unhomed_speed (above 0)", 0.0, SPEED, "units/s"),
+    (
+        "max_deceleration, stream_acceleration (above 0)",
+        0.0,
+        ACCELERATION,
+        "units/s²",
+    ),
+    ("stream_timeout_ms", 1.0, 1000.0, "ms"),
 ];

@@ -549,3 +549,65 @@ fn the_readme_prints_every_range() {
         );
     }
 }
+
+/// Issue 15's axis keys: parsed, defaults left to the engine (0), every
+/// mistake named by axis and key.
+#[test]
+fn the_keys_of_the_operations() {
+    let base = r#"
+[[axis]]
+name = "X"
+home_sequence = "immediate"
+home_speed = 20.0
+home_acceleration = 400.0
+home_deceleration = 500.0
+"#;
+    let m = parse(base).unwrap_or_else(|p| panic!("{p:#?}"));
+    let e = &m.axes[0].engine;
+    assert_eq!(
+        (e.unhomed_speed, e.max_deceleration, e.stream_acceleration),
+        (0.0, 0.0, 0.0),
+        "left out: the engine's defaults"
+    );
+    assert!(e.limit_switches && !e.stream_unhomed);
+    assert_eq!(e.stream_timeout_ns, 50_000_000);
+    let l = motion_homing::OpLimits::new(e);
+    assert_eq!((l.unhomed_speed, l.max_deceleration), (20.0, 500.0));
+    assert_eq!(l.stream_acceleration, 4000.0);
+
+    let set = format!(
+        "{base}unhomed_speed = 5\nlimit_switches = false\nmax_deceleration = 2000.0\n\
+         stream_acceleration = 1e4\nstream_timeout_ms = 20\nstream_unhomed = true\n"
+    );
+    let m = parse(&set).unwrap_or_else(|p| panic!("{p:#?}"));
+    let e = &m.axes[0].engine;
+    assert_eq!(e.unhomed_speed, 5.0);
+    assert!(!e.limit_switches && e.stream_unhomed);
+    assert_eq!((e.max_deceleration, e.stream_acceleration), (2000.0, 1e4));
+    assert_eq!(e.stream_timeout_ns, 20_000_000);
+
+    let bad = format!(
+        "{base}unhomed_speed = 0\nlimit_switches = 1\nmax_deceleration = -1.0\n\
+         stream_acceleration = nan\nstream_timeout_ms = 5000\nstream_unhomed = \"yes\"\n"
+    );
+    let lines: Vec<String> = parse(&bad)
+        .unwrap_err()
+        .iter()
+        .map(|p| p.to_string())
+        .collect();
+    for want in [
+        "axis X: unhomed_speed: must be above 0 units/s (leave it out for the default: home_speed (20))",
+        "axis X: limit_switches: expected true or false, found integer",
+        "axis X: max_deceleration: -1 is outside 0 (excluded)..=1000000000 units/s²",
+        "axis X: stream_acceleration: NaN is not a finite number",
+        "axis X: stream_timeout_ms: 5000 is outside 1..=1000 ms",
+        "axis X: stream_unhomed: expected true or false, found string",
+    ] {
+        assert!(
+            lines.iter().any(|l| l.starts_with(want)),
+            "missing {want:?} in\n{}",
+            lines.join("\n")
+        );
+    }
+    assert_eq!(lines.len(), 6, "{lines:#?}");
+}

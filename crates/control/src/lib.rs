@@ -12,6 +12,10 @@
 //!   [`Reason`]); the `REASON_*`/`RESULT_*` numbers are written there.
 //! * [`client`] — what `motionctl` (and any Rust HMI) uses: join the
 //!   supervisor's domain through its session file, send requests, read status.
+//! * [`ops`] — enable, disable, reset, move and the hold-to-run [`Jog`]
+//!   for Rust clients; [`stream`] — the supervised setpoint stream's
+//!   [`stream::Stream`] handle and the acquire answer's axis map;
+//!   [`follow`] — following operations to their end in the status.
 //! * [`server`] — the daemon's side: serve requests and publish status, off
 //!   the real-time thread.
 //!
@@ -21,16 +25,21 @@
 //! joined.
 
 pub mod client;
+pub mod follow;
 pub mod homing;
 pub mod message;
+mod names;
+pub mod ops;
 pub mod progress;
 pub mod report;
 pub mod request;
 pub mod response;
 pub mod server;
+pub mod stream;
 
 pub use client::{Client, ClientError};
 pub use message::*;
+pub use ops::{Jog, JogSpec, MoveSpec, OpError};
 pub use request::{Axes, DecodeError, Request, Since};
 pub use response::{AxisOutcome, Reason};
 pub use server::{Server, ServerError};

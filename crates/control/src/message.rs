@@ -12,7 +12,7 @@
 use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
 
 /// Layout version of every type in this file. Bump it on ANY change.
-pub const CONTROL_LAYOUT: u32 = 2;
+pub const CONTROL_LAYOUT: u32 = 3;
 
 /// Bytes of a name (axis, I/O process).
 pub const NAME_LEN: usize = 32;
@@ -26,6 +26,8 @@ pub const MESSAGE_LEN: usize = 256;
 pub const DATA_LEN: usize = 32 * 1024;
 /// Bytes of a phase name.
 pub const PHASE_LEN: usize = 16;
+/// `AxisAnswer::index` of a name that is no axis.
+pub const NO_INDEX: u16 = u16::MAX;
 
 // ---- request kinds ----------------------------------------------------
 /// Home the named axes (all: every axis, in home order).
@@ -44,6 +46,36 @@ pub const REQ_TRACE: u32 = 6;
 pub const REQ_TRACE_FETCH: u32 = 7;
 /// The latency histograms as an HdrHistogram log in `data`, paged.
 pub const REQ_HLOG: u32 = 8;
+/// MSO: enable the drives of the named axes (all: every axis), holding
+/// position.
+pub const REQ_ENABLE: u32 = 9;
+/// MSF: disable the drives of the named axes (all: every axis); a moving
+/// axis is stopped first.
+pub const REQ_DISABLE: u32 = 10;
+/// MAFR: clear the axis fault of the named axes (all: every axis) and ask
+/// their drives for a fault reset. Never enables, never moves.
+pub const REQ_RESET: u32 = 11;
+/// MAJ, hold to run: jog the one named axis (or gantry) at `speed` (its sign
+/// is the direction) with `accel`/`decel`, for as long as the client renews
+/// the lease (`lease_ms`, 50..=5000) with [`REQ_JOG_RENEW`]. The answer's
+/// `token` names this jog.
+pub const REQ_JOG: u32 = 12;
+/// Renew the lease of the jog `token` on the named axes (none: wherever
+/// that jog runs).
+pub const REQ_JOG_RENEW: u32 = 13;
+/// MAM: a trapezoidal move of the named axes (or gantry) to `position` (with
+/// [`FLAG_RELATIVE`]: by `position`) at `speed`, `accel`, `decel`.
+pub const REQ_MOVE: u32 = 14;
+/// Take the named axes over for the supervised setpoint stream: `owner`
+/// names the program, `node_id` its iceoryx2 node (the one that publishes;
+/// the supervisor releases the axes when it is gone). The answer's `token`
+/// is the owner token every setpoint frame must carry, and its `data` maps
+/// each requested name to the axis index setpoints address (JSON, see
+/// `crates/control/src/stream.rs`).
+pub const REQ_STREAM_ACQUIRE: u32 = 15;
+/// Give the axes of owner `token` back: the stream ends normally (the axes
+/// stop, nothing else).
+pub const REQ_STREAM_RELEASE: u32 = 16;
 
 // ---- request flags ----------------------------------------------------
 /// `REQ_STATS`: reset the "since reset" statistics after answering.
@@ -52,6 +84,14 @@ pub const FLAG_RESET: u32 = 1 << 0;
 pub const FLAG_SINCE_RESET: u32 = 1 << 1;
 /// `REQ_HOME`: start every named axis at once, ignoring the home order.
 pub const FLAG_PARALLEL: u32 = 1 << 2;
+/// `REQ_MOVE`: `position` is a distance from where the move starts.
+pub const FLAG_RELATIVE: u32 = 1 << 3;
+/// `REQ_MOVE`: replace a running jog or move (without it, ERR 3 Execution
+/// Collision). (A jog replaces a running jog by itself and never a move.)
+pub const FLAG_SUPERSEDE: u32 = 1 << 4;
+/// `REQ_JOG_RENEW`: end the jog now instead (a stop of this jog only: if
+/// it no longer runs, nothing is stopped).
+pub const FLAG_END: u32 = 1 << 5;
 
 // ---- results ------------------------------------------------------------
 /// Done / accepted for every addressed axis.
@@ -83,6 +123,14 @@ pub const REASON_EXITING: u8 = 5;
 pub const REASON_GANTRY: u8 = 6;
 /// Another home sequence is running on this axis.
 pub const REASON_BUSY: u8 = 7;
+/// A program owns the axis (setpoint stream): ERR 3 Execution Collision.
+pub const REASON_OWNED: u8 = 8;
+/// The token names no jog or stream of this axis (renew, release).
+pub const REASON_TOKEN: u8 = 9;
+/// The operation's instruction refuses: `err`/`exerr` say why (Logix
+/// motion error codes: 5 servo off, 13 parameter out of range, 16 home in
+/// process, 20 axis faulted, ...).
+pub const REASON_OPERATION: u8 = 10;
 
 /// Words for a refusal reason.
 pub fn reason_text(reason: u8) -> &'static str {
@@ -95,15 +143,22 @@ pub fn reason_text(reason: u8) -> &'static str {
         REASON_EXITING => "the supervisor is shutting down",
         REASON_GANTRY => "part of a gantry: name every side",
         REASON_BUSY => "another home sequence is running on it",
+        REASON_OWNED => "a program owns it (setpoint stream)",
+        REASON_TOKEN => "no jog or stream of this token runs on it",
+        REASON_OPERATION => "refused by the instruction",
         _ => "refused",
     }
 }
 
 /// A request to the control service. Zero it, set `kind`, `flags`, the axes
 /// and `offset`; the client sets `layout_version`, `key` and `request_id`.
+/// The operation parameters (`position` .. `owner`) are read only by the
+/// kinds that name them; an `f64` parameter that is NaN means "the axis's
+/// default" (`speed`: `home_speed`, `accel`: `home_acceleration`, `decel`:
+/// `home_deceleration`; a jog's `speed` and a move's `position` have none).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::ControlRequest@2")]
+#[type_name("motion_control::ControlRequest@3")]
 pub struct ControlRequest {
     pub layout_version: u32,
     /// `REQ_*`.
@@ -121,6 +176,29 @@ pub struct ControlRequest {
     /// Optional: seconds `REQ_HOME` may take before the axes are stopped
     /// (0 = the axes' own `home_timeout` only).
     pub timeout_s: f64,
+    /// `REQ_MOVE`: target in axis coordinates, units (with `FLAG_RELATIVE`:
+    /// the distance).
+    pub position: f64,
+    /// `REQ_JOG`: signed speed (the sign is the direction); `REQ_MOVE`: the
+    /// speed's magnitude; units/s. NaN (move): `home_speed`.
+    pub speed: f64,
+    /// `REQ_JOG`, `REQ_MOVE`: acceleration and deceleration, units/s²;
+    /// NaN: `home_acceleration` / `home_deceleration`.
+    pub accel: f64,
+    pub decel: f64,
+    /// `REQ_JOG_RENEW`: the jog's token (from the `REQ_JOG` answer);
+    /// `REQ_STREAM_RELEASE`: the owner token.
+    pub token: u64,
+    /// `REQ_STREAM_ACQUIRE`: the publishing program's iceoryx2 node id
+    /// (`UniqueNodeId::value()`, a u128): `[low 64 bits, high 64 bits]`.
+    pub node_id: [u64; 2],
+    /// `REQ_JOG`: the hold-to-run lease, ms (50..=5000): the jog stops when
+    /// no renewal came for this long.
+    pub lease_ms: u32,
+    pub reserved: u32,
+    /// `REQ_STREAM_ACQUIRE`: the program's name (shown in the status as the
+    /// axes' owner), UTF-8, NUL-padded.
+    pub owner: [u8; NAME_LEN],
     pub axes: [[u8; NAME_LEN]; MAX_AXES],
 }
 
@@ -133,16 +211,23 @@ pub struct AxisAnswer {
     pub accepted: u8,
     /// `REASON_*` when refused.
     pub reason: u8,
-    /// The Home instruction's ERR / EXERR, where it has one.
+    /// The instruction's ERR / EXERR, where it has one.
     pub err: u16,
     pub exerr: u16,
-    pub reserved: [u8; 2],
+    /// The axis's index in the configuration (config order, from 0: what a
+    /// setpoint frame addresses); [`NO_INDEX`] for a name that is no axis.
+    pub index: u16,
+    /// The operation id the engine gave an accepted jog, move, enable,
+    /// disable, reset or stream (the status's `op_id` shows it while it
+    /// runs and how it ended); 0 otherwise.
+    pub op_id: u32,
+    pub reserved: u32,
 }
 
 /// The answer to a [`ControlRequest`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::ControlResponse@2")]
+#[type_name("motion_control::ControlResponse@3")]
 pub struct ControlResponse {
     pub layout_version: u32,
     /// The request's kind.
@@ -162,6 +247,10 @@ pub struct ControlResponse {
     /// The real-time cycle in which the request took effect (home, stop,
     /// unhome, trace): status frames of this cycle or later show its effect.
     pub cycle: u64,
+    /// `REQ_JOG`: the jog's token (for `REQ_JOG_RENEW`);
+    /// `REQ_STREAM_ACQUIRE`: the owner token (for every setpoint frame and
+    /// `REQ_STREAM_RELEASE`); random, never 0 when accepted.
+    pub token: u64,
     /// Why, in words (UTF-8), when refused or bad.
     pub message: [u8; MESSAGE_LEN],
     pub axes: [AxisAnswer; MAX_AXES],
@@ -196,6 +285,31 @@ pub const ST_EVENT: u16 = 1 << 12;
 pub const ST_STOPPING: u16 = 1 << 13;
 /// A trace of the next homing is armed or recording.
 pub const ST_TRACE: u16 = 1 << 14;
+
+/// `AxisStatusEntry::motion`: ServoActionStatus (enable requested and the
+/// drive reports enabled).
+pub const MS_SERVO_ACTION: u16 = 1 << 0;
+/// JogStatus.
+pub const MS_JOGGING: u16 = 1 << 1;
+/// MoveStatus.
+pub const MS_MOVING: u16 = 1 << 2;
+/// A setpoint stream commands the axis.
+pub const MS_STREAMING: u16 = 1 << 3;
+/// The negative / positive hardware overtravel limit switch is tripped.
+pub const MS_LIMIT_NEGATIVE: u16 = 1 << 4;
+pub const MS_LIMIT_POSITIVE: u16 = 1 << 5;
+/// An axis fault is present (ER set by a drive fault, a limit switch, a
+/// refused setpoint, lost feedback): only `reset` clears it.
+pub const MS_FAULTED: u16 = 1 << 6;
+/// `cmd_position` is valid.
+pub const MS_COMMAND: u16 = 1 << 7;
+
+/// `AxisStatusEntry::op_flags`: the last operation is in process.
+pub const OP_IP: u8 = 1 << 0;
+/// ... ended as asked (MAM: at its target; a jog or stream: ended normally).
+pub const OP_PC: u8 = 1 << 1;
+/// ... was refused (`op_err` / `op_exerr` say why).
+pub const OP_REFUSED: u8 = 1 << 2;
 
 /// `AxisStatusEntry::aborted_by` when no other axis aborted it.
 pub const NO_AXIS: u8 = 0xff;
@@ -285,6 +399,25 @@ pub struct AxisStatusEntry {
     /// Switch then marker: the distance from the switch edge to the marker
     /// of the last homing, units; NaN otherwise.
     pub switch_to_marker: f64,
+    /// The position commanded this cycle, axis coordinates, units (valid
+    /// with `MS_COMMAND`): with `position`, the following error.
+    pub cmd_position: f64,
+    /// The last operation (enable, disable, reset, jog, move, stream, stop):
+    /// its id, the ERR / EXERR of a refusal, its kind (`OpKind` number).
+    pub op_id: u32,
+    pub op_err: u16,
+    pub op_exerr: u16,
+    /// `MS_*`.
+    pub motion: u16,
+    pub op_kind: u8,
+    /// `OP_*`.
+    pub op_flags: u8,
+    /// Why the last motion stopped (`StopCause` number, 0 none).
+    pub last_stop: u8,
+    pub reserved2: [u8; 3],
+    /// The program that owns the axis (setpoint stream), NUL-padded; empty:
+    /// none.
+    pub owner: [u8; NAME_LEN],
 }
 
 /// One I/O process of the status frame.
@@ -308,10 +441,33 @@ pub struct IoStatusEntry {
     pub gap_cycles: u64,
 }
 
+/// The setpoint stream's intake as the status frame shows it: frames taken,
+/// and refused by why (counted since start).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, ZeroCopySend, PlacementDefault)]
+pub struct StreamStatusEntry {
+    /// Frames that reached the intake's checks.
+    pub frames: u64,
+    /// Setpoints handed to engines.
+    pub setpoints: u64,
+    /// Refused: another layout, without the session key, too many entries,
+    /// a token owning none of the axes, a sequence number not above the
+    /// last, an entry for an axis the token does not own.
+    pub refused_layout: u64,
+    pub refused_key: u64,
+    pub refused_count: u64,
+    pub refused_token: u64,
+    pub refused_sequence: u64,
+    pub refused_axis: u64,
+    /// Streams granted since start, and running now.
+    pub acquired: u32,
+    pub owners: u32,
+}
+
 /// The status service's frame, published at 100 Hz.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::StatusFrame@2")]
+#[type_name("motion_control::StatusFrame@3")]
 pub struct StatusFrame {
     pub layout_version: u32,
     /// The supervisor's session id.
@@ -328,6 +484,7 @@ pub struct StatusFrame {
     pub reserved: u32,
     pub axes: [AxisStatusEntry; MAX_AXES],
     pub ios: [IoStatusEntry; MAX_IOS],
+    pub stream: StreamStatusEntry,
 }
 
 macro_rules! zeroed {
@@ -419,29 +576,46 @@ impl StatusFrame {
 const _: () = {
     use core::mem::{align_of, offset_of, size_of};
     assert!(
-        CONTROL_LAYOUT == 2,
+        CONTROL_LAYOUT == 3,
         "update the layout asserts together with CONTROL_LAYOUT"
     );
-    assert!(size_of::<ControlRequest>() == 56 + MAX_AXES * NAME_LEN);
+    assert!(size_of::<ControlRequest>() == 152 + MAX_AXES * NAME_LEN);
     assert!(offset_of!(ControlRequest, key) == 8);
     assert!(offset_of!(ControlRequest, request_id) == 24);
     assert!(offset_of!(ControlRequest, offset) == 40);
     assert!(offset_of!(ControlRequest, timeout_s) == 48);
-    assert!(offset_of!(ControlRequest, axes) == 56);
+    assert!(offset_of!(ControlRequest, position) == 56);
+    assert!(offset_of!(ControlRequest, speed) == 64);
+    assert!(offset_of!(ControlRequest, accel) == 72);
+    assert!(offset_of!(ControlRequest, decel) == 80);
+    assert!(offset_of!(ControlRequest, token) == 88);
+    assert!(offset_of!(ControlRequest, node_id) == 96);
+    assert!(offset_of!(ControlRequest, lease_ms) == 112);
+    assert!(offset_of!(ControlRequest, owner) == 120);
+    assert!(offset_of!(ControlRequest, axes) == 152);
     assert!(align_of::<ControlRequest>() == 8);
 
-    assert!(size_of::<AxisAnswer>() == 40);
+    assert!(size_of::<AxisAnswer>() == 48);
     assert!(offset_of!(AxisAnswer, err) == 34);
+    assert!(offset_of!(AxisAnswer, index) == 38);
+    assert!(offset_of!(AxisAnswer, op_id) == 40);
 
     assert!(offset_of!(ControlResponse, request_id) == 16);
     assert!(offset_of!(ControlResponse, offset) == 32);
     assert!(offset_of!(ControlResponse, cycle) == 48);
-    assert!(offset_of!(ControlResponse, message) == 56);
-    assert!(offset_of!(ControlResponse, axes) == 56 + MESSAGE_LEN);
-    assert!(offset_of!(ControlResponse, data) == 56 + MESSAGE_LEN + 40 * MAX_AXES);
-    assert!(size_of::<ControlResponse>() == 56 + MESSAGE_LEN + 40 * MAX_AXES + DATA_LEN);
+    assert!(offset_of!(ControlResponse, token) == 56);
+    assert!(offset_of!(ControlResponse, message) == 64);
+    assert!(offset_of!(ControlResponse, axes) == 64 + MESSAGE_LEN);
+    assert!(offset_of!(ControlResponse, data) == 64 + MESSAGE_LEN + 48 * MAX_AXES);
+    assert!(size_of::<ControlResponse>() == 64 + MESSAGE_LEN + 48 * MAX_AXES + DATA_LEN);
 
-    assert!(size_of::<AxisStatusEntry>() == 176);
+    assert!(size_of::<AxisStatusEntry>() == 232);
+    assert!(offset_of!(AxisStatusEntry, cmd_position) == 176);
+    assert!(offset_of!(AxisStatusEntry, op_id) == 184);
+    assert!(offset_of!(AxisStatusEntry, motion) == 192);
+    assert!(offset_of!(AxisStatusEntry, op_kind) == 194);
+    assert!(offset_of!(AxisStatusEntry, last_stop) == 196);
+    assert!(offset_of!(AxisStatusEntry, owner) == 200);
     assert!(offset_of!(AxisStatusEntry, io) == 48);
     assert!(offset_of!(AxisStatusEntry, bits) == 50);
     assert!(offset_of!(AxisStatusEntry, drive_error_code) == 56);
@@ -455,9 +629,13 @@ const _: () = {
     assert!(offset_of!(IoStatusEntry, gaps) == 72);
     assert!(offset_of!(IoStatusEntry, gap_cycles) == 112);
 
+    assert!(size_of::<StreamStatusEntry>() == 72);
+    assert!(offset_of!(StreamStatusEntry, acquired) == 64);
+
     assert!(offset_of!(StatusFrame, axes) == 48);
-    assert!(offset_of!(StatusFrame, ios) == 48 + 176 * MAX_AXES);
-    assert!(size_of::<StatusFrame>() == 48 + 176 * MAX_AXES + 120 * MAX_IOS);
+    assert!(offset_of!(StatusFrame, ios) == 48 + 232 * MAX_AXES);
+    assert!(offset_of!(StatusFrame, stream) == 48 + 232 * MAX_AXES + 120 * MAX_IOS);
+    assert!(size_of::<StatusFrame>() == 48 + 232 * MAX_AXES + 120 * MAX_IOS + 72);
 };
 
 #[cfg(test)]

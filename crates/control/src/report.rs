@@ -5,7 +5,9 @@
 
 use crate::message::*;
 use motion_homing::{HomeDirection, HomeMode, HomeSequence};
-use motion_report::{AxisResult, AxisStatus, ErrorEntry, GapCounts, IoStatus, StatusReport};
+use motion_report::{
+    AxisResult, AxisStatus, ErrorEntry, GapCounts, IoStatus, OpReport, StatusReport, StreamIntake,
+};
 
 impl AxisAnswer {
     /// A refused axis as an error entry: its name, the Home instruction's
@@ -16,7 +18,15 @@ impl AxisAnswer {
             key: None,
             err: (self.err != 0).then_some(self.err),
             exerr: (self.err != 0).then_some(self.exerr),
-            message: reason_text(self.reason).into(),
+            message: if matches!(self.reason, REASON_OPERATION | REASON_OWNED) && self.err != 0 {
+                format!(
+                    "{}: {}",
+                    reason_text(self.reason),
+                    motion_report::codes::explain(self.err, self.exerr)
+                )
+            } else {
+                reason_text(self.reason).into()
+            },
         }
     }
 }
@@ -226,6 +236,7 @@ impl StatusFrame {
                         restored: a.extra & SX_RESTORED != 0,
                         error: a.error_text(&names),
                         warnings: a.warning_texts(),
+                        ..a.motion_report()
                     }
                 })
                 .collect(),
@@ -249,6 +260,60 @@ impl StatusFrame {
                     gap_cycles: i.gap_cycles,
                 })
                 .collect(),
+            stream: self.stream.to_report(),
+        }
+    }
+}
+
+impl StreamStatusEntry {
+    /// The intake part of `status --json`.
+    pub fn to_report(&self) -> StreamIntake {
+        StreamIntake {
+            frames: self.frames,
+            setpoints: self.setpoints,
+            refused_layout: self.refused_layout,
+            refused_key: self.refused_key,
+            refused_count: self.refused_count,
+            refused_token: self.refused_token,
+            refused_sequence: self.refused_sequence,
+            refused_axis: self.refused_axis,
+            acquired: self.acquired,
+            owners: self.owners,
+        }
+    }
+}
+
+impl AxisStatusEntry {
+    pub fn motion_has(&self, bit: u16) -> bool {
+        self.motion & bit != 0
+    }
+
+    /// The operation fields of `status --json` (the rest default).
+    fn motion_report(&self) -> AxisStatus {
+        let owner = get_str(&self.owner);
+        AxisStatus {
+            servo_action: self.motion_has(MS_SERVO_ACTION),
+            jogging: self.motion_has(MS_JOGGING),
+            moving: self.motion_has(MS_MOVING),
+            streaming: self.motion_has(MS_STREAMING),
+            stopping: self.has(ST_STOPPING),
+            limit_negative: self.motion_has(MS_LIMIT_NEGATIVE),
+            limit_positive: self.motion_has(MS_LIMIT_POSITIVE),
+            faulted: self.motion_has(MS_FAULTED),
+            owner: (!owner.is_empty()).then_some(owner),
+            op: OpReport {
+                id: self.op_id,
+                kind: crate::names::op_kind(self.op_kind).into(),
+                ip: self.op_flags & OP_IP != 0,
+                pc: self.op_flags & OP_PC != 0,
+                err: self.op_err,
+                exerr: self.op_exerr,
+            },
+            last_stop: crate::names::stop_cause(self.last_stop).into(),
+            command: r6((self.motion_has(MS_COMMAND))
+                .then_some(self.cmd_position)
+                .and_then(finite)),
+            ..AxisStatus::default()
         }
     }
 }

@@ -76,6 +76,47 @@ pub enum Request {
     TraceFetch { axis: Option<String>, offset: u64 },
     /// The latency histograms as an HdrHistogram log, a page from `offset`.
     Hlog { since: Since, offset: u64 },
+    /// MSO: enable the drives of `axes`, holding position.
+    Enable { axes: Axes },
+    /// MSF: disable the drives of `axes` (a moving axis is stopped first).
+    Disable { axes: Axes },
+    /// MAFR: clear the axis faults of `axes`, ask their drives for a fault
+    /// reset.
+    Reset { axes: Axes },
+    /// MAJ, hold to run: jog `axes` (one axis or one gantry) at `speed`
+    /// (signed) while the lease is renewed; `accel`/`decel` `None`: the
+    /// axis's homing ones. (A jog replaces a running jog; on a moving axis
+    /// it is refused, ERR 3: nothing supersedes a move but another move.)
+    Jog {
+        axes: Axes,
+        speed: f64,
+        accel: Option<f64>,
+        decel: Option<f64>,
+        lease_ms: u32,
+    },
+    /// Renew the lease of jog `token` (on `axes`; none: wherever it runs);
+    /// `end`: end that jog now instead.
+    JogRenew { axes: Axes, token: u64, end: bool },
+    /// MAM: move `axes` to `position` (`relative`: by it); `None`: the
+    /// axis's homing speed, acceleration, deceleration.
+    Move {
+        axes: Axes,
+        position: f64,
+        relative: bool,
+        speed: Option<f64>,
+        accel: Option<f64>,
+        decel: Option<f64>,
+        supersede: bool,
+    },
+    /// Take `axes` over for the setpoint stream of program `owner`, whose
+    /// publishing iceoryx2 node is `node_id`.
+    StreamAcquire {
+        axes: Axes,
+        owner: String,
+        node_id: u128,
+    },
+    /// End the stream of owner `token`.
+    StreamRelease { token: u64 },
 }
 
 /// A request the supervisor cannot take as it is.
@@ -87,6 +128,16 @@ pub enum DecodeError {
 
 /// Longest `timeout_s` taken (a day); longer ones are cut to it.
 const TIMEOUT_MAX_S: f64 = 86_400.0;
+
+/// NaN on the wire: "the axis's default".
+fn param(x: f64) -> Option<f64> {
+    (!x.is_nan()).then_some(x)
+}
+
+/// A parameter for the wire: `None` is NaN.
+fn wire(x: Option<f64>) -> f64 {
+    x.unwrap_or(f64::NAN)
+}
 
 impl Request {
     /// The request a message carries (its layout and key were checked by
@@ -123,6 +174,36 @@ impl Request {
                 since,
                 offset: m.offset,
             },
+            REQ_ENABLE => Request::Enable { axes: axes() },
+            REQ_DISABLE => Request::Disable { axes: axes() },
+            REQ_RESET => Request::Reset { axes: axes() },
+            REQ_JOG => Request::Jog {
+                axes: axes(),
+                speed: m.speed,
+                accel: param(m.accel),
+                decel: param(m.decel),
+                lease_ms: m.lease_ms,
+            },
+            REQ_JOG_RENEW => Request::JogRenew {
+                axes: axes(),
+                token: m.token,
+                end: m.flags & FLAG_END != 0,
+            },
+            REQ_MOVE => Request::Move {
+                axes: axes(),
+                position: m.position,
+                relative: m.flags & FLAG_RELATIVE != 0,
+                speed: param(m.speed),
+                accel: param(m.accel),
+                decel: param(m.decel),
+                supersede: m.flags & FLAG_SUPERSEDE != 0,
+            },
+            REQ_STREAM_ACQUIRE => Request::StreamAcquire {
+                axes: axes(),
+                owner: get_str(&m.owner),
+                node_id: u128::from(m.node_id[0]) | u128::from(m.node_id[1]) << 64,
+            },
+            REQ_STREAM_RELEASE => Request::StreamRelease { token: m.token },
             k => return Err(DecodeError::UnknownKind(k)),
         })
     }
@@ -184,6 +265,80 @@ impl Request {
                 m.offset = *offset;
                 &[]
             }
+            Request::Enable { axes } => {
+                m.kind = REQ_ENABLE;
+                axes.names()
+            }
+            Request::Disable { axes } => {
+                m.kind = REQ_DISABLE;
+                axes.names()
+            }
+            Request::Reset { axes } => {
+                m.kind = REQ_RESET;
+                axes.names()
+            }
+            Request::Jog { .. } | Request::Move { .. } => return self.encode_motion(m),
+            Request::JogRenew { axes, token, end } => {
+                m.kind = REQ_JOG_RENEW;
+                m.token = *token;
+                m.flags = if *end { FLAG_END } else { 0 };
+                axes.names()
+            }
+            Request::StreamAcquire {
+                axes,
+                owner,
+                node_id,
+            } => {
+                if owner.len() > NAME_LEN {
+                    return None;
+                }
+                m.kind = REQ_STREAM_ACQUIRE;
+                put_str(&mut m.owner, owner);
+                m.node_id = [*node_id as u64, (*node_id >> 64) as u64];
+                axes.names()
+            }
+            Request::StreamRelease { token } => {
+                m.kind = REQ_STREAM_RELEASE;
+                m.token = *token;
+                &[]
+            }
+        };
+        m.set_axes(names).then_some(m)
+    }
+
+    /// `encode` of a jog or a move (the motion parameters; NaN for a
+    /// default).
+    fn encode_motion(&self, mut m: Box<ControlRequest>) -> Option<Box<ControlRequest>> {
+        let supersede = |s: bool| if s { FLAG_SUPERSEDE } else { 0 };
+        let names = match self {
+            Request::Jog {
+                axes,
+                speed,
+                accel,
+                decel,
+                lease_ms,
+            } => {
+                m.kind = REQ_JOG;
+                (m.speed, m.accel, m.decel) = (*speed, wire(*accel), wire(*decel));
+                m.lease_ms = *lease_ms;
+                axes.names()
+            }
+            Request::Move {
+                axes,
+                position,
+                relative,
+                speed,
+                accel,
+                decel,
+                supersede: s,
+            } => {
+                m.kind = REQ_MOVE;
+                m.flags = supersede(*s) | if *relative { FLAG_RELATIVE } else { 0 };
+                m.position = *position;
+                (m.speed, m.accel, m.decel) = (wire(*speed), wire(*accel), wire(*decel));
+                axes.names()
+            }
+            _ => return None,
         };
         m.set_axes(names).then_some(m)
     }
@@ -240,6 +395,54 @@ mod tests {
                 since: Since::Reset,
                 offset: 7,
             },
+            Request::Enable { axes: Axes::All },
+            Request::Disable {
+                axes: named(&["X"]),
+            },
+            Request::Reset {
+                axes: named(&["X", "Y"]),
+            },
+            Request::Jog {
+                axes: named(&["X"]),
+                speed: -2.5,
+                accel: None,
+                decel: Some(40.0),
+                lease_ms: 500,
+            },
+            Request::JogRenew {
+                axes: Axes::All,
+                token: 0xdead_beef_0123_4567,
+                end: false,
+            },
+            Request::JogRenew {
+                axes: named(&["X"]),
+                token: 1,
+                end: true,
+            },
+            Request::Move {
+                axes: named(&["Y"]),
+                position: 12.5,
+                relative: true,
+                speed: Some(3.0),
+                accel: Some(100.0),
+                decel: None,
+                supersede: false,
+            },
+            Request::Move {
+                axes: named(&["Y"]),
+                position: -1.0,
+                relative: false,
+                speed: None,
+                accel: None,
+                decel: None,
+                supersede: true,
+            },
+            Request::StreamAcquire {
+                axes: named(&["X", "Y"]),
+                owner: "cnc".into(),
+                node_id: u128::MAX - 12345,
+            },
+            Request::StreamRelease { token: 77 },
         ] {
             let m = r.encode().expect("encodes");
             assert_eq!(Request::decode(&m), Ok(r));
@@ -248,7 +451,7 @@ mod tests {
 
     #[test]
     fn an_unknown_kind_is_an_error_not_another_request() {
-        for k in [0, 9, 99, u32::MAX] {
+        for k in [0, 17, 99, u32::MAX] {
             let mut m = ControlRequest::zeroed();
             m.kind = k;
             assert_eq!(Request::decode(&m), Err(DecodeError::UnknownKind(k)));

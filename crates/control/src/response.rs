@@ -23,6 +23,12 @@ pub enum Reason {
     Gantry,
     /// Another home sequence is running on the axis.
     Busy,
+    /// A program owns the axis (ERR 3, Execution Collision).
+    Owned,
+    /// The token names no jog or stream of the axis.
+    Token,
+    /// The operation's instruction refuses, with its ERR / EXERR.
+    Operation { err: u16, exerr: u16 },
 }
 
 impl Reason {
@@ -36,6 +42,9 @@ impl Reason {
             Reason::Exiting => REASON_EXITING,
             Reason::Gantry => REASON_GANTRY,
             Reason::Busy => REASON_BUSY,
+            Reason::Owned => REASON_OWNED,
+            Reason::Token => REASON_TOKEN,
+            Reason::Operation { .. } => REASON_OPERATION,
         }
     }
 
@@ -47,7 +56,10 @@ impl Reason {
     /// The instruction's ERR / EXERR, where it has one.
     pub fn codes(self) -> Option<(u16, u16)> {
         match self {
-            Reason::Instruction { err, exerr } => Some((err, exerr)),
+            Reason::Instruction { err, exerr } | Reason::Operation { err, exerr } => {
+                Some((err, exerr))
+            }
+            Reason::Owned => Some((motion_homing::codes::ERR_EXECUTION_COLLISION, 0)),
             _ => None,
         }
     }
@@ -64,9 +76,13 @@ pub enum AxisOutcome {
 }
 
 impl AxisOutcome {
-    /// The wire's entry for axis `name`.
+    /// The wire's entry for axis `name` (its index not known here:
+    /// [`NO_INDEX`]).
     pub fn answer(self, name: &str) -> AxisAnswer {
-        let mut a = AxisAnswer::default();
+        let mut a = AxisAnswer {
+            index: NO_INDEX,
+            ..AxisAnswer::default()
+        };
         put_str(&mut a.name, name);
         match self {
             AxisOutcome::Accepted => a.accepted = 1,
@@ -108,6 +124,25 @@ impl ControlResponse {
         }
         self.axes[k] = outcome.answer(name);
         self.axis_count += 1;
+        true
+    }
+
+    /// Appends the answer of axis `name` at config index `index`, with the
+    /// engine's operation id where the operation was accepted; false once
+    /// [`MAX_AXES`] answers are there.
+    pub fn push_axis(
+        &mut self,
+        name: &str,
+        index: usize,
+        outcome: AxisOutcome,
+        op_id: u32,
+    ) -> bool {
+        let k = self.axis_count as usize;
+        if !self.push_answer(name, outcome) {
+            return false;
+        }
+        self.axes[k].index = u16::try_from(index).unwrap_or(NO_INDEX);
+        self.axes[k].op_id = op_id;
         true
     }
 

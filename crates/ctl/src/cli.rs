@@ -1,7 +1,7 @@
 //! `motionctl`'s command line (interface.md), parsed with clap.
 
 use clap::{Args, Parser, Subcommand};
-use motion_config::args::{axis, runtime_dir, seconds, service_prefix};
+use motion_config::args::{axis, number, runtime_dir, seconds, service_prefix};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -9,13 +9,14 @@ use std::path::PathBuf;
     name = "motionctl",
     version,
     about = "The operator's tool for a running motion-supervisor: home, stop, unhome, status, \
-             stats, trace.",
+             stats, trace; enable, disable, reset, jog, move, stream.",
     after_help = "The supervisor is found by its service prefix: --service-prefix, else the \
                   config's [supervisor] service_prefix (--config), else \"motion\".\n\n\
-                  Exit codes:\n  0  done (home: every named axis homed with PC set)\n  \
-                  1  refused, or homing did not succeed\n  2  bad argument or config\n  \
+                  Exit codes:\n  0  done (home: every named axis homed with PC set; move: \
+                  every axis at its target; jog, stream: ended without an axis fault)\n  \
+                  1  refused, or the operation did not succeed\n  2  bad argument or config\n  \
                   3  no supervisor running under the prefix (or it stopped answering)\n  \
-                  130/143  interrupted by SIGINT/SIGTERM (home: the axes were stopped)"
+                  130/143  interrupted by SIGINT/SIGTERM (the axes were stopped)"
 )]
 pub struct Cli {
     #[command(flatten)]
@@ -52,6 +53,24 @@ pub enum Command {
     /// Record every cycle of the next homing of AXIS: CSV, and a plot of
     /// velocity against position with the events marked.
     Trace(TraceArgs),
+    /// MSO: enable the drives of the named axes (all: every axis), holding
+    /// position.
+    Enable(AxesArgs),
+    /// MSF: disable the drives of the named axes (all: every axis); a
+    /// moving axis is stopped first.
+    Disable(AxesArgs),
+    /// MAFR: clear the axis faults of the named axes (all: every axis) and
+    /// ask their drives for a fault reset. Never enables, never moves.
+    Reset(AxesArgs),
+    /// MAJ, hold to run: jog AXIS (or a gantry) while this command runs;
+    /// Ctrl-C/SIGTERM, --for, `stop`, a limit or a fault end it.
+    Jog(JogArgs),
+    /// MAM: a trapezoidal move of AXIS (or a gantry) to P or by D; waits
+    /// like `home` (exit 0 only when it ended at the target).
+    Move(MoveArgs),
+    /// Play a CSV file of timed setpoints ("t,p1[,p2...]": s, units; one
+    /// column per AXIS, in order) through the supervised setpoint stream.
+    Stream(StreamArgs),
 }
 
 #[derive(Debug, Args)]
@@ -86,6 +105,70 @@ pub struct AxesArgs {
     /// Axes; none: every axis.
     #[arg(value_name = "AXIS", value_parser = axis)]
     pub axes: Vec<String>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct JogArgs {
+    /// The axis or gantry to jog.
+    #[arg(value_name = "AXIS", value_parser = axis)]
+    pub axis: String,
+    /// Units/s; the sign is the direction.
+    #[arg(long, value_name = "V", allow_negative_numbers = true, value_parser = number)]
+    pub speed: f64,
+    /// Units/s² (default: the axis's home_acceleration).
+    #[arg(long, value_name = "A", value_parser = number)]
+    pub accel: Option<f64>,
+    /// Units/s² (default: the axis's home_deceleration).
+    #[arg(long, value_name = "D", value_parser = number)]
+    pub decel: Option<f64>,
+    /// Stop after S seconds.
+    #[arg(long = "for", value_name = "S", value_parser = seconds)]
+    pub for_s: Option<f64>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("target").required(true).args(["to", "by"])))]
+pub struct MoveArgs {
+    /// The axis or gantry to move.
+    #[arg(value_name = "AXIS", value_parser = axis)]
+    pub axis: String,
+    /// Target position, axis coordinates (units).
+    #[arg(long, value_name = "P", allow_negative_numbers = true, value_parser = number)]
+    pub to: Option<f64>,
+    /// Distance from where the move starts (units).
+    #[arg(long, value_name = "D", allow_negative_numbers = true, value_parser = number)]
+    pub by: Option<f64>,
+    /// Units/s (default: the axis's home_speed).
+    #[arg(long, value_name = "V", value_parser = number)]
+    pub speed: Option<f64>,
+    /// Units/s² (default: the axis's home_acceleration).
+    #[arg(long, value_name = "A", value_parser = number)]
+    pub accel: Option<f64>,
+    /// Units/s² (default: the axis's home_deceleration).
+    #[arg(long, value_name = "D", value_parser = number)]
+    pub decel: Option<f64>,
+    /// Return once the move is accepted, without following it.
+    #[arg(long)]
+    pub no_wait: bool,
+    /// Replace a running jog or move of the axis (else refused, ERR 3).
+    #[arg(long)]
+    pub supersede: bool,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct StreamArgs {
+    /// The axes (or gantries) of the file's columns, in order.
+    #[arg(value_name = "AXIS", required = true, value_parser = axis)]
+    pub axes: Vec<String>,
+    /// Rows "t,p1[,p2...]": time in s (increasing), one position per AXIS.
+    #[arg(long, value_name = "FILE")]
+    pub csv: PathBuf,
     #[arg(long)]
     pub json: bool,
 }
@@ -131,7 +214,14 @@ impl Command {
         match self {
             Command::Status(a) => a.json,
             Command::Home(a) => a.json,
-            Command::Stop(a) | Command::Unhome(a) => a.json,
+            Command::Stop(a)
+            | Command::Unhome(a)
+            | Command::Enable(a)
+            | Command::Disable(a)
+            | Command::Reset(a) => a.json,
+            Command::Jog(a) => a.json,
+            Command::Move(a) => a.json,
+            Command::Stream(a) => a.json,
             Command::Stats(a) => a.json,
             Command::Trace(a) => a.json,
         }

@@ -31,8 +31,9 @@
 use motion_homing::{Command, DriveState, Edge, Feedback, LatchArm, LatchFeedback};
 
 use crate::frame::{
-    AxisCommand, AxisFeedback, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE,
-    DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED, SW_FAULT,
+    AxisCommand, AxisFeedback, CW_ENABLE, CW_FAULT_RESET, DI_HOME_SWITCH, DI_MARKER_PULSE,
+    DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED,
+    SW_FAULT,
 };
 
 /// Wire value of a position that was not a number (see the module docs).
@@ -102,6 +103,18 @@ fn edge_from_wire(edge: u8) -> Edge {
     }
 }
 
+/// The control word's bits: [`CW_ENABLE`], [`CW_FAULT_RESET`].
+fn control_word(cmd: &Command) -> u16 {
+    let mut cw = 0;
+    if cmd.enable {
+        cw |= CW_ENABLE;
+    }
+    if cmd.fault_reset {
+        cw |= CW_FAULT_RESET;
+    }
+    cw
+}
+
 /// Engine command (units) → wire command (counts).
 pub fn command_to_axis(cmd: &Command, counts_per_unit: f64) -> AxisCommand {
     AxisCommand {
@@ -111,7 +124,7 @@ pub fn command_to_axis(cmd: &Command, counts_per_unit: f64) -> AxisCommand {
         torque_limit_negative: cmd.torque_limit_negative as f32,
         position_error_tolerance: rate_to_counts(cmd.position_error_tolerance, counts_per_unit),
         velocity_error_tolerance: rate_to_counts(cmd.velocity_error_tolerance, counts_per_unit),
-        control_word: if cmd.enable { CW_ENABLE } else { 0 },
+        control_word: control_word(cmd),
         marker_arm_id: cmd.marker_arm.id,
         switch_arm_id: cmd.switch_arm.id,
         switch_arm_edge: edge_to_wire(cmd.switch_arm.edge),
@@ -137,6 +150,7 @@ pub fn axis_to_command(ac: &AxisCommand, counts_per_unit: f64) -> Command {
             id: ac.switch_arm_id,
             edge: edge_from_wire(ac.switch_arm_edge),
         },
+        fault_reset: ac.control_word & CW_FAULT_RESET != 0,
     }
 }
 
@@ -228,6 +242,7 @@ mod tests {
                 id: 200,
                 edge: Edge::Falling,
             },
+            fault_reset: true,
         }
     }
 
@@ -328,7 +343,7 @@ mod tests {
         assert_eq!(w.torque_limit_negative, 80.25);
         assert_eq!(w.position_error_tolerance, 500.0);
         assert_eq!(w.velocity_error_tolerance, 3000.0);
-        assert_eq!(w.control_word, CW_ENABLE);
+        assert_eq!(w.control_word, CW_ENABLE | CW_FAULT_RESET);
         assert_eq!(w.marker_arm_id, 7);
         assert_eq!(w.switch_arm_id, 200);
         assert_eq!(w.switch_arm_edge, EDGE_FALLING);
@@ -442,6 +457,19 @@ mod tests {
             reserved: [0; 3],
         };
         assert_eq!(command_to_axis(&axis_to_command(&c, 1000.0), 1000.0), c);
+        // The fault reset both ways, alone and with the enable.
+        for cw in [0, CW_ENABLE, CW_FAULT_RESET, CW_ENABLE | CW_FAULT_RESET] {
+            let c = AxisCommand {
+                control_word: cw,
+                ..c
+            };
+            let e = axis_to_command(&c, 1000.0);
+            assert_eq!(
+                (e.enable, e.fault_reset),
+                (cw & CW_ENABLE != 0, cw & CW_FAULT_RESET != 0)
+            );
+            assert_eq!(command_to_axis(&e, 1000.0), c);
+        }
     }
 
     #[test]
@@ -453,7 +481,7 @@ mod tests {
         };
         let c = axis_to_command(&w, CPU);
         assert_eq!(c.switch_arm.edge, Edge::Falling);
-        assert!(!c.enable);
+        assert!(!c.enable && c.fault_reset, "0xFFFE: bit 1 set, bit 0 clear");
         let f = AxisFeedback {
             marker_latched: 0xFF,
             digital_inputs: u32::MAX,

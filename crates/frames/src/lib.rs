@@ -7,6 +7,8 @@
 //! * [`frame`] — `#[repr(C)]` wire types with pinned layout, the layout
 //!   version and the versioned iceoryx2 type names.
 //! * [`convert`] — units ↔ counts, pure and allocation-free.
+//! * [`setpoint`] — the supervised setpoint stream's `#[repr(C)]` message
+//!   (a program → the supervisor), versioned like the frames.
 //! * `zero_copy` (feature `zero-copy`) — iceoryx2's `ZeroCopySend` (with the
 //!   type names above) and `PlacementDefault` for the frames.
 //!
@@ -27,6 +29,7 @@
 pub mod backend;
 pub mod convert;
 pub mod frame;
+pub mod setpoint;
 #[cfg(feature = "zero-copy")]
 mod zero_copy;
 
@@ -35,3 +38,4 @@ pub use convert::{
     units_to_counts, INVALID_COUNTS,
 };
 pub use frame::*;
+pub use setpoint::*;

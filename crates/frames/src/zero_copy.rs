@@ -9,6 +9,7 @@ use crate::frame::{
     AxisCommand, AxisFeedback, CommandFrame, FeedbackFrame, FrameHeader, COMMAND_FRAME_TYPE_NAME,
     FEEDBACK_FRAME_TYPE_NAME, MAX_AXES,
 };
+use crate::setpoint::{SetpointAxis, SetpointFrame, SETPOINT_FRAME_TYPE_NAME};
 
 // SAFETY: `#[repr(C)]`, fields are `FrameHeader` and an array of `AxisCommand`,
 // both `ZeroCopySend` (checked at compile time below), no pointers or
@@ -28,6 +29,15 @@ unsafe impl ZeroCopySend for FeedbackFrame {
     }
 }
 
+// SAFETY: as for `CommandFrame`: `#[repr(C)]`, integers and an array of
+// `SetpointAxis` (ZeroCopySend, checked below), no implicit padding (asserts
+// in `setpoint.rs`), the layout version in the type name.
+unsafe impl ZeroCopySend for SetpointFrame {
+    unsafe fn type_name() -> &'static str {
+        SETPOINT_FRAME_TYPE_NAME
+    }
+}
+
 const fn assert_zero_copy_send<T: ZeroCopySend + ?Sized>() {}
 
 const _: () = {
@@ -36,6 +46,7 @@ const _: () = {
     assert_zero_copy_send::<[AxisCommand; MAX_AXES]>();
     assert_zero_copy_send::<[AxisFeedback; MAX_AXES]>();
     assert_zero_copy_send::<u64>();
+    assert_zero_copy_send::<[SetpointAxis; MAX_AXES]>();
 };
 
 #[cfg(test)]

@@ -47,6 +47,7 @@ const FIXTURES: &[(&str, &str)] = &[
         "io_marker",
         include_str!("../../../tests/machines/io_marker.toml"),
     ),
+    ("ops", include_str!("../../../tests/machines/ops.toml")),
 ];
 
 /// `[supervisor]` keys every test machine gets unless it sets them: 1 kHz

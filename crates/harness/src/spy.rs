@@ -28,6 +28,9 @@ pub struct Cmd {
     /// Axis 0: velocity set-point, counts/s, and control word.
     pub velocity: f64,
     pub control_word: u16,
+    /// Axis 0: position set-point, counts (the setpoint-latency bench finds
+    /// the frame that carries a setpoint by it).
+    pub position: i64,
 }
 
 /// One feedback frame as the spy saw it.
@@ -238,6 +241,7 @@ fn run<F: FnMut(&Cmd)>(
                         ts: f.header.timestamp_ns,
                         velocity: a.target_velocity,
                         control_word: a.control_word,
+                        position: a.target_position,
                     };
                     on_cmd(&c);
                     if rec.cmds.len() < rec.cmds.capacity() {

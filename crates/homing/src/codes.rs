@@ -38,6 +38,42 @@
 //! | 1016 | leg | *ours* search limit: a search leg travelled farther than `search_limit`; EXERR names the leg: 2 seek, 5 return, 10 creep (an explicit mapping, kept equal to the numbers these legs' phases had when the code was introduced) |
 //! | 1017 | 0     | *ours* gantry skew: the sides of a gantry found their events further apart than `max_skew` (reported by the coordinator through `Request::stop_code`) |
 //! | 1018 | 0     | *ours* ambiguous marker: switch then marker found its marker closer than `marker_min_distance` to the switch edge, and `refuse_ambiguous_marker` is set (axis stopped, not homed) |
+//!
+//! The operations around homing (issue 15: enable, disable, reset, jog,
+//! move, stop, the supervised stream) use the Logix codes the Logix motion
+//! instructions report (MOTION-RM002, "Motion Error Codes (.ERR)") for
+//! their **refusals** — answered in `Status::op.refused`, never setting the
+//! axis's ER — and ERR 12 / 1019 for the **axis faults** that end a motion
+//! (ER set, `Status::faulted`, cleared by `Operation::Reset`):
+//!
+//! | ERR  | EXERR | meaning |
+//! |------|-------|---------|
+//! | 3    | 0     | execution collision: the axis runs an operation this one may not replace (a move on a jogging or moving axis without `supersede`, a jog on a moving axis, anything but a stop on a streaming axis, a stream start on an axis in motion, a home on an axis that jogs, moves or streams) |
+//! | 5    | 0     | servo off state: jog, move or stream on an axis whose drive is not enabled (ServoActionStatus false, or a disable in progress) |
+//! | 5    | 1     | *ours* not a servo axis: enable, jog, move or stream on a `feedback_only` axis |
+//! | 9    | 0     | overtravel condition: jog or move towards a tripped limit switch (motion away is allowed) |
+//! | 12   | 12    | axis in shutdown: enable, jog, move or stream while `Request::shutdown` is set |
+//! | 12   | 40    | as a refusal: enable, jog, move or stream without valid feedback (the position to start from is unknown) |
+//! | 13   | 1     | parameter out of range, speed: not finite, not above zero, above `max_speed`, or (not homed) above `unhomed_speed`; a stream start without any speed bound (no `max_speed` and no homing speed to derive one) |
+//! | 13   | 2     | parameter out of range, acceleration: not finite or not above zero |
+//! | 13   | 3     | parameter out of range, deceleration: not finite, not above zero, or above `max_deceleration` |
+//! | 13   | 4     | parameter out of range, target: outside `travel_limits` (homed, linear), beyond ±`max_position`, a jog towards a travel limit already reached, or a motion that could not stop inside the travel limits from where the axis is |
+//! | 13   | 5     | parameter out of range, target not finite |
+//! | 13   | 6     | parameter out of range, jog lease outside 50 ms ..= 5 s |
+//! | 16   | 0     | home in process: enable, reset, jog, move or stream on an axis that is homing (stop it first; `disable` and `stop` are always accepted) |
+//! | 20   | 0     | axis in faulted state: home, enable, jog, move or stream while the axis has an axis fault (`Status::faulted`): `reset` first |
+//! | 12   | 16    | axis fault: the drive faulted (or dropped its power stage) — during homing, a jog, move or stream, or at rest |
+//! | 12   | 40    | axis fault: feedback lost during a jog, move or stream (41 invalid, 44 implausible likewise) |
+//! | 12   | 42    | axis fault: the drive did not report enabled within `enable_timeout` after an enable |
+//! | 12   | 43    | axis fault: a jog, move or stream moved towards a tripped limit switch (stopped at `max_deceleration`) |
+//! | 1019 | 1     | *ours* setpoint refused (the stream stops the axis at `max_deceleration`): position or velocity not finite |
+//! | 1019 | 2     | *ours* setpoint refused: outside `travel_limits` (homed, linear) or beyond ±`max_position` |
+//! | 1019 | 3     | *ours* setpoint refused: step faster than `max_speed` (or a velocity feed-forward above it) |
+//! | 1019 | 4     | *ours* setpoint refused: change of segment velocity faster than `stream_acceleration` |
+//! | 1019 | 5     | *ours* stream silent: no new setpoint for `stream_timeout_ms` after the last one was reached |
+//! | 1019 | 6     | *ours* setpoint out of order: its time is not after the previous one's |
+//! | 1019 | 7     | *ours* axis not homed (cleared while streaming) and `stream_unhomed` false |
+//! | 1020 | 0     | *ours* jog lease expired (hold to run): NOT an error — the jog stops normally, ER stays false; only logged and shown as `StopCause::LeaseExpired` |
 
 /// Servo message failure.
 pub const ERR_SERVO_MESSAGE: u16 = 12;
@@ -89,3 +125,44 @@ pub const EX_HOME_POSITION_LIMITS: u16 = 31;
 pub const EX_TRAVEL_LIMITS: u16 = 32;
 pub const EX_ABSOLUTE_NOT_ABSOLUTE: u16 = 33;
 pub const EX_ABOVE_MAX_SPEED: u16 = 34;
+
+// --- the operations around homing (issue 15) ---------------------------
+
+/// Execution collision: another operation runs that this one may not replace.
+pub const ERR_EXECUTION_COLLISION: u16 = 3;
+/// Servo off state: the drive is not enabled.
+pub const ERR_SERVO_OFF: u16 = 5;
+/// Overtravel condition: motion towards a tripped limit switch.
+pub const ERR_OVERTRAVEL_CONDITION: u16 = 9;
+/// Parameter out of range; EXERR names the operand (`EX_PARAM_*`).
+pub const ERR_PARAMETER_OUT_OF_RANGE: u16 = 13;
+/// Home in process: stop homing first.
+pub const ERR_HOME_IN_PROCESS: u16 = 16;
+/// Axis in faulted state: reset first.
+pub const ERR_AXIS_FAULTED: u16 = 20;
+/// A setpoint of the supervised stream was refused; the stream stopped the
+/// axis (ours). EXERR: `EX_SETPOINT_*`.
+pub const ERR_SETPOINT_REFUSED: u16 = 1019;
+/// The jog's lease ran out (ours): a normal stop, only logged.
+pub const ERR_JOG_LEASE_EXPIRED: u16 = 1020;
+
+// EXERR under ERR 5.
+/// The axis is `feedback_only`: nothing to enable or move.
+pub const EX_NOT_SERVO: u16 = 1;
+
+// EXERR under ERR 13: the operand.
+pub const EX_PARAM_SPEED: u16 = 1;
+pub const EX_PARAM_ACCELERATION: u16 = 2;
+pub const EX_PARAM_DECELERATION: u16 = 3;
+pub const EX_PARAM_TARGET: u16 = 4;
+pub const EX_PARAM_NOT_FINITE: u16 = 5;
+pub const EX_PARAM_LEASE: u16 = 6;
+
+// EXERR under ERR 1019.
+pub const EX_SETPOINT_NOT_FINITE: u16 = 1;
+pub const EX_SETPOINT_OUTSIDE_LIMITS: u16 = 2;
+pub const EX_SETPOINT_SPEED: u16 = 3;
+pub const EX_SETPOINT_ACCELERATION: u16 = 4;
+pub const EX_SETPOINT_STALE: u16 = 5;
+pub const EX_SETPOINT_OUT_OF_ORDER: u16 = 6;
+pub const EX_SETPOINT_NOT_HOMED: u16 = 7;

@@ -235,6 +235,30 @@ pub struct AxisConfig {
     /// An ambiguous marker fails homing (ERR 1018) instead of completing with
     /// the `Status::ambiguous_marker` warning.
     pub refuse_ambiguous_marker: bool,
+
+    // --- the operations around homing (interface.md "Limits") -----------
+    /// Speed cap (units/s) of jogs and moves while the axis is not homed
+    /// (LinuxCNC jogs unhomed joints, slowly: without a reference no soft
+    /// limit protects the machine). `0.0` = `home_speed`. See
+    /// `validate::effective_unhomed_speed`.
+    pub unhomed_speed: f64,
+    /// The axis has overtravel limit switches: motion towards a tripped one
+    /// stops (ER 12 / 43) and is refused (ERR 9). `false`: the inputs are
+    /// ignored, also by homing (an EtherCAT drive then need not map them).
+    pub limit_switches: bool,
+    /// Logix "Maximum Deceleration", units/s²: the deceleration of a stop
+    /// at a limit switch and of the stops the stream makes, and the most an
+    /// operation may ask for. `0.0` = the largest deceleration configured
+    /// (`home_deceleration`). See `validate::effective_max_deceleration`.
+    pub max_deceleration: f64,
+    /// Largest change of segment velocity the supervised stream may ask
+    /// for, units/s² (ERR 1019 / 4 above it). `0.0` = 10 × `home_acceleration`.
+    pub stream_acceleration: f64,
+    /// The stream stops the axis (ERR 1019 / 5) after this long without a
+    /// new setpoint once the last one was reached, ns. `0` = 50 ms.
+    pub stream_timeout_ns: u64,
+    /// The stream may drive an axis that is not homed (no soft limits then).
+    pub stream_unhomed: bool,
 }
 
 impl Default for AxisConfig {
@@ -279,6 +303,12 @@ impl Default for AxisConfig {
             max_speed: 0.0,
             marker_min_distance: 0.0,
             refuse_ambiguous_marker: false,
+            unhomed_speed: 0.0,
+            limit_switches: true,
+            max_deceleration: 0.0,
+            stream_acceleration: 0.0,
+            stream_timeout_ns: 0,
+            stream_unhomed: false,
         }
     }
 }

@@ -1,7 +1,10 @@
 //! What crosses the engine's boundary each cycle: [`Feedback`] and
 //! [`Request`] in, [`Command`] out. Positions are *raw* (the drive's frame,
 //! never redefined and never wrapped) in position units; the engine keeps the
-//! axis-position offset itself.
+//! axis-position offset itself. The operations' types are in
+//! [`operation`](crate::operation).
+
+use crate::operation::{Operation, Setpoint};
 
 /// A position latch as the drive reports it (CiA 402 touch probe style).
 ///
@@ -89,10 +92,15 @@ pub struct Command {
     pub velocity_error_tolerance: f64,
     pub marker_arm: LatchArm,
     pub switch_arm: LatchArm,
+    /// Ask the drive for a fault reset (MAFR; CiA 402 control word bit 7):
+    /// set after `Operation::Reset` for at least three steps and until the
+    /// drive reports no fault (at most `enable_timeout`), so the drive sees
+    /// a rising edge however the frames are timed.
+    pub fault_reset: bool,
 }
 
 /// Control inputs for one cycle, as a PLC program would drive the MAH rung.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Request {
     /// Rung condition of the Home instruction: a rising edge starts homing.
     pub home: bool,
@@ -123,4 +131,14 @@ pub struct Request {
     /// missing sample is excused, within a bound, by the feedback-loss rule
     /// (see `axis::loss`).
     pub stalled: bool,
+
+    // --- the operations around homing (see `operation`) ----------------
+    /// An operation, applied in this step and answered in `Status::op`.
+    pub op: Option<Operation>,
+    /// A NEW setpoint of the supervised stream that arrived this cycle (the
+    /// newest one; `None`: nothing new). Used only while streaming.
+    pub setpoint: Option<Setpoint>,
+    /// The jog's client renewed its lease this cycle: it runs until
+    /// `now + lease_ns` at least.
+    pub jog_renew: bool,
 }

@@ -17,6 +17,9 @@
 //!   coordination hooks a machine coordinator uses for gantries and home
 //!   order: barrier, timed final move, stop code).
 //! * [`status`]: the instruction's and the axis's status after a cycle.
+//! * [`operation`]: the operations around homing (enable, disable, reset,
+//!   jog, move, stop, the supervised stream) as they cross the boundary;
+//!   [`op_limits`]: the bounds they run within.
 //! * [`names`]: every enum's spellings, written once next to the enum.
 //! * [`time`]: ns ↔ s conversions, exact and cheap.
 
@@ -25,6 +28,8 @@ pub mod codes;
 pub mod config;
 pub mod io;
 pub mod names;
+pub mod op_limits;
+pub mod operation;
 pub mod plan;
 pub mod position;
 pub mod profile;
@@ -36,6 +41,11 @@ pub use axis::loss::FeedbackLoss;
 pub use axis::{Axis, RestoreRefusal};
 pub use config::*;
 pub use io::*;
+pub use op_limits::{
+    effective_max_deceleration, effective_stream_acceleration, effective_stream_timeout_ns,
+    effective_unhomed_speed, OpLimits,
+};
+pub use operation::{OpKind, OpStatus, Operation, Setpoint, StopCause};
 pub use status::{Implausible, Phase, Status};
 pub use validate::{
     advisories, effective_max_speed, effective_search_limit, validate, ConfigError,

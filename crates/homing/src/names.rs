@@ -113,6 +113,8 @@ mod tests {
         round_trips(HomeDirection::NAMES, HomeDirection::name);
         round_trips(HomeSequence::NAMES, HomeSequence::name);
         round_trips(Phase::NAMES, Phase::name);
+        round_trips(OpKind::NAMES, OpKind::name);
+        round_trips(StopCause::NAMES, StopCause::name);
     }
 
     /// The numbers the status frame and the trace carry (CIP order).

@@ -154,6 +154,39 @@ impl Profile {
         b.finish(now_ns, End::Hold(p), 0.0)
     }
 
+    /// Decelerate uniformly from `(p0, v0)` to rest exactly at `target`
+    /// (the deceleration is `v0² / 2|target − p0|`, whatever it takes) and
+    /// hold there: a stop that must end on a given point — a travel limit —
+    /// and never beyond it. `target` must lie ahead of the motion; a
+    /// target behind it, or no motion, holds at `p0`.
+    pub fn stop_at(now_ns: u64, p0: f64, v0: f64, target: f64) -> Self {
+        let x = target - p0;
+        if v0 == 0.0 || x * v0 <= 0.0 {
+            return Self::hold(now_ns, p0);
+        }
+        let mut b = Builder::new(p0, v0);
+        let dt = 2.0 * x / v0;
+        b.push(-v0 / dt, dt);
+        b.v = 0.0;
+        b.finish(now_ns, End::Hold(target), 0.0)
+    }
+
+    /// From `p0` to `p1` at constant velocity in exactly `duration_ns`, then
+    /// hold at `p1`: one interpolated segment of a setpoint stream. At
+    /// `now_ns + duration_ns` the sample is `p1` bit for bit.
+    pub fn segment(now_ns: u64, p0: f64, p1: f64, duration_ns: u64) -> Self {
+        let t = crate::time::ns_to_s(duration_ns);
+        if t <= 0.0 {
+            return Self::hold(now_ns, p1);
+        }
+        let mut b = Builder::new(p0, (p1 - p0) / t);
+        b.push(0.0, t);
+        let mut p = b.finish(now_ns, End::Hold(p1), 0.0);
+        // Ends at the requested time exactly, as the sample computes it.
+        p.t_end = t;
+        p
+    }
+
     /// Time-optimal trapezoid from `(p0, v0)` to rest at `target`, never faster
     /// than `vmax`, accelerating at `acc` and decelerating at `dec`.
     ///
@@ -496,6 +529,42 @@ mod tests {
         let p = Profile::move_to_in(0, 3.0, 3.0, 500 * T, 1.0, 1.0, 1.0);
         assert_eq!(p.sample(250 * T), (3.0, 0.0));
         assert!(!p.is_done(499 * T) && p.is_done(500 * T));
+    }
+
+    #[test]
+    fn stop_at_ends_on_its_target_and_never_beyond() {
+        // 20 u/s, 0.3 to go: a = 400 / 0.6 = 666.7 u/s², 0.03 s.
+        let p = Profile::stop_at(0, 9.7, 20.0, 10.0);
+        let xs = run(&p, 40);
+        assert!(xs.iter().all(|x| x.0 <= 10.0), "{xs:?}");
+        assert!(xs.windows(2).all(|w| w[1].0 >= w[0].0));
+        // Done after 2 × 0.3 / 20 = 0.03 s (give or take the rounding of
+        // that duration), exactly on the target.
+        assert!((p.sample(30 * T).0 - 10.0).abs() < 1e-12);
+        assert_eq!(p.sample(31 * T), (10.0, 0.0));
+        assert!(!p.is_done(29 * T) && p.is_done(31 * T));
+        check_limits(&xs, 20.0, 0.0, 400.0 / 0.6);
+        // Backwards, and the degenerate cases: a hold where it stands.
+        let p = Profile::stop_at(0, -9.7, -20.0, -10.0);
+        assert_eq!(p.sample(31 * T), (-10.0, 0.0));
+        assert_eq!(Profile::stop_at(0, 1.0, 5.0, 0.5).sample(T), (1.0, 0.0));
+        assert_eq!(Profile::stop_at(0, 1.0, 0.0, 2.0).sample(T), (1.0, 0.0));
+    }
+
+    #[test]
+    fn a_segment_runs_at_constant_velocity_and_lands_exactly() {
+        let p = Profile::segment(5 * T, 1.0, 1.1, 10 * T);
+        for k in 0..=10u64 {
+            let (x, v) = p.sample(5 * T + k * T);
+            if k < 10 {
+                assert!((x - (1.0 + 0.01 * k as f64)).abs() < 1e-12, "{k}: {x}");
+                assert!((v - 10.0).abs() < 1e-9, "{v}");
+            } else {
+                assert_eq!((x, v), (1.1, 0.0));
+            }
+        }
+        assert_eq!(Profile::segment(0, 1.0, 2.0, T).sample(T), (2.0, 0.0));
+        assert_eq!(Profile::segment(0, 1.0, 2.0, 0).sample(0), (2.0, 0.0));
     }
 
     #[test]

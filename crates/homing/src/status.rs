@@ -1,5 +1,8 @@
 //! The Motion Axis Home instruction's status (EN, DN, ER, IP, PC, ERR, EXERR)
-//! and the axis status bits homing drives (HomingStatus, HomedStatus).
+//! and the axis status bits homing drives (HomingStatus, HomedStatus);
+//! the axis bits and the answer of the operations around homing.
+
+use crate::operation::{OpStatus, StopCause};
 
 /// Where the engine is in a sequence, derived from the state machine's state
 /// (the leg of the plan it runs). Names (the spellings table below) are
@@ -138,4 +141,31 @@ pub struct Status {
     pub lost_after_ns: Option<u64>,
     /// Implausible feedback refused so far.
     pub implausible: Implausible,
+
+    // --- the operations around homing (see `operation`) ----------------
+    // `er` / `err` / `exerr` above also carry an axis fault (a drive
+    // fault, a limit switch, a refused setpoint, lost feedback while
+    // moving), which `Operation::Reset` clears; `stopping` is also set
+    // while an operation's motion comes to rest.
+    /// ServoActionStatus: the power stage is requested on and the drive
+    /// reports it enabled (and not faulted).
+    pub servo_action: bool,
+    /// JogStatus: a jog runs (until its stop begins).
+    pub jogging: bool,
+    /// MoveStatus: a move runs (until its stop begins).
+    pub moving: bool,
+    /// The supervised stream drives the axis.
+    pub streaming: bool,
+    /// The hardware limit switch inputs (false when `limit_switches` is off).
+    pub limit_negative: bool,
+    pub limit_positive: bool,
+    /// An axis fault is present (the ER of a drive fault, limit switch,
+    /// refused setpoint, lost feedback while moving, enable timeout): home,
+    /// enable, jog, move and stream are refused (ERR 20) until `Reset`.
+    pub faulted: bool,
+    /// Why the last jog, move or stream ended.
+    pub last_stop: StopCause,
+    /// The last accepted operation and its progress, and the refusal of
+    /// the last one asked for.
+    pub op: OpStatus,
 }

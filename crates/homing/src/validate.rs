@@ -116,6 +116,9 @@ fn numbers(p: &mut Problems, cfg: &AxisConfig) -> Usable {
         ("velocity_error_tolerance", cfg.velocity_error_tolerance),
         ("enable_timeout", cfg.enable_timeout),
         ("feedback_loss_drain", cfg.feedback_loss_drain),
+        ("unhomed_speed", cfg.unhomed_speed),
+        ("max_deceleration", cfg.max_deceleration),
+        ("stream_acceleration", cfg.stream_acceleration),
     ] {
         p.number(key, v, true);
     }

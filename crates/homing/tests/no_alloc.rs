@@ -1,6 +1,7 @@
 //! The engine step never touches the heap: counted with a wrapping global
-//! allocator over complete homing runs of every sequence, and over the
-//! coordination, feedback-trouble and stored-reference paths.
+//! allocator over complete homing runs of every sequence, over the
+//! coordination, feedback-trouble and stored-reference paths, and over the
+//! operations around homing (power, jog, move, stream, limits, faults).
 
 use motion_homing::*;
 use motion_plant::{Plant, PlantConfig};
@@ -231,6 +232,178 @@ fn coordination_feedback_trouble_and_references_make_no_allocation() {
     });
     assert!(results[0].is_ok() && results[1].is_ok() && results[2].is_err());
     assert_eq!(during, 0, "allocator calls inside the engine");
+}
+
+/// The operations around homing: enable, home, jog (renewed, to the soft
+/// limit, by lease), moves (superseded, refused), the stream at the cycle
+/// rate and at 100 Hz with a refused setpoint, a limit switch hit, a drive
+/// fault, reset, disable, and refusals of every kind.
+#[test]
+fn operations_make_no_allocation() {
+    const T: u64 = 1_000_000;
+    let cfg = AxisConfig {
+        counts_per_unit: 1000.0,
+        home_sequence: HomeSequence::Immediate,
+        home_speed: 20.0,
+        home_acceleration: 500.0,
+        home_deceleration: 500.0,
+        travel_limits: Some((-10.0, 10.0)),
+        max_speed: 50.0,
+        max_deceleration: 2000.0,
+        cycle_ns: T,
+        ..AxisConfig::default()
+    };
+    let mut axis = Axis::new(cfg);
+    let mut plant = Plant::new(PlantConfig {
+        overtravel: Some((-12.0, 12.0)),
+        ..PlantConfig::default()
+    });
+    let mut fb = plant.feedback();
+    let jog = |speed: f64| Operation::Jog {
+        speed,
+        accel: 500.0,
+        decel: 500.0,
+        lease_ns: 300 * T,
+    };
+    let mv = |target: f64, supersede: bool| Operation::Move {
+        target,
+        relative: false,
+        speed: 20.0,
+        accel: 500.0,
+        decel: 500.0,
+        supersede,
+    };
+    // (step, request) of the script; every other step is empty.
+    let sp = |t_ms: u64, p: f64| Request {
+        setpoint: Some(Setpoint {
+            t_ns: t_ms * T,
+            position: p,
+            velocity: None,
+        }),
+        ..Request::default()
+    };
+    let op = |o: Operation| Request {
+        op: Some(o),
+        ..Request::default()
+    };
+    let script = |k: u64| -> Request {
+        match k {
+            1 => op(Operation::Enable),
+            10 => Request {
+                home: true,
+                ..Request::default()
+            },
+            20 => op(jog(20.0)),
+            21..=700 if k % 50 == 0 => Request {
+                jog_renew: true,
+                ..Request::default()
+            },
+            800 => op(mv(-5.0, false)),
+            850 => op(jog(5.0)),
+            860 => op(mv(2.0, true)),
+            1500 => op(Operation::StreamStart),
+            // From where the move left it (2.0) at 1 u/s: every cycle,
+            // then every tenth (100 Hz).
+            1501..=2000 => sp(k - 1501, 2.0 + 0.001 * (k - 1501) as f64),
+            2001..=2500 if k % 10 == 0 => sp(k - 1501, 2.0 + 0.001 * (k - 1501) as f64),
+            2520 => sp(1020, f64::NAN),
+            2700 => op(Operation::Reset),
+            2710 => op(move_outside()),
+            2720 => Request {
+                home: false,
+                ..Request::default()
+            },
+            2730 => op(Operation::Disable),
+            2740 => op(Operation::Enable),
+            2800 => {
+                let mut r = op(Operation::StreamStart);
+                r.stop = true;
+                r
+            }
+            2810 => op(Operation::StreamEnd),
+            2900 => Request {
+                shutdown: true,
+                ..Request::default()
+            },
+            2950 => op(Operation::Enable),
+            3000 => op(Operation::Stop),
+            _ => Request::default(),
+        }
+    };
+    let mut during = 0;
+    // Jogging, moving, streaming, a refused setpoint, a drive fault: seen.
+    let mut seen = [false; 5];
+    for k in 0..3200u64 {
+        let req = script(k);
+        let mut cmd = Command::default();
+        during += counted(|| {
+            cmd = axis.step(k * T, Some(&fb), &req);
+        });
+        fb = plant.step(&cmd, 0.001);
+        if k == 3050 {
+            plant.inject_fault();
+        }
+        let s = axis.status();
+        for (i, b) in [
+            s.jogging,
+            s.moving,
+            s.streaming,
+            s.err == codes::ERR_SETPOINT_REFUSED,
+            s.exerr == codes::EX_DRIVE_FAULT,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            seen[i] |= b;
+        }
+    }
+    assert_eq!(seen, [true; 5]);
+    // The unhomed part: a jog into the limit switch and a reset.
+    let mut axis = Axis::new(AxisConfig {
+        max_deceleration: 2000.0,
+        ..cfg
+    });
+    let mut plant = Plant::new(PlantConfig {
+        overtravel: Some((-12.0, 12.0)),
+        ..PlantConfig::default()
+    });
+    let mut fb = plant.feedback();
+    let mut hit = false;
+    for k in 0..2000u64 {
+        let req = match k {
+            1 => op(Operation::Enable),
+            10 => op(Operation::Jog {
+                speed: 20.0,
+                accel: 500.0,
+                decel: 500.0,
+                lease_ns: 5_000 * T,
+            }),
+            1500 => op(Operation::Reset),
+            1510 => op(jog(-5.0)),
+            _ => Request::default(),
+        };
+        let mut cmd = Command::default();
+        during += counted(|| {
+            cmd = axis.step(k * T, Some(&fb), &req);
+        });
+        fb = plant.step(&cmd, 0.001);
+        hit |= axis.status().last_stop == StopCause::LimitSwitch;
+    }
+    assert!(hit);
+    assert_eq!(axis.status().last_stop, StopCause::LeaseExpired);
+    assert_eq!(during, 0, "allocator calls inside Axis::step");
+}
+
+/// A move the travel limits refuse.
+fn move_outside() -> Operation {
+    Operation::Move {
+        target: 50.0,
+        relative: false,
+        speed: 20.0,
+        accel: 500.0,
+        decel: 500.0,
+        supersede: false,
+    }
 }
 
 #[test]

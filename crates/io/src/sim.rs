@@ -366,6 +366,40 @@ start = 1.0
         assert_eq!(fb.axes[0].status_word, SW_ENABLED);
     }
 
+    /// Issue 15's MAFR: the rising edge of `CW_FAULT_RESET` clears the
+    /// plant's fault and enables nothing; the enable needs its own rising
+    /// edge after that.
+    #[test]
+    fn a_fault_reset_in_the_control_word_clears_the_fault_and_enables_nothing() {
+        let mut b = backend();
+        let mut fb = FeedbackFrame::ZERO;
+        let cpu = [1000.0, 100.0];
+        b.exchange(&frame(&[on(1.0, 0.0), Command::default()], &cpu), &mut fb)
+            .unwrap();
+        assert!(b.watchdog_stop(0.001, &mut fb));
+        assert_eq!(fb.axes[0].status_word, SW_FAULT);
+        let reset = Command {
+            position: 1.0,
+            fault_reset: true,
+            ..Command::default()
+        };
+        let off = Command {
+            position: 1.0,
+            ..Command::default()
+        };
+        let f = frame(&[reset, Command::default()], &cpu);
+        assert_eq!(f.axes[0].control_word, motion_frames::CW_FAULT_RESET);
+        b.exchange(&f, &mut fb).unwrap();
+        assert_eq!(fb.axes[0].status_word, 0, "no fault, not enabled");
+        b.exchange(&frame(&[off, Command::default()], &cpu), &mut fb)
+            .unwrap();
+        assert_eq!(fb.axes[0].status_word, 0);
+        b.exchange(&frame(&[on(1.0, 0.0), Command::default()], &cpu), &mut fb)
+            .unwrap();
+        assert_eq!(fb.axes[0].status_word, SW_ENABLED);
+        assert_eq!(b.position(0), 1.0, "nothing moved");
+    }
+
     #[test]
     fn standstill_stops_in_one_cycle_and_garbage_is_bounded() {
         let mut b = backend();

@@ -16,13 +16,15 @@
 //! * [`names`] — service names.
 //! * [`ports`] — the frame ports of one I/O process ([`SupervisorPorts`],
 //!   [`IoPorts`]).
+//! * [`setpoints`] — the supervised setpoint stream's service
+//!   ([`SetpointSubscriber`] in the cycle, [`SetpointPublisher`] in programs).
 //! * [`wait`] — exact waits on an iceoryx2 listener (`ppoll`).
 //! * [`error`] — engineer-readable errors.
 //!
 //! The files depend on each other in one direction only: `error` and
 //! `names` at the bottom; `dir` and `domain` on `error`; `shm` and
 //! `liveness` on `domain`; `cleanup` on `shm`; `node` and `session` on those;
-//! `ports` on `domain`, `names` and `wait`.
+//! `ports` on `domain`, `names` and `wait`; `setpoints` on `domain` and `names`.
 
 pub mod cleanup;
 pub mod dir;
@@ -33,6 +35,7 @@ pub mod names;
 pub mod node;
 pub mod ports;
 pub mod session;
+pub mod setpoints;
 pub mod shm;
 pub mod wait;
 
@@ -43,6 +46,7 @@ pub use error::IpcError;
 pub use names::IoServiceNames;
 pub use ports::{IoPorts, Ports, Sent, ShmFrame, SupervisorPorts};
 pub use session::session_path;
+pub use setpoints::{SetpointPublisher, SetpointSubscriber};
 
 /// `CLOCK_MONOTONIC` now, in ns: the clock of every frame timestamp. It is
 /// system-wide on Linux, so values taken in `motion-supervisor` and

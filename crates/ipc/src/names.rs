@@ -10,6 +10,7 @@
 //! | `P/io/NAME/feedback_ready` | event | I/O process → supervisor |
 //! | `P/control` | request-response (`motion-control`) | motionctl, HMIs → supervisor |
 //! | `P/status` | publish-subscribe (`motion-control`), 100 Hz | supervisor → motionctl, HMIs |
+//! | `P/setpoints` | publish-subscribe of [`motion_frames::SetpointFrame`] | programs owning axes (≤ 8) → supervisor |
 
 /// The four frame services of one I/O process.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -48,4 +49,9 @@ pub fn control_service(prefix: &str) -> String {
 /// `P/status`.
 pub fn status_service(prefix: &str) -> String {
     format!("{prefix}/status")
+}
+
+/// `P/setpoints`.
+pub fn setpoint_service(prefix: &str) -> String {
+    format!("{prefix}/setpoints")
 }

@@ -77,8 +77,12 @@ impl Plant {
 
         self.marker_latch.arm(cmd.marker_arm);
         self.switch_latch.arm(cmd.switch_arm);
-        self.drive
-            .begin_step(cmd.enable, self.cfg.enable_delay_cycles, command_ok(cmd));
+        self.drive.begin_step(
+            cmd.enable,
+            cmd.fault_reset,
+            self.cfg.enable_delay_cycles,
+            command_ok(cmd),
+        );
 
         let old = self.position;
         let following = self.drive.enabled();
@@ -180,10 +184,18 @@ impl Plant {
         self.position
     }
 
-    /// Tests: the drive faults now (power stage off, torque 0); cleared by the
-    /// usual enable false → true handshake.
+    /// Tests: the drive faults now (power stage off, torque 0); cleared by a
+    /// rising edge of `Command::fault_reset`, or the enable false → true
+    /// handshake.
     pub fn inject_fault(&mut self) {
         self.trip();
+    }
+
+    /// The drive's fault reset, as the rising edge of
+    /// `Command::fault_reset` does it: the fault clears, the power stage
+    /// stays off until a new rising edge of `enable`.
+    pub fn reset_fault(&mut self) {
+        self.drive.reset_fault();
     }
 
     /// Tests: the home switch is moved by `shift` along the axis (a worn

@@ -115,13 +115,23 @@ fn wild_config() -> impl Strategy<Value = PlantConfig> {
 
 fn wild_command() -> impl Strategy<Value = (Command, f64)> {
     (
-        (prop::bool::weighted(0.9), wild_f64(), wild_f64()),
+        (
+            prop::bool::weighted(0.9),
+            wild_f64(),
+            wild_f64(),
+            prop::bool::weighted(0.1),
+        ),
         (wild_f64(), wild_f64(), wild_f64(), wild_f64()),
         (0u8..4, any::<bool>(), 0u8..4, any::<bool>()),
         prop_oneof![4 => Just(0.001), 1 => wild_f64()],
     )
         .prop_map(
-            |((enable, position, velocity), (lp, ln, pt, vt), (mi, me, si, se), dt)| {
+            |(
+                (enable, position, velocity, fault_reset),
+                (lp, ln, pt, vt),
+                (mi, me, si, se),
+                dt,
+            )| {
                 let edge = |b| if b { Edge::Rising } else { Edge::Falling };
                 (
                     Command {
@@ -140,6 +150,7 @@ fn wild_command() -> impl Strategy<Value = (Command, f64)> {
                             id: si,
                             edge: edge(se),
                         },
+                        fault_reset,
                     },
                     dt,
                 )

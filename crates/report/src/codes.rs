@@ -8,11 +8,11 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         (0, _) => "no error",
         (ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST) => "homing terminated by a stop or disable",
         (ERR_SERVO_MESSAGE, EX_AXIS_SHUTDOWN) => "axis in shutdown",
-        (ERR_SERVO_MESSAGE, EX_DRIVE_FAULT) => "drive fault during homing",
+        (ERR_SERVO_MESSAGE, EX_DRIVE_FAULT) => "drive fault",
         (ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST) => "feedback lost (I/O process silent or gone)",
         (ERR_SERVO_MESSAGE, EX_FEEDBACK_INVALID) => "invalid feedback (non-finite or absurd)",
         (ERR_SERVO_MESSAGE, EX_ENABLE_TIMEOUT) => "drive did not enable in time",
-        (ERR_SERVO_MESSAGE, EX_OVERTRAVEL) => "hardware overtravel during homing",
+        (ERR_SERVO_MESSAGE, EX_OVERTRAVEL) => "hardware overtravel: a limit switch was hit",
         (ERR_SERVO_MESSAGE, EX_FEEDBACK_IMPLAUSIBLE) => {
             "implausible feedback: a position the axis cannot have reached (never a home event)"
         }
@@ -30,6 +30,48 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         (ERR_AMBIGUOUS_MARKER, _) => {
             "the marker lies too close to the switch edge to tell which one is meant"
         }
+        (ERR_EXECUTION_COLLISION, _) => {
+            "execution collision: the axis runs an operation this one may not replace"
+        }
+        (ERR_SERVO_OFF, EX_NOT_SERVO) => "not a servo axis: nothing to enable or move",
+        (ERR_SERVO_OFF, _) => "servo off state: the drive is not enabled",
+        (ERR_OVERTRAVEL_CONDITION, _) => {
+            "overtravel condition: motion towards a tripped limit switch"
+        }
+        (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_SPEED) => "parameter out of range: speed",
+        (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_ACCELERATION) => {
+            "parameter out of range: acceleration"
+        }
+        (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_DECELERATION) => {
+            "parameter out of range: deceleration"
+        }
+        (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET) => {
+            "parameter out of range: target outside the travel limits"
+        }
+        (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NOT_FINITE) => {
+            "parameter out of range: target not finite"
+        }
+        (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_LEASE) => "parameter out of range: jog lease",
+        (ERR_PARAMETER_OUT_OF_RANGE, _) => "parameter out of range",
+        (ERR_HOME_IN_PROCESS, _) => "home in process: stop homing first",
+        (ERR_AXIS_FAULTED, _) => "axis in faulted state: reset first",
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_NOT_FINITE) => "setpoint refused: not finite",
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_OUTSIDE_LIMITS) => {
+            "setpoint refused: outside the travel limits"
+        }
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_SPEED) => "setpoint refused: step above max_speed",
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_ACCELERATION) => {
+            "setpoint refused: change of velocity above stream_acceleration"
+        }
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_STALE) => "stream silent longer than stream_timeout_ms",
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_OUT_OF_ORDER) => {
+            "setpoint out of order: its time is not after the previous one's"
+        }
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_NOT_HOMED) => {
+            "stream stopped: the axis is not homed (stream_unhomed is false)"
+        }
+        (ERR_SETPOINT_REFUSED, _) => "setpoint refused",
+        (ERR_JOG_LEASE_EXPIRED, _) => "jog lease expired: the jog stopped (hold to run)",
         (ERR_INTERRUPTED, _) => "homing interrupted externally",
         (ERR_TIMEOUT, _) => "home timeout exceeded",
         (ERR_SEARCH_LIMIT, _) => "search travelled beyond the search limit",

@@ -147,6 +147,31 @@ pub struct CheckReport {
     pub environment: Vec<String>,
     /// Empty when the config is valid.
     pub errors: Vec<ErrorEntry>,
+    /// Per axis: the bounds the operations around homing run within.
+    #[serde(default)]
+    pub operations: Vec<AxisOperationLimits>,
+}
+
+/// One axis's bounds of the operations around homing (jog, move, the
+/// setpoint stream), each default resolved, as `check` shows them.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AxisOperationLimits {
+    pub axis: String,
+    /// False for a feedback-only axis: nothing to enable or move (the
+    /// other fields mean nothing then).
+    pub movable: bool,
+    /// `travel_limits` as enforced while homed; `None`: none (not set, or a
+    /// cyclic axis).
+    pub soft_limits: Option<[f64; 2]>,
+    /// `max_speed`, or the one derived from the homing speeds; `None`:
+    /// none known (the stream is refused).
+    pub max_speed: Option<f64>,
+    pub unhomed_speed: f64,
+    pub max_deceleration: f64,
+    pub limit_switches: bool,
+    pub stream_acceleration: f64,
+    pub stream_timeout_ms: f64,
+    pub stream_unhomed: bool,
 }
 
 /// `motionctl stop|unhome --json`, `motionctl home --no-wait --json`.

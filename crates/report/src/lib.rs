@@ -7,6 +7,8 @@
 //! * [`home`] — `home --json`: one row per axis (interface.md).
 //! * [`status`] — `status --json`: the live state of every axis and I/O process.
 //! * [`io`] — per I/O process: attached, frames, gaps by length.
+//! * [`motion`] — `move --json` / `stream --json`, and the operation part of
+//!   the status.
 //! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`
 //!   (also for a refused command line).
 //! * [`codes`] — ERR/EXERR in plain words.
@@ -19,18 +21,21 @@ pub mod errors;
 pub mod home;
 pub mod io;
 pub mod latency;
+pub mod motion;
 pub mod panic;
 pub mod status;
 pub mod table;
 pub mod trace;
 
 pub use errors::{ErrorEntry, ErrorReport};
+pub use home::AxisOperationLimits;
 pub use home::{
     AcceptedReport, Allocations, AxisResult, CheckReport, CpuUse, CtlHomeReport, HomeReport,
     RtInfo, RunReport, StatsReport, TraceReport,
 };
 pub use io::{GapCounts, IoReport};
 pub use latency::{LateWakeup, Latency, Percentiles};
+pub use motion::{MotionReport, MotionRow, OpReport, StreamIntake};
 pub use status::{AxisStatus, IoStatus, StatusReport};
 pub use trace::TraceRow;
 

@@ -55,6 +55,42 @@ pub struct AxisStatus {
     /// stored reference).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// ServoActionStatus: enable requested and the drive reports enabled.
+    #[serde(default)]
+    pub servo_action: bool,
+    /// JogStatus, MoveStatus, a setpoint stream commanding the axis.
+    #[serde(default)]
+    pub jogging: bool,
+    #[serde(default)]
+    pub moving: bool,
+    #[serde(default)]
+    pub streaming: bool,
+    /// StoppingStatus: decelerating to rest (a stop, an abort, a limit).
+    #[serde(default)]
+    pub stopping: bool,
+    /// The hardware overtravel limit switches.
+    #[serde(default)]
+    pub limit_negative: bool,
+    #[serde(default)]
+    pub limit_positive: bool,
+    /// An axis fault is present: only `reset` clears it.
+    #[serde(default)]
+    pub faulted: bool,
+    /// The program that owns the axis (setpoint stream), if any.
+    #[serde(default)]
+    pub owner: Option<String>,
+    /// The last operation (enable, jog, move, ...).
+    #[serde(default)]
+    pub op: crate::OpReport,
+    /// Why the last motion stopped: `none`, `operator`, `lease_expired`,
+    /// `soft_limit`, `limit_switch`, `fault`, `feedback_lost`,
+    /// `setpoint_refused`, `disable`, ...
+    #[serde(default)]
+    pub last_stop: String,
+    /// The position commanded this cycle, axis coordinates (with
+    /// `position`: the following error).
+    #[serde(default)]
+    pub command: Option<f64>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -79,4 +115,7 @@ pub struct StatusReport {
     pub uptime_ms: u64,
     pub axes: Vec<AxisStatus>,
     pub io: Vec<IoStatus>,
+    /// The setpoint stream's intake: frames, setpoints, refusals by kind.
+    #[serde(default)]
+    pub stream: crate::StreamIntake,
 }

@@ -159,11 +159,12 @@ pub fn status(r: &crate::StatusReport) -> String {
         + 2;
     let b = |x: bool, c: &'static str| if x { c } else { "." };
     let mut s = format!(
-        "{:<w$}{:<8}{:<13}{:<12}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17} {:>19}\n",
+        "{:<w$}{:<8}{:<13}{:<15}{:<9}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17} {:>19}\n",
         "axis",
         "io",
         "phase",
         "EN DN ER IP PC",
+        "SJMTxF-+",
         "homed",
         "ERR/EXERR",
         "position",
@@ -179,7 +180,7 @@ pub fn status(r: &crate::StatusReport) -> String {
             x.map_or(format!("{:>width$}", "-"), |v| format!("{v:>width$.p$}"))
         };
         s += &format!(
-            "{:<w$}{:<8}{:<13}{} {} {} {} {} {:>7}{:>10}{}{}{}{} {}{}{:>17} {:>19}\n",
+            "{:<w$}{:<8}{:<13}{} {} {} {} {}  {:<9}{:>7}{:>10}{}{}{}{} {}{}{:>17} {:>19}\n",
             a.name,
             a.io,
             a.phase,
@@ -188,6 +189,7 @@ pub fn status(r: &crate::StatusReport) -> String {
             b(a.er, "ER"),
             b(a.ip, "IP"),
             b(a.pc, "PC"),
+            motion_flags(a),
             match (a.homed, a.restored) {
                 (true, true) => "stored",
                 (true, false) => "yes",
@@ -222,6 +224,17 @@ pub fn status(r: &crate::StatusReport) -> String {
         for wrn in &a.warnings {
             s += &format!("  └ warning: {wrn}\n");
         }
+        if let Some(o) = &a.owner {
+            s += &format!("  └ owned by {o} (setpoint stream)\n");
+        }
+        if a.op.err != 0 {
+            s += &format!(
+                "  └ last operation refused: ERR {} EXERR {}: {}\n",
+                a.op.err,
+                a.op.exerr,
+                crate::codes::explain(a.op.err, a.op.exerr)
+            );
+        }
     }
     for io in &r.io {
         s += &format!(
@@ -245,6 +258,57 @@ pub fn status(r: &crate::StatusReport) -> String {
         );
     }
     s
+}
+
+/// One row per axis, as `move`, `jog` and `stream` print how they ended.
+pub fn motion_rows(rows: &[crate::MotionRow]) -> String {
+    let w = rows
+        .iter()
+        .map(|r| r.name.chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4)
+        + 2;
+    let mut s = format!(
+        "{:<w$}{:>4}{:>4}{:>10}{:>12}{:>14}{:>12}\n",
+        "axis", "PC", "ER", "ERR/EXERR", "position", "follow err max", "final err"
+    );
+    for r in rows {
+        let b = |x: bool| if x { "1" } else { "0" };
+        s += &format!(
+            "{:<w$}{:>4}{:>4}{:>10}{}{}{}\n",
+            r.name,
+            b(r.pc),
+            b(r.er),
+            format!("{}/{}", r.err, r.exerr),
+            opt(r.position, 12),
+            opt(r.following_error_max, 14),
+            opt(r.final_error, 12),
+        );
+        if let Some(e) = &r.error {
+            s += &format!("  └ {e}\n");
+        }
+    }
+    s
+}
+
+/// The operation bits of an axis in eight characters (`.` = off):
+/// ServoActionStatus `S`, jogging `J`, moving `M`, streaming `T`, stopping
+/// `x`, faulted `F`, negative / positive limit switch `-` / `+`.
+fn motion_flags(a: &crate::AxisStatus) -> String {
+    [
+        (a.servo_action, 'S'),
+        (a.jogging, 'J'),
+        (a.moving, 'M'),
+        (a.streaming, 'T'),
+        (a.stopping, 'x'),
+        (a.faulted, 'F'),
+        (a.limit_negative, '-'),
+        (a.limit_positive, '+'),
+    ]
+    .iter()
+    .map(|&(on, c)| if on { c } else { '.' })
+    .collect()
 }
 
 #[cfg(test)]

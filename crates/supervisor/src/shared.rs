@@ -44,6 +44,32 @@ pub enum Control {
     Restore { id: u32, axis: usize, offset: f64 },
     /// Stop every axis, disable the drives once at rest, then leave the loop.
     Exit,
+    /// An operation for every axis of `mask` (a gantry: all its sides),
+    /// delivered to their engines in the same cycle and answered after that
+    /// cycle's step with each engine's answer. `f64` parameters that are
+    /// NaN are the axis's default (a gantry side: its gantry's first
+    /// side's): accel `home_acceleration`, decel `home_deceleration`, a
+    /// move's speed `home_speed`. `token` names a jog (for its renewals).
+    Op {
+        id: u32,
+        mask: u64,
+        op: motion_homing::Operation,
+        token: u64,
+    },
+    /// Renew (or with `end`, end) the jog `token` on the axes of `mask`
+    /// (0: wherever it runs).
+    JogRenew {
+        id: u32,
+        token: u64,
+        mask: u64,
+        end: bool,
+    },
+    /// `token` takes the axes of `mask` over for the setpoint stream (all
+    /// of them or none).
+    StreamAcquire { id: u32, mask: u64, token: u64 },
+    /// The stream of `token` ends (released, or its owner is gone): its
+    /// axes stop.
+    StreamRelease { id: u32, token: u64 },
 }
 
 /// Why the cycle refused a request for one axis: the domain's words. The
@@ -66,6 +92,12 @@ pub enum Refusal {
     NotStarted,
     /// The stored reference was not applied (`Restore`).
     Restore(motion_homing::RestoreRefusal),
+    /// A program owns the axis (setpoint stream): ERR 3.
+    Owned,
+    /// No jog or stream of the request's token runs on the axis.
+    Token,
+    /// The engine refused the operation, with the instruction's ERR / EXERR.
+    Operation { err: u16, exerr: u16 },
 }
 
 /// The answer for one axis.
@@ -91,6 +123,8 @@ pub struct Ack {
     /// The cycle that applied the request.
     pub cycle: u64,
     pub axes: [AxisAck; MAX_AXES],
+    /// The engine's operation id of each accepted operation (0 otherwise).
+    pub op_ids: [u32; MAX_AXES],
 }
 
 impl Ack {
@@ -99,6 +133,7 @@ impl Ack {
             id,
             cycle: 0,
             axes: [AxisAck::default(); MAX_AXES],
+            op_ids: [0; MAX_AXES],
         }
     }
 }
@@ -189,6 +224,10 @@ pub struct AxisSnap {
     /// HomedStatus comes from a stored reference (absolute axis, restored
     /// without motion), not from a homing run since start-up.
     pub restored: bool,
+    /// The owner token of the setpoint stream that owns the axis (0: none).
+    pub owner: u64,
+    /// This cycle's command position in axis coordinates.
+    pub cmd_axis: Option<f64>,
 }
 
 impl AxisSnap {
@@ -230,6 +269,9 @@ pub struct Snapshot {
     pub all_at_rest: bool,
     /// The supervisor is leaving (axes stopped, drives disabled).
     pub exiting: bool,
+    /// The setpoint stream's intake: frames, setpoints, refusals; owners.
+    pub stream: StreamCounts,
+    pub owners: u32,
 }
 
 impl Default for Snapshot {
@@ -243,6 +285,8 @@ impl Default for Snapshot {
             ios: [IoSnap::default(); MAX_IOS],
             all_at_rest: true,
             exiting: false,
+            stream: Default::default(),
+            owners: 0,
         }
     }
 }
@@ -252,6 +296,24 @@ impl Snapshot {
     pub fn all_attached(&self) -> bool {
         self.ios[..self.io_count].iter().all(|i| i.attached)
     }
+}
+
+/// The setpoint stream's intake counters (since start), kept by the
+/// cycle's intake (`core::stream`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StreamCounts {
+    /// Frames that reached the checks.
+    pub frames: u64,
+    /// Setpoints handed to engines (a gantry's counts once).
+    pub setpoints: u64,
+    pub refused_layout: u64,
+    pub refused_key: u64,
+    pub refused_count: u64,
+    pub refused_token: u64,
+    pub refused_sequence: u64,
+    pub refused_axis: u64,
+    /// Streams granted since start.
+    pub acquired: u32,
 }
 
 /// Lifecycle of the real-time thread.

@@ -101,7 +101,9 @@ pub fn fill(
         };
         let limit = effective_search_limit(&cfg.engine);
         e.search_limit = if limit.is_finite() { limit } else { 0.0 };
+        operation(a, e);
     }
+    stream(snap, &mut f.stream);
     let k = snap.io_count.min(m.ios.len()).min(MAX_IOS);
     f.io_count = k as u32;
     for (j, (io, e)) in snap.ios[..k].iter().zip(f.ios.iter_mut()).enumerate() {
@@ -119,6 +121,68 @@ pub fn fill(
         ];
         e.longest_gap_cycles = io.gaps.longest_cycles;
         e.gap_cycles = io.gap_cycles;
+    }
+}
+
+/// The operation part of an axis's entry: motion bits, the last
+/// operation, why the last motion stopped, the command position.
+fn operation(a: &crate::shared::AxisSnap, e: &mut AxisStatusEntry) {
+    let s = &a.status;
+    let mut m = 0u16;
+    for (on, bit) in [
+        (s.servo_action, MS_SERVO_ACTION),
+        (s.jogging, MS_JOGGING),
+        (s.moving, MS_MOVING),
+        (s.streaming, MS_STREAMING),
+        (s.limit_negative, MS_LIMIT_NEGATIVE),
+        (s.limit_positive, MS_LIMIT_POSITIVE),
+        (s.faulted, MS_FAULTED),
+        (a.cmd_axis.is_some(), MS_COMMAND),
+    ] {
+        if on {
+            m |= bit;
+        }
+    }
+    e.motion = m;
+    e.cmd_position = a.cmd_axis.unwrap_or(0.0);
+    e.op_id = s.op.id;
+    e.op_kind = s.op.kind as u8;
+    e.op_flags = (if s.op.ip { OP_IP } else { 0 })
+        | (if s.op.pc { OP_PC } else { 0 })
+        | (if s.op.refused.is_some() {
+            OP_REFUSED
+        } else {
+            0
+        });
+    (e.op_err, e.op_exerr) = s.op.refused.unwrap_or((0, 0));
+    e.last_stop = s.last_stop as u8;
+}
+
+/// The setpoint stream's intake counters.
+fn stream(snap: &Snapshot, e: &mut StreamStatusEntry) {
+    let c = &snap.stream;
+    *e = StreamStatusEntry {
+        frames: c.frames,
+        setpoints: c.setpoints,
+        refused_layout: c.refused_layout,
+        refused_key: c.refused_key,
+        refused_count: c.refused_count,
+        refused_token: c.refused_token,
+        refused_sequence: c.refused_sequence,
+        refused_axis: c.refused_axis,
+        acquired: c.acquired,
+        owners: snap.owners,
+    };
+}
+
+/// The owner of each axis by name (`name_of` a token: the control thread's
+/// table of owners).
+pub fn owners<'a>(snap: &Snapshot, name_of: impl Fn(u64) -> Option<&'a str>, f: &mut StatusFrame) {
+    let n = (f.axis_count as usize).min(snap.axis_count);
+    for (a, e) in snap.axes[..n].iter().zip(f.axes.iter_mut()) {
+        if a.owner != 0 {
+            put_str(&mut e.owner, name_of(a.owner).unwrap_or("?"));
+        }
     }
 }
 

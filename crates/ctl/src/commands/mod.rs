@@ -1,9 +1,13 @@
 //! The subcommands; each returns the exit code (see `motionctl --help`).
 
+mod csv;
 mod home;
+mod jog;
+mod moves;
 mod simple;
 mod stats;
 mod status;
+mod stream;
 mod trace;
 
 use crate::cli::{Cli, Command, Target};
@@ -35,8 +39,16 @@ pub fn run(cli: Cli) -> i32 {
     match cli.command {
         Command::Status(a) => status::status(&mut client, &a),
         Command::Home(a) => home::home(&mut client, &a),
-        Command::Stop(a) => simple::axes(&mut client, motion_control::REQ_STOP, &a),
-        Command::Unhome(a) => simple::axes(&mut client, motion_control::REQ_UNHOME, &a),
+        Command::Stop(a) => simple::axes(&mut client, motion_control::REQ_STOP, "stop", &a),
+        Command::Unhome(a) => simple::axes(&mut client, motion_control::REQ_UNHOME, "unhome", &a),
+        Command::Enable(a) => simple::axes(&mut client, motion_control::REQ_ENABLE, "enable", &a),
+        Command::Disable(a) => {
+            simple::axes(&mut client, motion_control::REQ_DISABLE, "disable", &a)
+        }
+        Command::Reset(a) => simple::axes(&mut client, motion_control::REQ_RESET, "reset", &a),
+        Command::Jog(a) => jog::jog(&mut client, &a),
+        Command::Move(a) => moves::move_axis(&mut client, &a),
+        Command::Stream(a) => stream::stream(&mut client, &a),
         Command::Stats(a) => stats::stats(&mut client, &a),
         Command::Trace(a) => trace::trace(&mut client, &a),
     }

@@ -4,13 +4,13 @@ use motion_control::*;
 use motion_report::print_json;
 use std::time::Duration;
 
-/// `stop` / `unhome`: one request, every axis's answer.
-pub fn axes(client: &mut Client, kind: u32, a: &AxesArgs) -> i32 {
+/// `stop` / `unhome` / `enable` / `disable` / `reset`: one request, every
+/// axis's answer.
+pub fn axes(client: &mut Client, kind: u32, what: &str, a: &AxesArgs) -> i32 {
     let resp = match client.simple(kind, 0, &a.axes, Duration::from_secs(3)) {
         Ok(r) => r,
         Err(e) => return client_error(a.json, &e),
     };
-    let what = if kind == REQ_STOP { "stop" } else { "unhome" };
     if resp.result != RESULT_ACCEPTED {
         return fail(a.json, resp.refusal(what, |x| x.accepted == 0), EXIT_FAILED);
     }

@@ -105,6 +105,7 @@ impl Drive {
             velocity_error_tolerance: 0.0,
             marker_arm,
             switch_arm,
+            fault_reset: false,
         };
         if let Some(mut r) = self.ramp {
             let dec = (self.od.get(0x6085, 0) as f64 / cpu).max(1e-9);

@@ -28,6 +28,7 @@ use super::{Abort, Axis};
 use crate::codes::*;
 use crate::config::AxisConfiguration;
 use crate::io::{DriveState, Feedback};
+use crate::operation::StopCause;
 
 /// What the detection needs of the sample before the newest (an edge is
 /// between the two).
@@ -88,14 +89,7 @@ impl Axis {
                     let n = &mut self.status.implausible.jumps;
                     *n = n.saturating_add(1);
                     self.status.homed = false;
-                    if self.status.ip {
-                        self.fail(
-                            now,
-                            ERR_SERVO_MESSAGE,
-                            EX_FEEDBACK_IMPLAUSIBLE,
-                            Abort::Controlled,
-                        );
-                    }
+                    self.feedback_trouble(now, EX_FEEDBACK_IMPLAUSIBLE);
                     false
                 }
                 Ok(()) => {
@@ -106,14 +100,7 @@ impl Axis {
                     self.status.bad_attribute = Some(attribute);
                     // Corrupt feedback: the reference can no longer be trusted.
                     self.status.homed = false;
-                    if self.status.ip {
-                        self.fail(
-                            now,
-                            ERR_SERVO_MESSAGE,
-                            EX_FEEDBACK_INVALID,
-                            Abort::Controlled,
-                        );
-                    }
+                    self.feedback_trouble(now, EX_FEEDBACK_INVALID);
                     false
                 }
             },
@@ -145,10 +132,23 @@ impl Axis {
             // Edges across a gap of unknown length mean nothing.
             self.prev = None;
             self.last = None;
-            if self.status.ip {
-                self.fail(now, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, Abort::Controlled);
-            }
+            self.feedback_trouble(now, EX_FEEDBACK_LOST);
         }
+    }
+
+    /// Feedback that cannot be used (12 / `exerr`): homing in process
+    /// aborts, an operation's motion is an axis fault; both stop the axis
+    /// (at Home Deceleration, at `max_deceleration`).
+    fn feedback_trouble(&mut self, now: u64, exerr: u16) {
+        if self.status.ip {
+            self.fail(now, ERR_SERVO_MESSAGE, exerr, Abort::Controlled);
+        }
+        self.op_fault(
+            now,
+            (ERR_SERVO_MESSAGE, exerr),
+            StopCause::FeedbackLost,
+            false,
+        );
     }
 }
 

@@ -41,6 +41,7 @@ mod intake;
 mod latches;
 mod legs;
 pub mod loss;
+mod ops;
 mod plausible;
 mod reference;
 mod state;
@@ -48,6 +49,8 @@ mod state;
 use crate::codes::*;
 use crate::config::*;
 use crate::io::*;
+use crate::op_limits::OpLimits;
+use crate::operation::StopCause;
 use crate::plan::Leg;
 use crate::position::wrap;
 use crate::profile::Profile;
@@ -58,6 +61,7 @@ use followed::Followed;
 use intake::{Sample, Seen};
 use latches::Latches;
 use loss::FeedbackLoss;
+use ops::Ops;
 use plausible::Plausibility;
 pub use reference::RestoreRefusal;
 use state::{Run, State};
@@ -87,6 +91,11 @@ pub struct Axis {
     torque_time_ns: u64,
     /// What [`Axis::output`] writes besides the motion, worked out once.
     out: OutputLimits,
+    /// The bounds of the operations around homing, worked out once.
+    limits: OpLimits,
+    /// What the operations keep besides the state (power stage, reset,
+    /// the previous step's time).
+    ops: Ops,
     status: Status,
     /// What the engine keeps of the latest request.
     request: Kept,
@@ -131,6 +140,8 @@ impl Axis {
             enable_timeout_ns: secs_to_ns(cfg.enable_timeout),
             torque_time_ns: secs_to_ns(cfg.home_torque_time),
             out: OutputLimits::new(&cfg),
+            limits: OpLimits::new(&cfg),
+            ops: Ops::default(),
             cfg,
             status: Status::default(),
             request: Kept::default(),
@@ -222,6 +233,13 @@ impl Axis {
         self.last_sample_ns = None;
         self.plausible = Plausibility::new(&self.cfg);
         self.status.homed = false;
+        // The drives of a new I/O process are off: a motion ends with them.
+        self.op_fault(
+            now_ns,
+            (ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST),
+            StopCause::FeedbackLost,
+            true,
+        );
         if self.status.ip {
             self.fail(
                 now_ns,
@@ -240,8 +258,11 @@ impl Axis {
             Some(s) => self.advance(now_ns, &s),
             None => self.advance_blind(now_ns),
         }
+        self.settle();
         self.report(now_ns);
-        self.output(now_ns)
+        let cmd = self.output(now_ns);
+        self.ops.prev_step_ns = Some(now_ns);
+        cmd
     }
 
     /// The status fields that describe the state after this step.
@@ -250,6 +271,7 @@ impl Axis {
         self.status.stopping = matches!(self.state, State::Stopping { .. });
         self.status.waiting = false;
         self.status.min_move_ns = 0;
+        self.report_ops();
         let State::Homing(h) = &self.state else {
             return;
         };
@@ -279,6 +301,7 @@ impl Axis {
         self.request = Kept {
             home: req.home,
             stop: req.stop,
+            shutdown: req.shutdown,
             hold: req.hold,
             move_duration_ns: req.move_duration_ns,
         };
@@ -286,18 +309,25 @@ impl Axis {
             if self.status.ip {
                 self.fail(now, ERR_SERVO_MESSAGE, EX_AXIS_SHUTDOWN, Abort::Disable);
             }
-            self.enable = false;
+            self.shutdown_ops(now);
             self.status.homed = false;
         }
-        if req.stop && !prev.stop && self.status.ip {
-            let (err, exerr) = req
-                .stop_code
-                .unwrap_or((ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST));
-            self.fail(now, err, exerr, Abort::Controlled);
+        if req.stop && !prev.stop {
+            if self.status.ip {
+                let (err, exerr) = req
+                    .stop_code
+                    .unwrap_or((ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST));
+                self.fail(now, err, exerr, Abort::Controlled);
+            }
+            self.stop_motion(now, None, StopCause::Operator);
         }
         if req.home && !prev.home {
             self.start(now, req.shutdown);
         }
+        if let Some(op) = req.op {
+            self.operation(now, op);
+        }
+        self.operation_inputs(now, req.jog_renew, req.setpoint);
         if !req.home && (self.status.dn || self.status.er) {
             self.status.en = false;
         }
@@ -317,8 +347,19 @@ impl Axis {
             feedback_loss_ns: self.status.feedback_loss_ns,
             implausible: self.status.implausible,
             started_ns: now,
+            faulted: self.status.faulted,
+            last_stop: self.status.last_stop,
+            op: self.status.op,
             ..Status::default()
         };
+        // Logix: MAH on a faulted axis errors (20); a jog, move or stream
+        // must be stopped first (3); a stop in progress is taken over.
+        if self.status.faulted {
+            return self.fail(now, ERR_AXIS_FAULTED, 0, Abort::Controlled);
+        }
+        if self.op_in_motion() {
+            return self.fail(now, ERR_EXECUTION_COLLISION, 0, Abort::Controlled);
+        }
         if let Some(exerr) = self.config_error {
             return self.fail(now, ERR_ILLEGAL_HOMING_CONFIG, exerr, Abort::Controlled);
         }
@@ -328,6 +369,7 @@ impl Axis {
         let Some(s) = self.last else {
             return self.fail(now, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, Abort::Controlled);
         };
+        self.homing_takes_over();
         self.status.ip = true;
         self.status.homing = true;
         self.status.homed = false;
@@ -360,13 +402,15 @@ impl Axis {
     // ------------------------------------------------------------------
 
     fn advance(&mut self, now: u64, s: &Sample) {
+        self.power_tick(now);
+        self.watch_drive(now, s);
         let moving = self.state.commands_motion();
-        let stopping = matches!(self.state, State::Stopping { .. });
+        let stopping = matches!(self.state, State::Stopping { .. } | State::Motion(_));
         if !moving && !stopping && !s.fb.drive.enabled {
             // Nobody holds the axis: follow it, so enabling never jumps.
             self.profile.set(Profile::hold(now, s.fb.position));
         }
-        if matches!(self.state, State::Idle) && s.fb.drive.fault {
+        if matches!(self.state, State::Idle) && s.fb.drive.fault && !self.in_reset() {
             self.enable = false;
         }
         if moving {
@@ -382,7 +426,8 @@ impl Axis {
                 );
             }
             let v = self.profile.at(now).1;
-            if (v > 0.0 && s.fb.overtravel_positive) || (v < 0.0 && s.fb.overtravel_negative) {
+            let (neg, pos) = (s.fb.overtravel_negative, s.fb.overtravel_positive);
+            if self.cfg.limit_switches && ((v > 0.0 && pos) || (v < 0.0 && neg)) {
                 return self.fail(now, ERR_SERVO_MESSAGE, EX_OVERTRAVEL, Abort::Controlled);
             }
         }
@@ -399,9 +444,10 @@ impl Axis {
             &State::Enabling { since } => {
                 if s.fb.drive.enabled && !s.fb.drive.fault {
                     self.begin(now, s);
-                } else if s.fb.drive.fault && self.enable {
-                    // Fault reset: enable must go low before it goes high again.
-                    self.enable = false;
+                } else if s.fb.drive.fault && !self.in_reset() {
+                    // The drive faults while we wait for it (it used to be
+                    // reset by toggling the enable; now only `Reset` does).
+                    self.fail(now, ERR_SERVO_MESSAGE, EX_DRIVE_FAULT, Abort::Disable);
                 } else if now.saturating_sub(since) > self.enable_timeout_ns {
                     self.fail(now, ERR_SERVO_MESSAGE, EX_ENABLE_TIMEOUT, Abort::Controlled);
                 } else {
@@ -433,6 +479,7 @@ impl Axis {
                 }
             }
             State::Stopping { .. } => {}
+            State::Motion(_) => self.advance_motion(now, Some(s)),
         }
     }
 
@@ -440,6 +487,8 @@ impl Axis {
     /// An abort's stop still finishes; a release (which needs the actual
     /// position) waits for feedback, keeping the reduced torque limits.
     fn advance_blind(&mut self, now: u64) {
+        self.power_tick(now);
+        self.advance_motion(now, None);
         self.check_timeout(now);
         if matches!(self.state, State::Stopping { .. })
             && !self.overrides
@@ -501,6 +550,10 @@ impl Axis {
     }
 
     fn fail(&mut self, now: u64, err: u16, exerr: u16, how: Abort) {
+        if (err, exerr) == (ERR_SERVO_MESSAGE, EX_DRIVE_FAULT) {
+            // A drive fault is an axis fault: `Reset` before the next homing.
+            self.status.faulted = true;
+        }
         self.status.er = true;
         self.status.pc = false;
         self.status.err = err;
@@ -540,6 +593,9 @@ impl Axis {
 
     fn output(&mut self, now: u64) -> Command {
         let (mut p, mut v) = self.profile.at(now);
+        if let Some(vs) = self.stream_velocity(now) {
+            v = vs;
+        }
         if !p.is_finite() || !v.is_finite() {
             // Unreachable by construction; never let it out if it happens.
             p = self.last_command.position;
@@ -568,6 +624,7 @@ impl Axis {
                 id: self.latches.switch_id,
                 edge: self.latches.switch_edge,
             },
+            fault_reset: self.fault_reset_out(),
         };
         self.last_command = cmd;
         self.plausible.commanded(cmd.position);
@@ -581,6 +638,8 @@ impl Axis {
 struct Kept {
     home: bool,
     stop: bool,
+    /// `Request::shutdown` (a level).
+    shutdown: bool,
     /// `Request::hold`.
     hold: bool,
     /// `Request::move_duration_ns`.

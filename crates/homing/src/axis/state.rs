@@ -6,6 +6,7 @@
 //! [`Phase`] is derived from the state, never stored.
 
 use super::detect::Search;
+use super::ops::motion::Motion;
 use crate::plan::{phase_of, Leg};
 use crate::status::Phase;
 
@@ -22,6 +23,8 @@ pub(super) enum State {
     /// overridden, `released` once the command is back on the actual
     /// position, then restoring.
     Stopping { released: bool },
+    /// An operation's motion (jog, move, stream, or its stop): see `ops`.
+    Motion(Motion),
 }
 
 /// A homing sequence in progress.
@@ -73,7 +76,8 @@ impl Homing {
 impl State {
     pub fn phase(&self) -> Phase {
         match self {
-            State::Idle => Phase::Idle,
+            // Homing's phase: an operation's motion is not homing.
+            State::Idle | State::Motion(_) => Phase::Idle,
             State::Enabling { .. } => Phase::Enabling,
             State::Stopping { .. } => Phase::Stopping,
             State::Homing(h) => {

@@ -161,3 +161,206 @@ pub fn run_with(
         axis,
     }
 }
+
+// ----------------------------------------------------------------------
+// Operations around homing (issue 15)
+// ----------------------------------------------------------------------
+
+/// 1 ms.
+pub const MS: u64 = 1_000_000;
+
+/// The axis most operation tests run: homes immediately at 0 (so HomedStatus
+/// is one step away), 1000 counts per unit, home speed 20 (the unhomed cap),
+/// acceleration and deceleration 500, max_speed 50, travel limits ±10, a
+/// 1 ms cycle.
+pub fn op_axis() -> AxisConfig {
+    AxisConfig {
+        counts_per_unit: 1000.0,
+        home_sequence: HomeSequence::Immediate,
+        home_speed: 20.0,
+        home_acceleration: 500.0,
+        home_deceleration: 500.0,
+        travel_limits: Some((-10.0, 10.0)),
+        max_speed: 50.0,
+        cycle_ns: MS,
+        ..AxisConfig::default()
+    }
+}
+
+/// The plant behind it: at rest at `start`, no sensors, the default
+/// two-cycle enable delay.
+pub fn op_plant(start: f64) -> PlantConfig {
+    PlantConfig {
+        start,
+        ..PlantConfig::default()
+    }
+}
+
+/// Engine and plant stepped together, one cycle per step, with every
+/// command and status kept.
+pub struct Rig {
+    pub axis: Axis,
+    pub plant: Plant,
+    pub fb: Feedback,
+    /// The next step's index (its time is `k * cycle_ns`).
+    pub k: u64,
+    pub cycle_ns: u64,
+    pub cmds: Vec<Command>,
+    pub sts: Vec<Status>,
+    /// Rewrites the frame the engine sees (None: withheld).
+    pub frame: fn(u64, Feedback) -> Option<Feedback>,
+}
+
+fn pass(_: u64, fb: Feedback) -> Option<Feedback> {
+    Some(fb)
+}
+
+impl Rig {
+    pub fn new(cfg: AxisConfig, plant: PlantConfig) -> Self {
+        let plant = Plant::new(plant);
+        Self {
+            axis: Axis::new(cfg),
+            fb: plant.feedback(),
+            plant,
+            k: 0,
+            cycle_ns: if cfg.cycle_ns > 0 { cfg.cycle_ns } else { MS },
+            cmds: Vec::new(),
+            sts: Vec::new(),
+            frame: pass,
+        }
+    }
+
+    /// `op_axis()` on `op_plant(start)`.
+    pub fn at(start: f64) -> Self {
+        Self::new(op_axis(), op_plant(start))
+    }
+
+    pub fn now(&self) -> u64 {
+        self.k * self.cycle_ns
+    }
+
+    /// One cycle with `req`: the engine's command (the plant applies it).
+    pub fn step(&mut self, req: Request) -> Command {
+        let seen = (self.frame)(self.k, self.fb);
+        let cmd = self.axis.step(self.now(), seen.as_ref(), &req);
+        self.fb = self.plant.step(&cmd, self.cycle_ns as f64 * 1e-9);
+        self.cmds.push(cmd);
+        self.sts.push(*self.axis.status());
+        self.k += 1;
+        cmd
+    }
+
+    /// `n` cycles of an empty request.
+    pub fn run(&mut self, n: u64) {
+        for _ in 0..n {
+            self.step(Request::default());
+        }
+    }
+
+    /// Cycles until `done(status)` holds after one (at most `max`): true if
+    /// it did.
+    pub fn run_until(&mut self, max: u64, done: impl Fn(&Status) -> bool) -> bool {
+        for _ in 0..max {
+            self.step(Request::default());
+            if done(self.axis.status()) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// One cycle with `op`: `Ok(id)` when accepted, `Err(code)` when refused.
+    pub fn op(&mut self, op: Operation) -> Result<u32, (u16, u16)> {
+        let before = self.axis.status().op.id;
+        self.step(Request {
+            op: Some(op),
+            ..Request::default()
+        });
+        let st = self.axis.status().op;
+        if st.id != before {
+            assert_eq!(st.refused, None);
+            Ok(st.id)
+        } else {
+            Err(st.refused.expect("neither accepted nor refused"))
+        }
+    }
+
+    /// One cycle with a setpoint.
+    pub fn setpoint(&mut self, t_ns: u64, position: f64, velocity: Option<f64>) -> Command {
+        self.step(Request {
+            setpoint: Some(Setpoint {
+                t_ns,
+                position,
+                velocity,
+            }),
+            ..Request::default()
+        })
+    }
+
+    /// Enabled and at rest: the enable accepted and the drive on.
+    pub fn enable(&mut self) {
+        self.run(1);
+        self.op(Operation::Enable).expect("enable accepted");
+        assert!(
+            self.run_until(100, |s| s.servo_action && s.op.pc),
+            "{:?}",
+            self.axis.status()
+        );
+    }
+
+    /// Enabled and homed (immediate: Home Position where it stands).
+    pub fn enable_and_home(&mut self) {
+        self.enable();
+        self.step(home());
+        self.step(Request::default());
+        let s = self.axis.status();
+        assert!(s.homed && s.pc && s.servo_action, "{s:?}");
+    }
+
+    /// Axis position of the last command.
+    pub fn cmd_axis(&self) -> f64 {
+        self.axis.to_axis(self.cmds.last().unwrap().position)
+    }
+
+    /// Commands from step `from` on.
+    pub fn since(&self, from: u64) -> &[Command] {
+        &self.cmds[from as usize..]
+    }
+}
+
+/// A jog at `speed` with acceleration and deceleration 500 and a 500 ms lease.
+pub fn jog(speed: f64) -> Operation {
+    Operation::Jog {
+        speed,
+        accel: 500.0,
+        decel: 500.0,
+        lease_ns: 500 * MS,
+    }
+}
+
+/// A move to `target` (axis position) at 20, acceleration and deceleration 500.
+pub fn move_to(target: f64) -> Operation {
+    Operation::Move {
+        target,
+        relative: false,
+        speed: 20.0,
+        accel: 500.0,
+        decel: 500.0,
+        supersede: false,
+    }
+}
+
+/// Largest |second difference| / cycle² of the commanded positions: the
+/// acceleration the drive was asked for.
+pub fn max_accel(cmds: &[Command], cycle_s: f64) -> f64 {
+    cmds.windows(3)
+        .map(|w| (w[2].position - 2.0 * w[1].position + w[0].position).abs() / (cycle_s * cycle_s))
+        .fold(0.0, f64::max)
+}
+
+/// Largest |first difference| / cycle of the commanded positions.
+pub fn max_speed(cmds: &[Command], cycle_s: f64) -> f64 {
+    cmds.windows(2)
+        .map(|w| (w[1].position - w[0].position).abs() / cycle_s)
+        .fold(0.0, f64::max)
+}

@@ -1,6 +1,8 @@
 use super::load;
 use crate::cli::CheckArgs;
-use motion_report::{print_json, CheckReport};
+use motion_config::MachineConfig;
+use motion_homing::{AxisConfiguration, OpLimits, TravelMode};
+use motion_report::{print_json, AxisOperationLimits, CheckReport};
 use motion_rt::{check_environment, RtConfig};
 
 pub fn check(a: &CheckArgs) -> i32 {
@@ -12,6 +14,9 @@ pub fn check(a: &CheckArgs) -> i32 {
     let mut notes = Vec::new();
     for ax in &m.axes {
         for note in motion_homing::advisories(&ax.engine, cycle_s) {
+            notes.push(format!("axis {}: {note}", ax.name));
+        }
+        for note in motion_homing::op_limits::advisories(&ax.engine) {
             notes.push(format!("axis {}: {note}", ax.name));
         }
     }
@@ -32,6 +37,7 @@ pub fn check(a: &CheckArgs) -> i32 {
             warnings: m.warnings.clone(),
             environment,
             errors: Vec::new(),
+            operations: operation_limits(&m),
         });
         return 0;
     }
@@ -50,6 +56,9 @@ pub fn check(a: &CheckArgs) -> i32 {
         m.supervisor.priority,
         m.supervisor.service_prefix
     );
+    for a in operation_limits(&m) {
+        println!("{}", operations_line(&a));
+    }
     for w in &m.warnings {
         println!("warning: {w}");
     }
@@ -61,4 +70,67 @@ pub fn check(a: &CheckArgs) -> i32 {
         println!("  {line}");
     }
     0
+}
+
+/// Every axis's bounds of the operations around homing, defaults resolved
+/// as the engine resolves them.
+fn operation_limits(m: &MachineConfig) -> Vec<AxisOperationLimits> {
+    m.axes
+        .iter()
+        .map(|a| {
+            let e = &a.engine;
+            let l = OpLimits::new(e);
+            AxisOperationLimits {
+                axis: a.name.clone(),
+                movable: e.configuration != AxisConfiguration::FeedbackOnly,
+                soft_limits: e
+                    .travel_limits
+                    .filter(|_| e.travel == TravelMode::Linear)
+                    .map(|(lo, hi)| [lo, hi]),
+                max_speed: l.max_speed,
+                unhomed_speed: l.unhomed_speed,
+                max_deceleration: l.max_deceleration,
+                limit_switches: e.limit_switches,
+                stream_acceleration: l.stream_acceleration,
+                stream_timeout_ms: l.stream_timeout_ns as f64 / 1e6,
+                stream_unhomed: e.stream_unhomed,
+            }
+        })
+        .collect()
+}
+
+/// `axis X: operations: soft limits [-100, 100] while homed, max_speed 40,
+/// unhomed 20, max_deceleration 500, limit switches, stream: 5000 units/s²,
+/// timeout 50 ms, homed only`.
+fn operations_line(a: &AxisOperationLimits) -> String {
+    if !a.movable {
+        return format!("axis {}: operations: none (feedback-only axis)", a.axis);
+    }
+    let soft = match a.soft_limits {
+        Some([lo, hi]) => format!("soft limits [{lo}, {hi}] while homed"),
+        None => "no soft limits".to_string(),
+    };
+    let speed = match a.max_speed {
+        Some(v) => format!("max_speed {v}"),
+        None => "no max_speed (stream refused)".to_string(),
+    };
+    format!(
+        "axis {}: operations: {soft}, {speed}, unhomed_speed {}, max_deceleration {}, {}, \
+         stream: acceleration {} units/s², timeout {} ms, {}",
+        a.axis,
+        a.unhomed_speed,
+        a.max_deceleration,
+        if a.limit_switches {
+            "limit switches"
+        } else {
+            "no limit switches"
+        },
+        a.stream_acceleration,
+        a.stream_timeout_ms,
+        if a.stream_unhomed {
+            "also unhomed"
+        } else {
+            "homed only"
+        },
+    )
 }

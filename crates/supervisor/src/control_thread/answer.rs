@@ -15,6 +15,9 @@ pub fn reason(r: Refusal) -> Option<Reason> {
         Refusal::Instruction { err, exerr } => Reason::Instruction { err, exerr },
         Refusal::Exiting => Reason::Exiting,
         Refusal::Busy => Reason::Busy,
+        Refusal::Owned => Reason::Owned,
+        Refusal::Token => Reason::Token,
+        Refusal::Operation { err, exerr } => Reason::Operation { err, exerr },
         Refusal::NotStarted | Refusal::Restore(_) => return None,
     })
 }
@@ -46,6 +49,7 @@ mod tests {
             (Refusal::IoNotAttached, REASON_IO_NOT_ATTACHED),
             (Refusal::Exiting, REASON_EXITING),
             (Refusal::Busy, REASON_BUSY),
+            (Refusal::Token, REASON_TOKEN),
             (Refusal::NotStarted, REASON_NONE),
             (
                 Refusal::Restore(motion_homing::RestoreRefusal::NoFeedback),
@@ -56,5 +60,9 @@ mod tests {
             assert_eq!((a.accepted, a.reason, a.err), (0, code, 0), "{r:?}");
         }
         assert_eq!(outcome(AxisAck::Accepted).answer("X").accepted, 1);
+        let a = wire(Refusal::Operation { err: 13, exerr: 4 });
+        assert_eq!((a.reason, a.err, a.exerr), (REASON_OPERATION, 13, 4));
+        let a = wire(Refusal::Owned);
+        assert_eq!((a.reason, a.err, a.exerr), (REASON_OWNED, 3, 0));
     }
 }

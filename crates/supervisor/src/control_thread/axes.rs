@@ -91,14 +91,19 @@ impl ControlThread {
     }
 
     /// Every axis of the machine.
-    fn every_axis(&self) -> u64 {
+    pub(super) fn every_axis(&self) -> u64 {
         (0..self.s.machine.axes.len()).fold(0, |m, i| m | 1u64 << i)
     }
 
     /// The axes a request names, as a mask: a gantry's name stands for its
     /// sides, no name for `default`. An unknown name refuses the request
     /// (`None`).
-    fn axes_of(&self, axes: &Axes, default: u64, r: &mut ControlResponse) -> Option<u64> {
+    pub(super) fn axes_of(
+        &self,
+        axes: &Axes,
+        default: u64,
+        r: &mut ControlResponse,
+    ) -> Option<u64> {
         let names = axes.names();
         match self.resolve(names) {
             Ok(0) => Some(default),
@@ -157,10 +162,10 @@ impl ControlThread {
         }
     }
 
-    /// A gantry is homed as one machine axis: all its sides or none. False
-    /// (and the request refused, naming the sides) when a gantry is named
-    /// in part.
-    fn whole_gantries(&self, mask: u64, r: &mut ControlResponse) -> bool {
+    /// A gantry is homed (and jogged, moved, streamed, enabled, …) as one
+    /// machine axis: all its sides or none. False (and the request refused,
+    /// naming the sides) when a gantry is named in part.
+    pub(super) fn whole_gantries(&self, mask: u64, r: &mut ControlResponse) -> bool {
         let m = &self.s.machine;
         let named = |i: &usize| mask & (1 << i) != 0;
         let partial: Vec<_> = (m.gantries.iter())
@@ -182,7 +187,8 @@ impl ControlThread {
                 .find(|(i, _)| named(i) && g.axes.contains(i))
                 .map_or("an axis", |(_, a)| a.name.as_str());
             why.push(format!(
-                "{side} is a side of gantry {} (sides {}): home {} or all its sides",
+                "{side} is a side of gantry {} (sides {}): name {} or all its sides (a gantry \
+                 is homed, jogged, moved and streamed as one axis)",
                 g.name,
                 sides.join(", "),
                 g.name
@@ -194,7 +200,12 @@ impl ControlThread {
 
     /// The cycle's answer for every axis of `mask` into the response, in
     /// config order: whether all were accepted, and why not, in words.
-    fn answers(&self, mask: u64, ack: &Ack, r: &mut ControlResponse) -> (bool, Vec<String>) {
+    pub(super) fn answers(
+        &self,
+        mask: u64,
+        ack: &Ack,
+        r: &mut ControlResponse,
+    ) -> (bool, Vec<String>) {
         let m = &self.s.machine;
         let mut all = true;
         let mut why = Vec::new();
@@ -203,7 +214,7 @@ impl ControlThread {
                 continue;
             }
             let x = ack.axes[i];
-            r.push_answer(&a.name, outcome(x));
+            r.push_axis(&a.name, i, outcome(x), ack.op_ids[i]);
             if x.accepted() {
                 continue;
             }
@@ -215,6 +226,14 @@ impl ControlThread {
                 continue;
             };
             let mut w = match reason {
+                Reason::Owned => format!(
+                    "{}: {} ({})",
+                    a.name,
+                    reason.text(),
+                    self.owners
+                        .name_of(self.owner_token(i))
+                        .unwrap_or("a program")
+                ),
                 Reason::IoNotAttached => format!(
                     "{}: its I/O process {} is not attached",
                     a.name, m.ios[a.io].name
@@ -234,7 +253,7 @@ impl ControlThread {
     }
 
     /// The request's result and message, and its log line.
-    fn verdict(
+    pub(super) fn verdict(
         &self,
         what: &str,
         mask: u64,
@@ -263,6 +282,17 @@ impl ControlThread {
 }
 
 /// The cycle did not answer in time.
-fn no_answer(r: &mut ControlResponse) {
+pub(super) fn no_answer(r: &mut ControlResponse) {
     r.refuse("the real-time cycle did not answer (shutting down or stalled)");
+}
+
+impl ControlThread {
+    /// The owner token of axis `i` in the newest snapshot (0: none).
+    fn owner_token(&self, i: usize) -> u64 {
+        let hub = self.hub.lock();
+        hub.snapshot
+            .as_deref()
+            .and_then(|s| s.axes.get(i))
+            .map_or(0, |a| a.owner)
+    }
 }

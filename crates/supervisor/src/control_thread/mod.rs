@@ -15,6 +15,9 @@
 //!
 //! * `axes.rs` — home, stop, unhome, trace: names → axes, the gantry rule,
 //!   the cycle's answer per axis, the keeper, the log line;
+//! * `ops.rs` — enable, disable, reset, jog (and its renewals), move, the
+//!   setpoint stream's acquire and release; `owners.rs` — the programs
+//!   that own axes and whether their nodes are alive (every 100 ms);
 //! * `pages.rs` — status, statistics, trace and histogram log, paged;
 //! * `answer.rs` — the cycle's answers (domain words) as the wire's reasons;
 //! * `pump.rs` — what the cycle hands over (snapshots, histograms, trace
@@ -22,6 +25,8 @@
 
 pub(crate) mod answer;
 mod axes;
+mod ops;
+mod owners;
 mod pages;
 mod pump;
 
@@ -34,6 +39,7 @@ use crate::shared::{Ack, Control, Phase, Shared};
 use crate::status_fill;
 use motion_config::MachineConfig;
 use motion_control::{ControlRequest, ControlResponse, Request, Server};
+use motion_homing::Operation;
 use motion_ipc::Domain;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -116,6 +122,7 @@ struct ControlThread {
     ios: pump::IoWatch,
     all_mask: u64,
     keeper: Keeper,
+    owners: owners::Owners,
 }
 
 impl ControlThread {
@@ -134,8 +141,10 @@ impl ControlThread {
         let orders: Vec<Option<u32>> = s.machine.axes.iter().map(|a| a.home_order).collect();
         let all_mask = crate::core::sequence::Sequencer::new(&orders).all_mask();
         let keeper = Keeper::open(&s.machine);
+        let owners = owners::Owners::new(s.domain.iceoryx2_config().ok());
         Self {
             keeper,
+            owners,
             ios: pump::IoWatch::new(s.machine.ios.len()),
             s,
             shared,
@@ -157,6 +166,7 @@ impl ControlThread {
                 log::warn!("control service: {e}");
             }
             self.hub.lock().requests_refused = server.refused();
+            self.check_owners();
             if Instant::now() >= next_status {
                 next_status += period;
                 if Instant::now() > next_status {
@@ -180,9 +190,11 @@ impl ControlThread {
         };
         let uptime = hub.started.elapsed().as_nanos() as u64;
         let notes = self.keeper.notes();
-        if let Err(e) =
-            server.publish_status(|f| status_fill::fill(&self.s.machine, snap, notes, uptime, f))
-        {
+        let owners = &self.owners;
+        if let Err(e) = server.publish_status(|f| {
+            status_fill::fill(&self.s.machine, snap, notes, uptime, f);
+            status_fill::owners(snap, |t| owners.name_of(t), f);
+        }) {
             log::warn!("status service: {e}");
         }
     }
@@ -236,6 +248,52 @@ impl ControlThread {
             Ok(Request::TraceFetch { axis, offset }) => {
                 self.paged(pages::PageKey::Trace(axis), false, offset, r)
             }
+            Ok(Request::Enable { axes }) => self.operation("enable", &axes, Operation::Enable, r),
+            Ok(Request::Disable { axes }) => {
+                self.operation("disable", &axes, Operation::Disable, r)
+            }
+            Ok(Request::Reset { axes }) => self.operation("reset", &axes, Operation::Reset, r),
+            Ok(Request::Jog {
+                axes,
+                speed,
+                accel,
+                decel,
+                lease_ms,
+            }) => {
+                let op = Operation::Jog {
+                    speed,
+                    accel: accel.unwrap_or(f64::NAN),
+                    decel: decel.unwrap_or(f64::NAN),
+                    lease_ns: u64::from(lease_ms) * 1_000_000,
+                };
+                self.jog(&axes, op, r)
+            }
+            Ok(Request::JogRenew { axes, token, end }) => self.jog_renew(&axes, token, end, r),
+            Ok(Request::Move {
+                axes,
+                position,
+                relative,
+                speed,
+                accel,
+                decel,
+                supersede,
+            }) => {
+                let op = Operation::Move {
+                    target: position,
+                    relative,
+                    speed: speed.unwrap_or(f64::NAN),
+                    accel: accel.unwrap_or(f64::NAN),
+                    decel: decel.unwrap_or(f64::NAN),
+                    supersede,
+                };
+                self.operation("move", &axes, op, r)
+            }
+            Ok(Request::StreamAcquire {
+                axes,
+                owner,
+                node_id,
+            }) => self.stream_acquire(&axes, &owner, node_id, r),
+            Ok(Request::StreamRelease { token }) => self.stream_release(token, r),
             Err(e) => r.bad_request(&e.to_string()),
         }
     }

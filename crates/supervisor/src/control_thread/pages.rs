@@ -29,6 +29,7 @@ impl ControlThread {
                 let uptime = hub.started.elapsed().as_nanos() as u64;
                 let notes = self.keeper.notes();
                 status_fill::fill(&self.s.machine, s, notes, uptime, &mut frame);
+                status_fill::owners(s, |t| self.owners.name_of(t), &mut frame);
             }
         }
         let json = serde_json::to_vec(&frame.to_report()).unwrap_or_default();

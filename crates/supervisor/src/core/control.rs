@@ -4,19 +4,21 @@
 //! sides) were applied by the control thread before; these are the ones
 //! only the cycle can judge (in process, attached, busy, leaving).
 
-use motion_homing::codes::ERR_ILLEGAL_HOMING_CONFIG;
+use motion_homing::codes::{ERR_AXIS_FAULTED, ERR_EXECUTION_COLLISION, ERR_ILLEGAL_HOMING_CONFIG};
 
+use super::ops::Then;
 use super::Core;
 use crate::shared::{Ack, AxisAck, Control, Refusal};
 
 /// The axes of `mask` among the first `n`, in index order.
-fn named(mask: u64, n: usize) -> impl Iterator<Item = usize> {
+pub(super) fn named(mask: u64, n: usize) -> impl Iterator<Item = usize> {
     (0..n.min(64)).filter(move |&i| mask & (1 << i) != 0)
 }
 
 impl Core {
     /// Applies one control request; requests with an id are answered (with
-    /// the cycle in which they take effect: the next step).
+    /// the cycle in which they take effect: the next step) — the operations
+    /// an engine must judge after that step ([`Core::answers`]).
     pub fn control(&mut self, c: Control, now_ns: u64) -> Option<Ack> {
         let mut ack = match c {
             Control::Home {
@@ -35,6 +37,31 @@ impl Core {
                 self.exit();
                 return None;
             }
+            Control::Op {
+                id,
+                mask,
+                op,
+                token,
+            } => {
+                let then = match op {
+                    motion_homing::Operation::Jog { .. } => Then::Jog(token),
+                    _ => Then::Nothing,
+                };
+                self.op(Ack::new(id), mask, op, then)?
+            }
+            Control::JogRenew {
+                id,
+                token,
+                mask,
+                end,
+            } => self.jog_renew(Ack::new(id), token, mask, end),
+            Control::StreamAcquire { id, mask, token } => self.op(
+                Ack::new(id),
+                mask,
+                motion_homing::Operation::StreamStart,
+                Then::Own(token),
+            )?,
+            Control::StreamRelease { id, token } => self.stream_release(Ack::new(id), token)?,
         };
         ack.cycle = self.cycle + 1;
         Some(ack)
@@ -46,8 +73,27 @@ impl Core {
         if self.exiting {
             return Some(Refusal::Exiting);
         }
+        if self.stream.owner_of(i) != 0 {
+            return Some(Refusal::Owned);
+        }
         if slot.status().ip || slot.rung.pending > 0 {
             return Some(Refusal::AlreadyHoming);
+        }
+        // The engine would refuse these too, by the Home instruction's ER —
+        // which would overwrite the axis fault's own ERR / EXERR: answered
+        // here instead, and the engine never sees the rung rise.
+        let s = slot.status();
+        if s.faulted {
+            return Some(Refusal::Instruction {
+                err: ERR_AXIS_FAULTED,
+                exerr: 0,
+            });
+        }
+        if s.jogging || s.moving || s.streaming {
+            return Some(Refusal::Instruction {
+                err: ERR_EXECUTION_COLLISION,
+                exerr: 0,
+            });
         }
         if self.seq.busy() & (1 << i) != 0 {
             return Some(Refusal::Busy);
@@ -156,9 +202,11 @@ impl Core {
         ack
     }
 
-    /// Leaving: stop every axis; the drives are disabled once at rest.
+    /// Leaving: stop every axis (setpoints are no longer taken); the drives
+    /// are disabled once at rest.
     fn exit(&mut self) {
         self.exiting = true;
+        self.stream.drop_axes(u64::MAX);
         for s in &mut self.slots {
             s.rung.pending = 0;
             s.rung.request.home = false;

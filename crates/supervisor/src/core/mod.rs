@@ -18,22 +18,30 @@
 //! * [`sequence`] — home order and the failure of a home sequence.
 //! * [`gantry`] — the sides of a gantry homed in lockstep.
 //! * [`trace`] — recording one homing cycle by cycle.
+//! * `ops` — the operations around homing (enable … move, the stream's
+//!   acquire and release): delivery, the engines' answers, gantries whole.
+//! * [`stream`] — the setpoint stream's owners and intake.
 
 mod control;
 pub mod gantry;
 pub mod link;
+mod ops;
 pub mod sequence;
 pub mod slot;
+pub mod stream;
 pub mod trace;
 
 use crate::shared::{Snapshot, TraceRecord};
 use gantry::GantryCoord;
 use link::IoLink;
 use motion_config::MachineConfig;
+use motion_frames::SetpointFrame;
 use motion_frames::{CommandFrame, FeedbackFrame};
 use motion_homing::codes::{ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, EX_TERMINATED_ON_REQUEST};
+use ops::{Pending, MAX_PENDING};
 use sequence::{Action, AxisView, Sequencer};
 pub use slot::AxisSlot;
+pub use stream::StreamIntake;
 use trace::Tracer;
 
 /// What one cycle measured, for the statistics.
@@ -56,9 +64,19 @@ pub struct Core {
     exiting: bool,
     cycle: u64,
     all_mask: u64,
+    /// Per axis, the axis whose configuration and setpoints a request for
+    /// it uses: itself, or its gantry's first side.
+    lead: Vec<usize>,
+    /// Per gantry, its sides.
+    gantry_mask: Vec<u64>,
+    /// Operations delivered this cycle, answered after the step.
+    pending: [Option<Pending>; MAX_PENDING],
+    stream: StreamIntake,
 }
 
 impl Core {
+    /// The cycle's work for machine `m`; setpoint frames are refused until
+    /// [`Core::with_session_key`] names the key they must carry.
     pub fn new(m: &MachineConfig) -> Self {
         let sup = &m.supervisor;
         let links: Vec<IoLink> = (0..m.ios.len())
@@ -80,7 +98,21 @@ impl Core {
             .iter()
             .map(|g| GantryCoord::new(g, &cfgs, sup.cycle_ns()))
             .collect();
+        let lead: Vec<usize> = (0..m.axes.len())
+            .map(|i| {
+                m.gantry_of(i)
+                    .and_then(|g| m.gantries[g].axes.iter().copied().min())
+                    .unwrap_or(i)
+            })
+            .collect();
+        let gantry_mask = (m.gantries.iter())
+            .map(|g| g.axes.iter().fold(0u64, |k, &i| k | 1 << i))
+            .collect();
         Self {
+            stream: StreamIntake::new(None, &lead),
+            lead,
+            gantry_mask,
+            pending: [None; MAX_PENDING],
             slots: (m.axes.iter().enumerate())
                 .map(|(i, a)| AxisSlot::new(a, m.gantry_of(i)))
                 .collect(),
@@ -131,8 +163,31 @@ impl Core {
         let info = self.intake(now_ns, stalled, frames);
         self.sequences(now_ns);
         self.gantries();
+        self.hand_setpoints();
         self.engines(now_ns, stalled);
+        self.op_upkeep();
         info
+    }
+
+    /// Setpoint frames must carry `key` (this session's).
+    pub fn with_session_key(mut self, key: [u64; 2]) -> Self {
+        self.stream.set_key(key);
+        self
+    }
+
+    /// Before the frames of a cycle: last cycle's setpoints are forgotten.
+    pub fn setpoints_begin(&mut self) {
+        self.stream.begin_cycle();
+    }
+
+    /// One received setpoint frame (the intake judges it).
+    pub fn setpoints_take(&mut self, f: &SetpointFrame) {
+        self.stream.take(f);
+    }
+
+    /// After a step: the answers of the operations delivered in it.
+    pub fn answers(&mut self, each: impl FnMut(crate::shared::Ack)) {
+        self.op_answers(each);
     }
 
     /// Stage 1: every link judges its frame (attached, gaps, reconnection)
@@ -287,9 +342,12 @@ impl Core {
                 timed_out: self.seq.timed_out(i),
                 in_sequence: busy & (1 << i) != 0 || slot.rung.pending > 0,
                 traced: self.tracer.armed() == Some(i),
+                owner: self.stream.owner_of(i),
                 ..slot.snap()
             };
         }
+        s.stream = self.stream.counts;
+        s.owners = self.stream.owner_count();
         s.io_count = self.links.len();
         for (k, l) in self.links.iter().enumerate() {
             s.ios[k] = l.snap();
@@ -301,6 +359,8 @@ impl Core {
 
 #[cfg(test)]
 mod fuzz;
+#[cfg(test)]
+mod stream_fuzz;
 #[cfg(test)]
 pub(crate) mod testbench;
 #[cfg(test)]

@@ -3,9 +3,11 @@
 //! status reports about it. The cycle's stages walk the slots in order; an
 //! axis's data sits together in memory.
 //!
-//! (The operations of issue 15 — enable, reset, jog, move, a supervised
-//! setpoint stream — are per-axis state too: they belong here, beside the
-//! rung, and their requests beside `control.rs`'s.)
+//! The operations around homing (enable, reset, jog, move, the supervised
+//! setpoint stream) travel in the same `Request` as the rung (`op`,
+//! `setpoint`, `jog_renew`, one step each); what the cycle keeps of them
+//! per axis — the jog's token, the operation id before a request — is
+//! here too, and their rules are in `ops.rs`.
 
 use motion_frames::{axis_to_feedback, AxisFeedback, SW_NO_DATA};
 use motion_homing::{Axis, Command, Feedback, Phase, Request, Status};
@@ -153,6 +155,16 @@ pub struct AxisSlot {
     pub(super) command: Command,
     /// The gantry side whose failure stopped it.
     pub(super) gantry_aborted_by: Option<u8>,
+    /// The hold-to-run jog running on the axis: its token (0: none) and
+    /// the engine's operation id.
+    pub(super) jog_token: u64,
+    pub(super) jog_op: u32,
+    /// The engine's operation id before this cycle's operation was given
+    /// (a new id after the step: accepted).
+    pub(super) op_before: u32,
+    /// `Status::faulted` after the previous step (its rising edge stops a
+    /// gantry's other sides).
+    pub(super) was_faulted: bool,
 }
 
 impl AxisSlot {
@@ -170,6 +182,10 @@ impl AxisSlot {
             drive_error: 0,
             command: Command::default(),
             gantry_aborted_by: None,
+            jog_token: 0,
+            jog_op: 0,
+            op_before: 0,
+            was_faulted: false,
         }
     }
 
@@ -223,9 +239,13 @@ impl AxisSlot {
         if self.feedback.is_some() && self.engine.sampled_ns() == Some(now_ns) {
             self.last_feedback = self.feedback;
         }
-        // Stop is a one-cycle pulse (the engine takes its rising edge).
+        // Stop is a one-cycle pulse (the engine takes its rising edge); an
+        // operation, a setpoint and a renewal count in their step only.
         self.rung.request.stop = false;
         self.rung.request.stop_code = None;
+        self.rung.request.op = None;
+        self.rung.request.setpoint = None;
+        self.rung.request.jog_renew = false;
         if started {
             self.homed.started();
         } else {
@@ -276,6 +296,7 @@ impl AxisSlot {
             lost_cause: self.homed.cause,
             offset: a.reference_offset(),
             restored: self.homed.restored && a.status().homed,
+            cmd_axis: c.position.is_finite().then(|| a.to_axis(c.position)),
             ..AxisSnap::default()
         }
     }

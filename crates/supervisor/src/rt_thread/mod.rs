@@ -4,12 +4,15 @@
 //! One cycle (`run` reads as this list):
 //! 1. sleep to the absolute deadline (`clock_nanosleep`, TIMER_ABSTIME);
 //! 2. take control requests (lock-free queue), answer them (lock-free
-//!    queue): `control_queue`;
+//!    queue): `control_queue`; then every setpoint frame programs
+//!    published since the last cycle (a bounded drain of the setpoint
+//!    subscriber, checked by the core's intake): `setpoints`;
 //! 3. take the newest feedback frame of every I/O process — the answer to
 //!    the previous cycle's command, which arrived while we slept:
 //!    `IoPorts::receive`;
 //! 4. step every axis's homing engine and the home sequences: `Core::step`
-//!    (`IoPorts::step`);
+//!    (`IoPorts::step`), then answer the operations the engines judged in
+//!    that step: `answers`;
 //! 5. publish one command frame per I/O process and notify each:
 //!    `IoPorts::publish`;
 //! 6. record wake-up latency and compute time (and the I/O round trip, from
@@ -29,12 +32,13 @@
 //! for the no-allocation test.
 
 mod record;
+mod setpoints;
 
 use crate::core::{Core, CycleInfo};
 use crate::shared::{Phase, Shared, MAX_IOS};
 use motion_config::MachineConfig;
 use motion_frames::FeedbackFrame;
-use motion_ipc::{Domain, IpcError, SupervisorPorts};
+use motion_ipc::{Domain, IpcError, SetpointSubscriber, SupervisorPorts};
 use motion_rt::{enter_realtime, now_ns, rt_pool, PeriodicTimer, RtConfig, RtReport};
 use record::Recorder;
 use std::sync::atomic::Ordering;
@@ -152,16 +156,24 @@ fn body(s: RtSettings, shared: &Shared) -> RtOutcome {
             return out;
         }
     };
-    let mut core = Core::new(&s.machine);
+    let mut sp = match SetpointSubscriber::create(&node, &s.domain) {
+        Ok(sp) => sp,
+        Err(e) => {
+            out.error = Some(format!("setpoint stream: {e}"));
+            return out;
+        }
+    };
+    let mut core = Core::new(&s.machine).with_session_key(s.domain.key);
     let mut rec = Recorder::new(&s, shared);
     if let Err(e) = rt_pool::enter(s.pool_bytes) {
         out.error = Some(format!("real-time allocation pool: {e:?}"));
         return out;
     }
     shared.set_phase(Phase::Running);
-    out.cycles = run(&s, shared, &mut core, &mut io, &mut rec);
+    out.cycles = run(&s, shared, &mut core, &mut io, &mut sp, &mut rec);
     out.pool = rt_pool::thread_stats();
     // Tear down outside the loop: releasing iceoryx2 resources allocates.
+    drop(sp);
     drop(io);
     drop(node);
     out
@@ -174,6 +186,7 @@ fn run(
     shared: &Shared,
     core: &mut Core,
     io: &mut IoPorts,
+    sp: &mut SetpointSubscriber,
     rec: &mut Recorder,
 ) -> u64 {
     let period = s.machine.supervisor.cycle_ns();
@@ -182,7 +195,8 @@ fn run(
     loop {
         let wake = timer.wait();
         cycle += 1;
-        control_queue(shared, core, wake.deadline_ns);
+        control_queue(shared, core, sp, wake.deadline_ns);
+        setpoints::receive(sp, core);
         io.receive(core);
         // Woke more than a quarter cycle late (or missed a deadline): the CPU the
         // I/O process shares was taken away too, and this thread, of higher
@@ -190,6 +204,7 @@ fn run(
         let stalled = wake.missed > 0 || wake.latency_ns > period / 4;
         let info = io.step(core, wake.deadline_ns, stalled);
         io.publish(core);
+        answers(shared, core);
         let t_published = now_ns();
         trace_record(shared, core);
         rec.cycle(
@@ -215,16 +230,25 @@ fn run(
     }
 }
 
-/// Takes every request of the control queue and answers each one.
+/// Takes every request of the control queue and answers each one (an
+/// operation only after the step its engines judge it in: `answers`).
 /// Bounded: the queue holds at most 256 requests.
-fn control_queue(shared: &Shared, core: &mut Core, now_ns: u64) {
+fn control_queue(shared: &Shared, core: &mut Core, sp: &mut SetpointSubscriber, now_ns: u64) {
     while let Some(c) = shared.control.pop() {
+        setpoints::before(sp, &c);
         if let Some(ack) = core.control(c, now_ns) {
             // The answering side drains this queue every few ms; if it
             // is full the requester times out and says so.
             let _ = shared.acks.push(ack);
         }
     }
+}
+
+/// The answers of the operations the engines judged in this cycle's step.
+fn answers(shared: &Shared, core: &mut Core) {
+    core.answers(|ack| {
+        let _ = shared.acks.push(ack);
+    });
 }
 
 /// This cycle's trace record, if a trace is recording, to the control

@@ -1,0 +1,176 @@
+//! What every part of the stream bench shares: the machine (N linear axes,
+//! immediate homing: homed where they stand, no motion), a daemon started
+//! and ready, its axes homed and enabled through the control service, and
+//! the streaming program — a thread of this process at the stream's rate
+//! that takes the axes over and publishes one setpoint per axis per tick
+//! through `motion_control`'s [`Stream`](motion_control::stream::Stream),
+//! the Rust client the issue asks for.
+
+use motion_bench::drive::{self, Binaries};
+use motion_bench::machine::Supervisor;
+use motion_bench::proc::Running;
+use motion_control::{Axes, Client, Request, RESULT_ACCEPTED};
+use motion_rt::{enter_realtime, now_ns, PeriodicTimer, RtConfig};
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// `counts_per_unit` of every axis: 1e5, so consecutive setpoints of the
+/// latency ramp (≥ 25 counts apart) are told apart in the command frames.
+pub const COUNTS_PER_UNIT: f64 = 1e5;
+
+/// A machine of `n` axes `A00`.. (immediate homing, all `home_order = 0`,
+/// travel ±1000, max_speed 100, stream_acceleration from home_acceleration
+/// 1000 → 10,000 u/s²).
+pub fn machine(s: &Supervisor, n: usize) -> String {
+    let mut t = format!(
+        "# Written by motion-bench stream: {n} linear axes, immediate homing.\n\
+         [supervisor]\ncycle_us = {}\ncpu = {}\npriority = {}\nio = \"sim\"\nservice_prefix = \"{}\"\n\n",
+        s.cycle_us, s.cpu, s.priority, s.service_prefix
+    );
+    for i in 0..n {
+        let _ = write!(
+            t,
+            "[[axis]]\nname = \"A{i:02}\"\ncounts_per_unit = {COUNTS_PER_UNIT}\n\
+             home_sequence = \"immediate\"\nhome_order = 0\nhome_speed = 10.0\n\
+             home_return_speed = 2.0\nhome_acceleration = 1000.0\nhome_deceleration = 1000.0\n\
+             max_speed = 100.0\ntravel_limits = [-1000.0, 1000.0]\n\
+             [axis.sim]\nstart = 0.0\nhard_stop = [-1100.0, 1100.0]\n\n"
+        );
+    }
+    t
+}
+
+/// The axis names of [`machine`].
+pub fn names(n: usize) -> Vec<String> {
+    (0..n).map(|i| format!("A{i:02}")).collect()
+}
+
+/// A daemon of `toml` under `prefix`, ready with its I/O process attached.
+pub fn daemon(b: &Binaries, tmp: &Path, prefix: &str, toml: &str) -> Result<Running, String> {
+    let cfg = tmp.join(format!("{prefix}.toml"));
+    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
+    drive::start_run(b, &cfg, prefix, Duration::from_secs(20)).map_err(|e| format!("{prefix}: {e}"))
+}
+
+/// Homes (immediate: no motion) and enables every axis, and waits until
+/// all are homed with their drives enabled.
+pub fn prepare(prefix: &str, n: usize) -> Result<(), String> {
+    let mut c = Client::connect(prefix, None).map_err(|e| e.to_string())?;
+    let all = Axes::All;
+    let home = Request::Home {
+        axes: all.clone(),
+        parallel: true,
+        timeout_s: None,
+    };
+    for r in [home, Request::Enable { axes: all }] {
+        let resp = c
+            .send(&r, Duration::from_secs(3))
+            .map_err(|e| e.to_string())?;
+        if resp.result != RESULT_ACCEPTED {
+            return Err(format!("{r:?} refused: {}", resp.message_text()));
+        }
+    }
+    let until = Instant::now() + Duration::from_secs(10);
+    loop {
+        let st = c
+            .status(Duration::from_secs(2))
+            .map_err(|e| e.to_string())?;
+        let ready = st.axes().iter().take(n).all(|a| {
+            a.has(motion_control::ST_HOMED) && a.motion_has(motion_control::MS_SERVO_ACTION)
+        });
+        if ready {
+            return Ok(());
+        }
+        if Instant::now() > until {
+            return Err("the axes were not homed and enabled within 10 s".into());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Positions of every axis at tick `k`.
+pub type Shape = Box<dyn Fn(u64) -> Vec<f64> + Send>;
+
+/// A streaming program: a thread that owns the axes and publishes one
+/// frame per tick.
+pub struct Streamer {
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<Result<Vec<u64>, String>>>,
+}
+
+impl Streamer {
+    /// Starts streaming `names` under `prefix`: a frame every `period_ns`
+    /// (program time `t_ns = k × period`), pinned to `cpu` at SCHED_FIFO
+    /// `priority` (0: normal). The publish times are kept for the latency
+    /// (`CLOCK_MONOTONIC` right before each publish).
+    pub fn start(
+        prefix: &str,
+        names: Vec<String>,
+        period_ns: u64,
+        (cpu, priority): (usize, i32),
+        shape: Shape,
+    ) -> Streamer {
+        let stop = Arc::new(AtomicBool::new(false));
+        let (s, prefix) = (stop.clone(), prefix.to_string());
+        let thread = std::thread::Builder::new()
+            .name("mb-stream".into())
+            .spawn(move || {
+                let rt = RtConfig {
+                    cpu: Some(cpu),
+                    priority: priority.max(1),
+                    lock_memory: false,
+                    ..RtConfig::default()
+                };
+                if priority > 0 {
+                    let _ = enter_realtime(&rt);
+                } else {
+                    let _ = motion_rt::thread::pin_to_cpu(cpu);
+                }
+                run(&prefix, &names, period_ns, &s, shape)
+            })
+            .ok();
+        Streamer { stop, thread }
+    }
+
+    /// Stops and releases the stream; the publish time of every tick.
+    pub fn finish(mut self) -> Result<Vec<u64>, String> {
+        self.stop.store(true, Ordering::Release);
+        match self.thread.take().map(JoinHandle::join) {
+            Some(Ok(r)) => r,
+            Some(Err(_)) => Err("the streaming thread panicked".into()),
+            None => Err("the streaming thread did not start".into()),
+        }
+    }
+}
+
+/// The streaming thread's body.
+fn run(
+    prefix: &str,
+    names: &[String],
+    period_ns: u64,
+    stop: &AtomicBool,
+    shape: Shape,
+) -> Result<Vec<u64>, String> {
+    let mut c = Client::connect(prefix, None).map_err(|e| e.to_string())?;
+    let mut s = c.stream("mb-stream", names).map_err(|e| e.to_string())?;
+    let mut sent = Vec::with_capacity(1 << 20);
+    let mut timer = PeriodicTimer::new(period_ns);
+    let mut k = 0u64;
+    while !stop.load(Ordering::Acquire) {
+        timer.wait();
+        k += 1;
+        let p = shape(k);
+        let t = now_ns();
+        s.publish(k * period_ns, &p, None)
+            .map_err(|e| e.to_string())?;
+        if sent.len() < sent.capacity() {
+            sent.push(t);
+        }
+    }
+    s.release().map_err(|e| e.to_string())?;
+    Ok(sent)
+}

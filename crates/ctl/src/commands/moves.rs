@@ -1,0 +1,81 @@
+//! `move AXIS (--to P | --by D) [--speed V] [--accel A] [--decel D]
+//! [--no-wait] [--json] [--supersede]` (MAM): waits like `home`; exit 0
+//! only when every axis ended at its target.
+
+use super::{client_error, fail, signal_code, EXIT_FAILED, EXIT_OK};
+use crate::cli::MoveArgs;
+use motion_control::follow::{follow, followed};
+use motion_control::progress::Progress;
+use motion_control::*;
+use motion_report::{print_json, AcceptedReport, MotionReport};
+use std::time::Duration;
+
+/// How long a move may take before `motionctl` gives up following it (the
+/// move itself goes on: stop it with `stop`).
+const FOLLOW_WALL: Duration = Duration::from_secs(86_400);
+
+pub fn move_axis(client: &mut Client, a: &MoveArgs) -> i32 {
+    let spec = MoveSpec {
+        axes: vec![a.axis.clone()],
+        position: a.to.or(a.by).unwrap_or(f64::NAN),
+        relative: a.to.is_none(),
+        speed: a.speed,
+        accel: a.accel,
+        decel: a.decel,
+        supersede: a.supersede,
+    };
+    let resp = match client.move_axes(&spec) {
+        Ok(r) => r,
+        Err(e) => return op_error(a.json, "move", &e),
+    };
+    if a.no_wait {
+        let names: Vec<String> = resp.answers().iter().map(|x| get_str(&x.name)).collect();
+        if a.json {
+            print_json(&AcceptedReport { accepted: names });
+        } else {
+            println!("move started: {}", names.join(" "));
+        }
+        return EXIT_OK;
+    }
+    let mut progress = Progress::new();
+    let outcome = follow(
+        client,
+        &followed(&resp),
+        resp.cycle,
+        FOLLOW_WALL,
+        |st, members| progress.show_motion(st, members),
+        || motion_rt::termination::received().is_some(),
+    );
+    match outcome {
+        Err(e) => client_error(a.json, &e),
+        Ok((rows, _)) => report(a.json, MotionReport { axes: rows }),
+    }
+}
+
+/// Prints the rows (JSON or a table) and returns the exit code: the
+/// signal's, else 0 when every axis ended as asked.
+pub fn report(json: bool, r: MotionReport) -> i32 {
+    if json {
+        print_json(&r);
+    } else {
+        print!("{}", motion_report::table::motion_rows(&r.axes));
+    }
+    match signal_code() {
+        Some(code) => code,
+        None if r.succeeded() => EXIT_OK,
+        None => EXIT_FAILED,
+    }
+}
+
+/// A refused or failed operation request: the reason per axis, exit 1 (or
+/// the client's exit code).
+pub fn op_error(json: bool, what: &str, e: &OpError) -> i32 {
+    match e {
+        OpError::Client(e) => client_error(json, e),
+        OpError::Refused(resp) => fail(
+            json,
+            resp.refusal(what, |x| x.reason != REASON_NONE),
+            EXIT_FAILED,
+        ),
+    }
+}

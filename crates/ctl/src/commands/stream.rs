@@ -1,0 +1,198 @@
+//! `stream AXIS... --csv FILE [--json]`: plays a file of timed setpoints
+//! through the supervised setpoint stream — the commissioning tool and the
+//! reference client of the stream. The file is checked first; then the
+//! axes are acquired (owner "motionctl"), the rows published at their times
+//! (filled in where rows are further apart than 10 ms), the axes released
+//! once the last setpoint is reached, and followed to rest. Progress on
+//! stderr; at the end one row per axis with the largest following error
+//! seen (command − actual, from the 100 Hz status) and the final error
+//! (last row − final position).
+//!
+//! Exit: 0 when every axis streamed to the end and was released normally,
+//! 1 when refused or an axis stopped with an error (a refused setpoint:
+//! ERR 1019), 130 / 143 when interrupted (the stream released: the axes
+//! stop).
+
+use super::csv::{self, Row};
+use super::moves::{op_error, report};
+use super::{client_error, fail, EXIT_FAILED};
+use crate::cli::StreamArgs;
+use motion_control::follow::{follow, followed, Followed};
+use motion_control::progress::Progress;
+use motion_control::stream::{Stream, StreamError};
+use motion_control::*;
+use motion_report::{ErrorEntry, MotionReport, MotionRow};
+use std::time::Duration;
+
+pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
+    let rows = match csv::read(&a.csv, a.axes.len()) {
+        Ok(r) => r,
+        Err(e) => return fail(a.json, vec![ErrorEntry::message(e)], super::EXIT_USAGE),
+    };
+    let points = csv::points(&rows);
+    let mut s = match client.stream("motionctl", &a.axes) {
+        Ok(s) => s,
+        Err(StreamError::Op(e)) => return op_error(a.json, "stream", &e),
+        Err(e) => {
+            return fail(
+                a.json,
+                vec![ErrorEntry::message(e.to_string())],
+                EXIT_FAILED,
+            )
+        }
+    };
+    let axes = followed(s.answer());
+    let column = columns(&s, &axes);
+    let cycle = s.answer().cycle;
+    let mut play = Play::new(axes.len());
+    let mut progress = Progress::new();
+    if let Err(e) = play.run(&mut s, &points, &axes, &mut progress) {
+        drop(s);
+        return client_error(a.json, &e);
+    }
+    // Released: followed by the stream ends' operations (PC: at rest on the
+    // last setpoint). Not released: already over on the supervisor's side
+    // (an axis stopped with an error ends the stream): followed by the
+    // stream's own operations, whose rows say why.
+    let (axes, cycle) = match s.release() {
+        Ok(resp) => (followed(&resp), resp.cycle),
+        Err(e) => {
+            log::debug!("release: {e}");
+            (axes, cycle)
+        }
+    };
+    let last = &rows[rows.len() - 1];
+    match follow(
+        client,
+        &axes,
+        cycle,
+        Duration::from_secs(600),
+        |st, m| progress.show_motion(st, m),
+        || false,
+    ) {
+        Err(e) => client_error(a.json, &e),
+        Ok((rows, _)) => {
+            let rows = rows
+                .into_iter()
+                .zip(&column)
+                .zip(&play.max_error)
+                .map(|((r, &k), &m)| with_errors(r, last.p.get(k).copied(), m))
+                .collect();
+            report(a.json, MotionReport { axes: rows })
+        }
+    }
+}
+
+/// For each followed axis, the file column that moves it (a gantry side:
+/// its gantry's column).
+fn columns(s: &Stream, axes: &[Followed]) -> Vec<usize> {
+    axes.iter()
+        .map(|f| {
+            (s.map().axes.iter())
+                .position(|m| m.sides.contains(&(f.index as u32)))
+                .unwrap_or(0)
+        })
+        .collect()
+}
+
+/// A row with its following errors.
+fn with_errors(mut r: MotionRow, last: Option<f64>, max: f64) -> MotionRow {
+    r.following_error_max = Some(motion_report::round(max, 6));
+    r.final_error = match (last, r.position) {
+        (Some(l), Some(p)) => Some(motion_report::round(l - p, 6)),
+        _ => None,
+    };
+    r
+}
+
+/// Playing the points.
+struct Play {
+    /// Per followed axis, the largest |command − actual| seen.
+    max_error: Vec<f64>,
+}
+
+impl Play {
+    fn new(n: usize) -> Self {
+        Self {
+            max_error: vec![0.0; n],
+        }
+    }
+
+    /// Publishes every point at its time (the program's clock:
+    /// CLOCK_MONOTONIC from the first point), watching the status between
+    /// points; stops early on a signal or when an axis no longer streams.
+    /// Then waits until the last setpoint is commanded.
+    fn run(
+        &mut self,
+        s: &mut Stream,
+        points: &[Row],
+        axes: &[Followed],
+        progress: &mut Progress,
+    ) -> Result<(), ClientError> {
+        let t0 = motion_rt::now_ns();
+        let first = points[0].t;
+        let at = |p: &Row| t0 + ((p.t - first) * 1e9) as u64;
+        let mut next_look = t0;
+        for p in points {
+            let t = at(p);
+            while motion_rt::now_ns() < t {
+                std::thread::sleep(Duration::from_nanos(
+                    (t - motion_rt::now_ns()).min(2_000_000),
+                ));
+            }
+            if motion_rt::termination::received().is_some() {
+                return Ok(());
+            }
+            if let Err(e) = s.publish(t, &p.p, None) {
+                log::error!("{e}");
+                return Ok(());
+            }
+            if motion_rt::now_ns() >= next_look {
+                next_look = motion_rt::now_ns() + 50_000_000;
+                if !self.look(s, axes, progress)? {
+                    return Ok(());
+                }
+            }
+        }
+        // The last segment takes its own length to be reached: then the
+        // stream is released (the engine lands the axis on the last
+        // setpoint). Not longer: a stream silent longer than the axis's
+        // stream_timeout_ms (default 50) after its last setpoint stops the
+        // axis with an error.
+        let last = points
+            .len()
+            .checked_sub(2)
+            .map_or(0.0, |k| points[k + 1].t - points[k].t);
+        std::thread::sleep(Duration::from_secs_f64(last.min(csv::FILL_S)));
+        Ok(())
+    }
+
+    /// One look at the status: the following errors, the progress; false
+    /// when an axis no longer streams.
+    fn look(
+        &mut self,
+        s: &mut Stream,
+        axes: &[Followed],
+        progress: &mut Progress,
+    ) -> Result<bool, ClientError> {
+        let st = s.client().status(Duration::from_secs(2))?;
+        let members: Vec<usize> = axes.iter().map(|a| a.index).collect();
+        progress.show_motion(&st, &members);
+        let mut streaming = true;
+        for (k, f) in axes.iter().enumerate() {
+            let Some(e) = st.axes().get(f.index) else {
+                continue;
+            };
+            if e.has(ST_FEEDBACK) && e.motion_has(MS_COMMAND) {
+                let err = (e.cmd_position - e.position).abs();
+                if err.is_finite() {
+                    self.max_error[k] = self.max_error[k].max(err);
+                }
+            }
+            if st.cycle > s.answer().cycle && !e.motion_has(MS_STREAMING) {
+                streaming = false;
+            }
+        }
+        Ok(streaming)
+    }
+}

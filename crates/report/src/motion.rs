@@ -1,0 +1,72 @@
+//! `move --json` and `stream --json` (interface.md): one row per axis, how
+//! its operation ended; and the operation part of `status --json`.
+
+use serde::{Deserialize, Serialize};
+
+/// How one axis's move or stream ended.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MotionRow {
+    pub name: String,
+    /// The operation ended as asked: the move at its target, the stream
+    /// released normally.
+    pub pc: bool,
+    /// An error: the operation was refused, or an axis fault stopped it.
+    pub er: bool,
+    pub err: u16,
+    pub exerr: u16,
+    /// Axis position at the end, units.
+    pub position: Option<f64>,
+    /// `stream`: the largest following error seen (command − actual, from
+    /// the 100 Hz status), and the last setpoint − the final position,
+    /// units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub following_error_max: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub final_error: Option<f64>,
+    /// What went wrong, in words (absent when nothing did).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// `move --json`, `stream --json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MotionReport {
+    pub axes: Vec<MotionRow>,
+}
+
+impl MotionReport {
+    /// Every axis ended as asked.
+    pub fn succeeded(&self) -> bool {
+        !self.axes.is_empty() && self.axes.iter().all(|r| r.pc && !r.er)
+    }
+}
+
+/// The last operation of an axis, in `status --json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct OpReport {
+    /// Incremented by the engine for every accepted operation (0: none yet).
+    pub id: u32,
+    /// `enable`, `disable`, `reset`, `jog`, `move`, `stream`, `stop`, or
+    /// `none`.
+    pub kind: String,
+    pub ip: bool,
+    pub pc: bool,
+    /// ERR / EXERR of a refusal (0 / 0 when accepted).
+    pub err: u16,
+    pub exerr: u16,
+}
+
+/// The setpoint stream's intake, in `status --json`.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct StreamIntake {
+    pub frames: u64,
+    pub setpoints: u64,
+    pub refused_layout: u64,
+    pub refused_key: u64,
+    pub refused_count: u64,
+    pub refused_token: u64,
+    pub refused_sequence: u64,
+    pub refused_axis: u64,
+    pub acquired: u32,
+    pub owners: u32,
+}

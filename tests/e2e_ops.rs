@@ -1,0 +1,558 @@
+//! The operations of issue 15 end to end, through real processes: the
+//! daemon and its `motion-io` (sim), `motionctl` and a Rust program of the
+//! setpoint stream. The machine is `tests/machines/ops.toml`: X and Z
+//! (immediate homing, soft limits ±20 while homed, hard stops ±40 that
+//! fault the drive when pushed into), gantry G (G1, G2).
+//!
+//! Timing bounds are checked as distances (how far an axis went after its
+//! client died), never as wall-clock times.
+
+use motion_control::stream::Stream;
+use motion_control::Client;
+use motion_harness::*;
+use motion_report::{AxisStatus, ErrorReport, MotionReport};
+use nix::sys::signal::Signal;
+use std::time::Duration;
+
+fn ops(tag: &str) -> TempConfig {
+    Machine::fixture("ops").write(tag)
+}
+
+/// Waits (at most `secs`) until axis `name` satisfies `f`; its status then.
+#[track_caller]
+fn wait_axis(d: &Daemon, name: &str, secs: u64, f: impl Fn(&AxisStatus) -> bool) -> AxisStatus {
+    let mut last = AxisStatus::default();
+    let ok = wait_for(Duration::from_secs(secs), || {
+        last = d.axis(name);
+        f(&last)
+    });
+    assert!(ok, "{name} never got there: {last:#?}");
+    last
+}
+
+/// At rest: no operation motion, not stopping.
+fn at_rest(a: &AxisStatus) -> bool {
+    !a.jogging && !a.moving && !a.streaming && !a.stopping && !a.op.ip
+}
+
+fn pos(a: &AxisStatus) -> f64 {
+    value(a.position, &a.name)
+}
+
+/// `motionctl ARGS --json` refused (exit 1) with ERR `err` / EXERR `exerr`.
+#[track_caller]
+fn refused_with(d: &Daemon, args: &[&str], err: u16, exerr: u16) {
+    let mut all = args.to_vec();
+    all.push("--json");
+    let r = d.ctl(&all);
+    let e: ErrorReport = r.expect_code(1).report();
+    assert!(
+        e.errors
+            .iter()
+            .any(|x| x.err == Some(err) && x.exerr == Some(exerr)),
+        "{args:?}: expected ERR {err} EXERR {exerr}: {}",
+        r.stdout
+    );
+}
+
+/// `motionctl move ... --json`, its one row.
+#[track_caller]
+fn move_json(d: &Daemon, args: &[&str], code: i32) -> motion_report::MotionRow {
+    let mut all = vec!["move"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let r = d.ctl(&all);
+    let m: MotionReport = r.expect_code(code).report();
+    m.axes.into_iter().next().expect("a row")
+}
+
+#[test]
+fn enable_jog_stop_move_and_reset_after_a_drive_fault() {
+    let _serial = serial();
+    let cfg = ops("ops_basic");
+    let d = Daemon::start(&cfg, &["io"]);
+    let x = d.axis("X");
+    assert!(
+        !x.enabled && !x.servo_action,
+        "nothing enabled by itself: {x:#?}"
+    );
+
+    // servo off: jog and move refused (ERR 5), nothing moves
+    refused_with(&d, &["jog", "X", "--speed", "5"], 5, 0);
+    refused_with(&d, &["move", "X", "--to", "1"], 5, 0);
+
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.enabled && a.servo_action);
+
+    // jog until `stop`: a normal end (no ER), motionctl exits 0
+    let mut jog = spawn_motionctl(&["--service-prefix", &cfg.prefix, "jog", "X", "--speed", "5"]);
+    wait_axis(&d, "X", 5, |a| a.jogging && pos(a) > 0.5);
+    d.ctl(&["stop", "X"]).expect_code(0);
+    let x = wait_axis(&d, "X", 5, at_rest);
+    assert!(!x.er && !x.faulted && x.enabled, "{x:#?}");
+    assert_eq!(x.last_stop, "operator");
+    assert_eq!(
+        jog.wait_exit(Duration::from_secs(5)).and_then(|s| s.code()),
+        Some(0)
+    );
+
+    // move to a target, then by a distance: PC, at the target
+    let row = move_json(&d, &["X", "--to", "5"], 0);
+    assert!(row.pc && !row.er, "{row:#?}");
+    assert!(
+        (value(row.position, "X") - 5.0).abs() <= 2.0 * COUNT,
+        "{row:#?}"
+    );
+    let row = move_json(&d, &["X", "--by", "-2", "--speed", "4"], 0);
+    assert!(
+        (value(row.position, "X") - 3.0).abs() <= 2.0 * COUNT,
+        "{row:#?}"
+    );
+
+    // a drive fault mid-jog: unhomed (no soft limits), the jog pushes into
+    // the hard stop at 40; the following error faults the drive
+    let r = d.ctl(&["jog", "X", "--speed", "10", "--json"]);
+    let m: MotionReport = r.expect_code(1).report();
+    assert!(m.axes[0].er, "{}", r.stdout);
+    let x = wait_axis(&d, "X", 5, at_rest);
+    assert!(x.er && x.faulted && !x.enabled, "{x:#?}");
+    assert_eq!((x.err, x.exerr), (12, 16), "{x:#?}");
+    assert_eq!(x.last_stop, "drive_fault");
+
+    // faulted: everything but reset/stop/disable refused (ERR 20)
+    refused_with(&d, &["move", "X", "--to", "0"], 20, 0);
+    refused_with(&d, &["enable", "X"], 20, 0);
+    refused_with(&d, &["home", "X", "--no-wait"], 20, 0);
+
+    // reset: the fault is gone, nothing enabled or moved by itself
+    d.ctl(&["reset", "X"]).expect_code(0);
+    let x = wait_axis(&d, "X", 5, |a| !a.faulted && !a.er);
+    assert!(!x.enabled && !x.fault, "{x:#?}");
+    let p = pos(&x);
+    std::thread::sleep(Duration::from_millis(200));
+    assert!((pos(&d.axis("X")) - p).abs() <= COUNT, "moved after reset");
+
+    // enable again and move away from the stop
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.servo_action);
+    let row = move_json(&d, &["X", "--to", "0"], 0);
+    assert!(
+        row.pc && (value(row.position, "X")).abs() <= 2.0 * COUNT,
+        "{row:#?}"
+    );
+
+    // disable: drive off
+    d.ctl(&["disable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| !a.enabled && !a.servo_action);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn software_overtravel_is_enforced_when_homed_and_not_after_unhome() {
+    let _serial = serial();
+    let cfg = ops("ops_soft");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["home", "X"]).expect_code(0);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
+
+    // a move outside the travel limits: refused, ERR 13 / EXERR 4
+    refused_with(&d, &["move", "X", "--to", "25"], 13, 4);
+    // above max_speed: ERR 13 / EXERR 1
+    refused_with(&d, &["move", "X", "--to", "5", "--speed", "50"], 13, 1);
+
+    // a jog towards the limit stops inside it, normally (no ER)
+    let r = d.ctl(&["jog", "X", "--speed", "10", "--json"]);
+    let m: MotionReport = r.expect_code(0).report();
+    let end = value(m.axes[0].position, "X");
+    assert!(end <= 20.0 + COUNT && end > 19.0, "{}", r.stdout);
+    let x = d.axis("X");
+    assert!(!x.er && x.last_stop == "soft_limit", "{x:#?}");
+    // at the limit, a jog further out is refused
+    refused_with(&d, &["jog", "X", "--speed", "1"], 13, 4);
+
+    // unhome: no soft limits any more
+    d.ctl(&["unhome", "X"]).expect_code(0);
+    let row = move_json(&d, &["X", "--to", "25"], 0);
+    assert!(row.pc && (value(row.position, "X") - 25.0).abs() <= 2.0 * COUNT);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn a_jogging_motionctl_killed_stops_within_its_lease() {
+    let _serial = serial();
+    let cfg = ops("ops_jogkill");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.servo_action);
+    let (v, decel) = (2.0, 100.0);
+    let mut jog = spawn_motionctl(&["--service-prefix", &cfg.prefix, "jog", "X", "--speed", "2"]);
+    wait_axis(&d, "X", 5, |a| a.jogging && pos(a) > 0.2);
+    jog.signal(Signal::SIGKILL);
+    let at_kill = pos(&d.axis("X"));
+    let x = wait_axis(&d, "X", 5, at_rest);
+    // hold to run: the lease (500 ms) runs out, a normal stop
+    assert!(!x.er, "{x:#?}");
+    assert_eq!(x.last_stop, "lease_expired");
+    // bound: the lease after the last renewal (renewed every 100 ms), the
+    // status's 10 ms, the stop at the jog's deceleration
+    let bound = v * (0.5 + 0.1 + 0.05) + v * v / (2.0 * decel);
+    let went = pos(&x) - at_kill;
+    assert!(went <= bound, "went {went} after the kill, bound {bound}");
+    let _ = jog.wait_exit(Duration::from_secs(1));
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+/// A CSV of `t,x` rows: a smooth ramp from 0 to `to` over `secs`, at `hz`.
+fn ramp_csv(dir: &TempDir, name: &str, to: f64, secs: f64, hz: f64) -> String {
+    let path = dir.file(name);
+    let n = (secs * hz) as usize;
+    let mut text = String::from("t,x\n");
+    for k in 0..=n {
+        let t = k as f64 / hz;
+        let s = t / secs;
+        // 3s² − 2s³: starts and ends at rest
+        text += &format!("{t},{}\n", to * s * s * (3.0 - 2.0 * s));
+    }
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn a_stream_played_from_csv_ends_at_the_expected_position() {
+    let _serial = serial();
+    // A silence of the program longer than stream_timeout_ms stops the
+    // stream (its own test below); here, on a busy CI machine, motionctl
+    // may be descheduled for tens of ms: 500 ms keeps this test about the
+    // positions.
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_timeout_ms", 500)
+        .write("ops_csv");
+    let d = Daemon::start(&cfg, &["io"]);
+    // not homed: refused (ERR 1019 / EXERR 7 would be the engine's; the
+    // acquire answers with the instruction's code)
+    d.ctl(&["enable", "X"]).expect_code(0);
+    d.ctl(&["home", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
+    let dir = TempDir::new("ops_csv");
+    let csv = ramp_csv(&dir, "ramp.csv", 4.0, 1.0, 100.0);
+    let r = d.ctl(&["stream", "X", "--csv", &csv, "--json"]);
+    let m: MotionReport = r.expect_code(0).report();
+    let row = &m.axes[0];
+    assert!(row.pc && !row.er, "{}", r.stdout);
+    assert!(
+        (value(row.position, "X") - 4.0).abs() <= 2.0 * COUNT,
+        "{}",
+        r.stdout
+    );
+    assert!(row.following_error_max.is_some() && row.final_error.is_some());
+    let x = d.axis("X");
+    assert!(x.owner.is_none() && !x.streaming, "{x:#?}");
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn the_owner_killed_mid_stream_stops_the_axis_within_the_bound() {
+    let _serial = serial();
+    let cfg = ops("ops_ownerkill");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["home", "X"]).expect_code(0);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
+    let dir = TempDir::new("ops_ownerkill");
+    // 1 u/s for 10 s at 100 rows/s
+    let csv = dir.file("slow.csv");
+    let rows: String = (0..=1000)
+        .map(|k| format!("{},{}\n", k as f64 / 100.0, k as f64 / 100.0))
+        .collect();
+    std::fs::write(&csv, rows).unwrap();
+    let mut s = spawn_motionctl(&[
+        "--service-prefix",
+        &cfg.prefix,
+        "stream",
+        "X",
+        "--csv",
+        &csv,
+    ]);
+    let x = wait_axis(&d, "X", 5, |a| a.streaming && pos(a) > 0.5);
+    assert_eq!(x.owner.as_deref(), Some("motionctl"), "{x:#?}");
+    s.signal(Signal::SIGKILL);
+    let at_kill = pos(&d.axis("X"));
+    let x = wait_axis(&d, "X", 5, at_rest);
+    // Whichever comes first: the stream silent longer than
+    // stream_timeout_ms (50) after the last setpoint (10 ms apart) was
+    // reached — ERR 1019 / EXERR 5, a stop at max_deceleration
+    // (home_deceleration 100) — or the owner's node found gone (checked
+    // every 100 ms) — released, a normal stop. Bound: the first, plus a
+    // cycle and the stop.
+    if x.er {
+        assert!(x.faulted, "{x:#?}");
+        assert_eq!((x.err, x.exerr), (1019, 5), "{x:#?}");
+        assert_eq!(x.last_stop, "setpoint_refused");
+    } else {
+        assert_eq!(x.last_stop, "released", "{x:#?}");
+    }
+    let (v, decel) = (1.0, 100.0);
+    let bound = v * (0.05 + 0.01 + 0.001) + v * v / (2.0 * decel);
+    let went = pos(&x) - at_kill;
+    assert!(went <= bound, "went {went} after the kill, bound {bound}");
+    // the ownership ended with it
+    wait_axis(&d, "X", 2, |a| a.owner.is_none());
+    let _ = s.wait_exit(Duration::from_secs(1));
+    if x.er {
+        d.ctl(&["reset", "X"]).expect_code(0);
+        wait_axis(&d, "X", 5, |a| !a.faulted);
+    }
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+/// A program's stream of `axes`, already enabled and homed.
+fn stream<'c>(c: &'c mut Client, axes: &[&str]) -> Stream<'c> {
+    let names: Vec<String> = axes.iter().map(|s| s.to_string()).collect();
+    c.stream("e2e", &names).expect("acquired")
+}
+
+/// Publishes `p` for the first axis of `s` at program time `t_ms`.
+fn put(s: &mut Stream, t_ms: u64, p: f64) {
+    s.publish(t_ms * 1_000_000, &[p], None).expect("published");
+}
+
+/// Home, enable and wait for X and Z.
+fn ready(d: &Daemon) {
+    d.ctl(&["home", "X"]).expect_code(0);
+    d.ctl(&["home", "Z"]).expect_code(0);
+    d.ctl(&["enable", "X", "Z"]).expect_code(0);
+    wait_axis(d, "X", 5, |a| a.homed && a.servo_action);
+    wait_axis(d, "Z", 5, |a| a.homed && a.servo_action);
+}
+
+/// Streams `bad` after a few good setpoints at 1 kHz (`bad` gets the last
+/// one's time and position); the axis must stop with ERR 1019 / `exerr`,
+/// never past the travel limit, and be reset.
+#[track_caller]
+fn stops_with(d: &Daemon, c: &mut Client, exerr: u16, bad: impl FnOnce(&mut Stream, u64, f64)) {
+    let start = pos(&d.axis("X"));
+    {
+        let mut s = stream(c, &["X"]);
+        let (mut t, mut p) = (1_000, start);
+        for _ in 1..=50 {
+            t += 1;
+            p += 0.001;
+            put(&mut s, t, p);
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        bad(&mut s, t, p);
+        let x = wait_axis(d, "X", 5, |a| !a.streaming && at_rest(a));
+        assert!(x.er, "{x:#?}");
+        assert_eq!((x.err, x.exerr), (1019, exerr), "{x:#?}");
+        assert!(pos(&x).abs() <= 20.0 + COUNT, "past the limit: {x:#?}");
+        let _ = s.release();
+    }
+    d.ctl(&["reset", "X"]).expect_code(0);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(d, "X", 5, |a| !a.faulted && a.servo_action);
+}
+
+#[test]
+fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
+    let _serial = serial();
+    // stream_timeout_ms 300 (not 50): the test's own pauses (a status
+    // read, a descheduled thread) must not read as a silent program; the
+    // silence has its case below.
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_timeout_ms", 300)
+        .write("ops_bad");
+    let d = Daemon::start(&cfg, &["io"]);
+    ready(&d);
+    let mut c = Client::connect(&cfg.prefix, None).expect("client");
+
+    // NaN / inf: 1019 / 1
+    stops_with(&d, &mut c, 1, |s, t, _| put(s, t + 1, f64::NAN));
+    stops_with(&d, &mut c, 1, |s, t, _| put(s, t + 1, f64::INFINITY));
+    // outside travel_limits: 1019 / 2, never past the limit
+    stops_with(&d, &mut c, 2, |s, t, _| put(s, t + 1, 30.0));
+    // a jump beyond max_speed (20 u/s: 1 unit in 1 ms): 1019 / 3
+    stops_with(&d, &mut c, 3, |s, t, p| put(s, t + 1, p + 1.0));
+    // silent: 1019 / 5
+    stops_with(&d, &mut c, 5, |_, _, _| {
+        std::thread::sleep(Duration::from_millis(600))
+    });
+    // out of order (a time not after the previous): 1019 / 6
+    stops_with(&d, &mut c, 6, |s, t, p| put(s, t - 5, p));
+
+    // a second owner: refused ERR 3; home, jog and move on an owned axis
+    // too (the owner, a thread, holds X where it stands meanwhile)
+    let x0 = pos(&d.axis("X"));
+    {
+        let _holder = Holder::start(&cfg.prefix, "X", x0);
+        let mut c2 = Client::connect(&cfg.prefix, None).expect("client");
+        match c2.stream("second", &["X".to_string()]) {
+            Err(motion_control::stream::StreamError::Op(motion_control::OpError::Refused(r))) => {
+                assert!(
+                    r.answers().iter().any(|a| a.err == 3),
+                    "{}",
+                    r.message_text()
+                );
+            }
+            other => panic!("a second owner was not refused: {:?}", other.err()),
+        }
+        refused_with(&d, &["jog", "X", "--speed", "1"], 3, 0);
+        refused_with(&d, &["move", "X", "--to", "1"], 3, 0);
+        refused_with(&d, &["home", "X", "--no-wait"], 3, 0);
+        let x = d.axis("X");
+        assert_eq!(x.owner.as_deref(), Some("e2e"), "{x:#?}");
+        assert!(x.streaming && !x.er, "{x:#?}");
+    }
+    // released by its owner: a normal end
+    let x = wait_axis(&d, "X", 5, |a| a.owner.is_none() && at_rest(a));
+    assert!(!x.er, "{x:#?}");
+    assert_eq!(x.last_stop, "released");
+
+    // a replayed sequence number, a frame without the session key,
+    // setpoints for an axis the stream does not own: refused and counted,
+    // nothing moves (sent last: the frame for Z is the token's, so its
+    // sequence number counts)
+    let (x0, z0) = (pos(&d.axis("X")), pos(&d.axis("Z")));
+    let before = d.status().stream;
+    let domain = c_domain(&cfg.prefix);
+    let node = domain.create_node("forger").unwrap();
+    let mut raw = motion_ipc::SetpointPublisher::open(&node, &domain).unwrap();
+    {
+        let mut s = stream(&mut c, &["X"]);
+        let token = s.token();
+        for k in 0..5 {
+            put(&mut s, 2_000 + 10 * k, x0);
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let z_index = 1; // Z is the second axis of the machine
+        for (seq, key, axis) in [
+            (1, domain.key, 0),
+            (1000, [1, 2], 0),
+            (1001, domain.key, z_index),
+        ] {
+            raw.publish_raw(|f| {
+                f.layout_version = motion_frames::SETPOINT_LAYOUT;
+                f.key = key;
+                f.token = token;
+                f.seq = seq;
+                f.t_ns = 5_000_000_000;
+                f.count = 1;
+                f.axes[0].axis = axis;
+                f.axes[0].position = 10.0;
+            })
+            .unwrap();
+        }
+        s.release().expect("released");
+    }
+    let after = d.status().stream;
+    assert!(after.refused_axis > before.refused_axis, "{after:?}");
+    assert!(
+        after.refused_sequence > before.refused_sequence,
+        "{after:?}"
+    );
+    assert!(after.refused_key > before.refused_key, "{after:?}");
+    let x = wait_axis(&d, "X", 5, at_rest);
+    assert!(!x.er && (pos(&x) - x0).abs() <= COUNT, "{x:#?}");
+    assert!((pos(&d.axis("Z")) - z0).abs() <= COUNT, "Z moved");
+    // the test's own nodes go before the daemon
+    drop((raw, node, c));
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+/// A program holding `axis` at `at` (a setpoint every 10 ms), from a
+/// thread of its own, until dropped (then it releases the axis).
+struct Holder {
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Holder {
+    fn start(prefix: &str, axis: &str, at: f64) -> Holder {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let stop = std::sync::Arc::new(AtomicBool::new(false));
+        let (tx, rx) = std::sync::mpsc::channel();
+        let (p, a, s) = (prefix.to_string(), axis.to_string(), stop.clone());
+        let thread = std::thread::spawn(move || {
+            let mut c = Client::connect(&p, None).expect("client");
+            let mut st = stream(&mut c, &[&a]);
+            let _ = tx.send(());
+            let mut t = 1_000;
+            while !s.load(Ordering::Acquire) {
+                put(&mut st, t, at);
+                t += 10;
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            st.release().expect("released");
+        });
+        rx.recv_timeout(Duration::from_secs(5)).expect("acquired");
+        Holder {
+            stop,
+            thread: Some(thread),
+        }
+    }
+}
+
+impl Drop for Holder {
+    fn drop(&mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Release);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// The domain of the daemon under `prefix` (a forger with the session file).
+fn c_domain(prefix: &str) -> motion_ipc::Domain {
+    motion_ipc::Domain::join(prefix, None).expect("joined")
+}
+
+#[test]
+fn a_gantry_jogs_moves_and_streams_as_one_axis_never_a_side_alone() {
+    let _serial = serial();
+    let cfg = ops("ops_gantry");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["home", "G"]).expect_code(0);
+    d.ctl(&["enable", "G"]).expect_code(0);
+    wait_axis(&d, "G2", 5, |a| a.homed && a.servo_action);
+    // a side alone: refused with the reason
+    for args in [
+        &["move", "G1", "--to", "1", "--json"][..],
+        &["jog", "G2", "--speed", "1", "--json"],
+        &["enable", "G1", "--json"],
+    ] {
+        let r = d.ctl(args);
+        r.expect_code(1);
+        assert!(r.stdout.contains("gantry"), "{}", r.stdout);
+    }
+    // a move of the gantry: both sides, each at the target
+    let r = d.ctl(&["move", "G", "--to", "3", "--json"]);
+    let m: MotionReport = r.expect_code(0).report();
+    assert_eq!(m.axes.len(), 2, "{}", r.stdout);
+    for row in &m.axes {
+        assert!(row.pc && (value(row.position, &row.name) - 3.0).abs() <= 2.0 * COUNT);
+    }
+    // a stream of the gantry: its setpoints move both sides
+    let dir = TempDir::new("ops_gantry");
+    let rows: String = (0..=100)
+        .map(|k| format!("{},{}\n", k as f64 / 100.0, 3.0 + k as f64 / 100.0))
+        .collect();
+    let csv = dir.file("g.csv");
+    std::fs::write(&csv, rows).unwrap();
+    let r = d.ctl(&["stream", "G", "--csv", &csv, "--json"]);
+    let m: MotionReport = r.expect_code(0).report();
+    for row in &m.axes {
+        assert!(
+            (value(row.position, &row.name) - 4.0).abs() <= 2.0 * COUNT,
+            "{}",
+            r.stdout
+        );
+    }
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
