@@ -31,6 +31,10 @@ pub enum Phase {
     Stopping = 9,
     /// Creeping back over a marker found at speed (drives without a latch).
     Creep = 10,
+    /// `home_reverse_at_limit`: a limit switch ended the seek before the home
+    /// switch; running back at Home Speed past the home switch, to search
+    /// again from its near side.
+    Reverse = 11,
 }
 
 crate::spellings!(Phase {
@@ -45,6 +49,7 @@ crate::spellings!(Phase {
     Passive => "passive",
     Stopping => "stopping",
     Creep => "creep",
+    Reverse => "reverse",
 });
 
 /// Feedback refused as implausible, by kind, counted over the axis's life.
@@ -138,4 +143,7 @@ pub struct Status {
     pub lost_after_ns: Option<u64>,
     /// Implausible feedback refused so far.
     pub implausible: Implausible,
+    /// `home_reverse_at_limit`: this homing met the limit switch in Home
+    /// Direction before the home switch and reversed its search.
+    pub reversed_at_limit: bool,
 }
