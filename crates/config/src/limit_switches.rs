@@ -8,7 +8,7 @@
 //! beyond them; now a switch is actuated at its end, as the home switch is
 //! at the ends of its interval. Giving both is a problem.
 
-use crate::keys::{num, Reader};
+use crate::keys::Reader;
 use crate::limits::POSITION;
 use crate::Problem;
 use motion_homing::AxisConfig;
@@ -93,18 +93,14 @@ pub(crate) fn check_sim(
     } else {
         ("negative", lo - stop_lo)
     };
-    {
-        if room < needed {
-            problems.push(Problem::new(
-                Some(axis),
-                "sim.limit_switches",
-                format!(
-                    "the {side} limit switch ends {} units before the hard stop; a seek at \
-                     home_speed stops up to {} units past it ({why})",
-                    num(room),
-                    num(needed)
-                ),
-            ));
-        }
+    if room < needed {
+        problems.push(Problem::new(
+            Some(axis),
+            "sim.limit_switches",
+            format!(
+                "the {side} limit switch ends {room:.3} units before the hard stop; a seek at \
+                 home_speed stops up to {needed:.3} units past it ({why})"
+            ),
+        ));
     }
 }
