@@ -205,6 +205,12 @@ impl Plant {
         self.limits.break_wire();
     }
 
+    /// Both NC limit inputs read actuated now: the wire-break fault's cause
+    /// (a drive model names it in its error code).
+    pub fn limit_wire_break(&self) -> bool {
+        self.limits.wire_break(self.position)
+    }
+
     /// Tests: the home switch is moved by `shift` along the axis (a worn
     /// switch, a loose bracket) while everything else stays as it is; a
     /// non-finite shift changes nothing.
