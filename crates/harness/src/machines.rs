@@ -47,6 +47,10 @@ const FIXTURES: &[(&str, &str)] = &[
         "io_marker",
         include_str!("../../../tests/machines/io_marker.toml"),
     ),
+    (
+        "limits",
+        include_str!("../../../tests/machines/limits.toml"),
+    ),
 ];
 
 /// `[supervisor]` keys every test machine gets unless it sets them: 1 kHz
