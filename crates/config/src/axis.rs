@@ -1,6 +1,7 @@
 //! `[[axis]]` and its `[axis.sim]`.
 
 use crate::keys::Reader;
+use crate::limit_switches;
 use crate::limits::*;
 use crate::{names, AxisEntry, IoConfig, Problem, SupervisorConfig};
 use motion_homing::{validate, AxisConfig};
@@ -28,6 +29,13 @@ pub(crate) fn parse(
     let sim_table = r.table("sim");
     r.finish();
     let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
+    if ios
+        .get(io)
+        .is_none_or(|i| i.backend == crate::IoBackend::Sim)
+    {
+        let cycle_s = f64::from(sup.cycle_us) * 1e-6;
+        limit_switches::check_sim(&name, &engine, &sim, cycle_s, problems);
+    }
     engine_problems(&name, &engine, problems, before);
     (problems.len() == before).then_some(AxisEntry {
         name,
@@ -169,6 +177,7 @@ fn engine(r: &mut Reader<'_>, sup: &SupervisorConfig) -> AxisConfig {
         stream_acceleration: d.stream_acceleration,
         stream_timeout_ns: d.stream_timeout_ns,
         stream_unhomed: d.stream_unhomed,
+        home_reverse_at_limit: r.bool("home_reverse_at_limit", false),
     };
     // A switch edge sampled once per cycle is known to a cycle of travel at
     // return speed; a marker closer than two such cycles to it is ambiguous.
@@ -216,7 +225,10 @@ fn parse_sim(
         marker_every: r.f64_in("marker_every", 0.0, 0.0, POSITION, "units"),
         marker_at: r.f64_in("marker_at", 0.0, -POSITION, POSITION, "units"),
         hard_stop: r.interval("hard_stop", POSITION),
-        overtravel: r.interval("overtravel", POSITION),
+        overtravel: limit_switches::read(&mut r),
+        limit_switches_normally_closed: r.bool("limit_switches_normally_closed", false),
+        // The probe input is wired to the switch the axis homes on.
+        registration_input: limit_switches::registration_input(engine),
         external_speed: r.f64_in("external_speed", 0.0, -SPEED, SPEED, "units/s"),
         push_gain: r.f64_in("push_gain", d.push_gain, 0.0, 1e6, "% per unit"),
         inertia_gain: r.f64_in("inertia_gain", d.inertia_gain, 0.0, 1e3, "% per unit/s²"),

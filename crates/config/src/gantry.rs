@@ -113,6 +113,21 @@ fn lockstep_checks(gantry: &str, sides: &[usize], axes: &[AxisEntry], problems: 
             format!("gantry {gantry}: sides must home actively with a sequence that moves"),
         ));
     }
+    // A side that met its limit would reverse alone: its plan would leave
+    // the lockstep, and the gantry would rack.
+    for &i in sides
+        .iter()
+        .filter(|&&i| axes[i].engine.home_reverse_at_limit)
+    {
+        problems.push(Problem::new(
+            Some(&axes[i].name),
+            "home_reverse_at_limit",
+            format!(
+                "gantry {gantry}: a gantry's sides cannot reverse at a limit (one side would \
+                 reverse alone)"
+            ),
+        ));
+    }
     for &i in &sides[1..] {
         let b = &axes[i];
         let f = &b.engine;

@@ -19,6 +19,7 @@ pub mod file;
 mod gantry;
 mod io;
 mod keys;
+mod limit_switches;
 pub mod limits;
 pub mod names;
 pub mod opcua;

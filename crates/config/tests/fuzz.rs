@@ -21,7 +21,7 @@ const AXIS_KEYS: &[&str] = &[
     "home_torque_threshold", "home_torque_time", "home_timeout", "home_creep_speed",
     "search_limit", "torque_limit", "max_position", "travel_limits", "home_order",
     "enable_timeout", "marker_latch", "ethercat_position", "ethercat_name",
-    "ethercat_index_pulse_bit",
+    "ethercat_index_pulse_bit", "home_reverse_at_limit", "limit_switches",
 ];
 #[rustfmt::skip]
 const IO_KEYS: &[&str] = &[
@@ -32,6 +32,7 @@ const IO_KEYS: &[&str] = &[
 const SIM_KEYS: &[&str] = &[
     "start", "switch", "marker_every", "marker_at", "hard_stop", "overtravel",
     "external_speed", "push_gain", "inertia_gain", "friction", "enable_delay_cycles",
+    "limit_switches", "limit_switches_normally_closed",
 ];
 #[rustfmt::skip]
 const WORDS: &[&str] = &[
@@ -39,7 +40,7 @@ const WORDS: &[&str] = &[
     "linear", "cyclic", "active", "passive", "absolute", "bidirectional_forward",
     "unidirectional_reverse", "switch", "marker", "switch_then_marker", "torque_then_marker",
     "immediate", "X", "io", "bus0", "a/b", "\u{1b}[31m", "", "../x", "ethercat", "supervisor",
-    "eth0", "auto", "on", "off",
+    "eth0", "auto", "on", "off", "limit_switch", "limit_switch_then_marker",
 ];
 
 #[rustfmt::skip]

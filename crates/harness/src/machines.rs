@@ -48,6 +48,10 @@ const FIXTURES: &[(&str, &str)] = &[
         include_str!("../../../tests/machines/io_marker.toml"),
     ),
     ("ops", include_str!("../../../tests/machines/ops.toml")),
+    (
+        "limits",
+        include_str!("../../../tests/machines/limits.toml"),
+    ),
 ];
 
 /// `[supervisor]` keys every test machine gets unless it sets them: 1 kHz

@@ -33,11 +33,27 @@
 //! | 41   | 32    | *ours* travel limits empty or reversed |
 //! | 41   | 33    | *ours* absolute home mode on a non-absolute feedback device |
 //! | 41   | 34    | *ours* a homing speed the sequence commands is above `max_speed` |
+//! | 41   | 35    | *ours* limit-switch sequence with a unidirectional direction (the axis must come back off the limit) |
+//! | 41   | 36    | *ours* limit-switch sequence whose `home_offset` does not end the axis off the switch: it must point away from the limit, into the travel, by more than one cycle of travel at Home Return Speed |
+//! | 41   | 37    | *ours* `home_reverse_at_limit` on a sequence that cannot reverse (only active bidirectional switch and switch then marker can; a unidirectional search is refused here, not failed at the limit) |
+//! | 41   | 38    | *ours* limit-switch sequence or `home_reverse_at_limit` on an axis without limit switches (`limit_switches = false`, or a cyclic axis, which has no ends) |
 //! | 1014 | 0     | homing interrupted externally: the wrapper's code, kept for tools that map it; this engine reports every interruption it sees more precisely (a stop request or the supervisor shutting down: 12/1, a shutdown: 12/12, lost feedback: 12/40) |
 //! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
-//! | 1016 | leg | *ours* search limit: a search leg travelled farther than `search_limit`; EXERR names the leg: 2 seek, 5 return, 10 creep (an explicit mapping, kept equal to the numbers these legs' phases had when the code was introduced) |
+//! | 1016 | leg | *ours* search limit: a search leg travelled farther than `search_limit`; EXERR names the leg: 2 seek, 5 return, 10 creep, 11 reverse (the run back past the home switch after a limit, `home_reverse_at_limit`) (an explicit mapping, kept equal to the numbers these legs' phases had when the code was introduced) |
 //! | 1017 | 0     | *ours* gantry skew: the sides of a gantry found their events further apart than `max_skew` (reported by the coordinator through `Request::stop_code`) |
 //! | 1018 | 0     | *ours* ambiguous marker: switch then marker found its marker closer than `marker_min_distance` to the switch edge, and `refuse_ambiguous_marker` is set (axis stopped, not homed) |
+//!
+//! **Limit switches while homing** (12 / 43): a limit switch tripped in the
+//! direction of travel aborts homing, except where the sequence means to be
+//! on it: the seek of a limit-switch sequence and the stop on its limit, and
+//! the stop at the limit after which `home_reverse_at_limit` reverses the
+//! search — each for the limit in Home Direction only. The other limit, and
+//! that limit in any other leg (the return, the move home, the second seek
+//! after a reversal, the run back past the home switch, which meets the
+//! other limit when there is no home switch between the two), still abort
+//! with 12 / 43. A unidirectional sequence that reaches a limit also ends
+//! with 12 / 43 (it cannot reverse; `home_reverse_at_limit` is refused for
+//! it with 41 / 37).
 //!
 //! The operations around homing (issue 15: enable, disable, reset, jog,
 //! move, stop, the supervised stream) use the Logix codes the Logix motion
@@ -95,6 +111,7 @@ pub const ERR_AMBIGUOUS_MARKER: u16 = 1018;
 pub const EX_SEARCH_SEEK: u16 = 2;
 pub const EX_SEARCH_RETURN: u16 = 5;
 pub const EX_SEARCH_CREEP: u16 = 10;
+pub const EX_SEARCH_REVERSE: u16 = 11;
 
 // EXERR under ERR 12.
 pub const EX_TERMINATED_ON_REQUEST: u16 = 1;
@@ -166,3 +183,7 @@ pub const EX_SETPOINT_ACCELERATION: u16 = 4;
 pub const EX_SETPOINT_STALE: u16 = 5;
 pub const EX_SETPOINT_OUT_OF_ORDER: u16 = 6;
 pub const EX_SETPOINT_NOT_HOMED: u16 = 7;
+pub const EX_LIMIT_UNIDIRECTIONAL: u16 = 35;
+pub const EX_LIMIT_OFFSET: u16 = 36;
+pub const EX_REVERSE_NOT_APPLICABLE: u16 = 37;
+pub const EX_NO_LIMIT_SWITCHES: u16 = 38;

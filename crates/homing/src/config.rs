@@ -110,6 +110,15 @@ pub enum HomeSequence {
     SwitchThenMarker = 3,
     Torque = 4,
     TorqueThenMarker = 5,
+    /// *Ours* (CIP reserves 6..=255): the limit switch in Home Direction is
+    /// the reference (CiA 402 methods 17 / 18; PLCopen MC_StepLimitSwitch).
+    /// Seek it at Home Speed, stop on it, return off it at Home Return
+    /// Speed: the event is where it clears.
+    LimitSwitch = 6,
+    /// *Ours*: as [`LimitSwitch`](Self::LimitSwitch), then on at Home Return
+    /// Speed to the first marker after the clear point, which is the event
+    /// (CiA 402 methods 1 / 2).
+    LimitSwitchThenMarker = 7,
 }
 
 crate::spellings!(HomeSequence {
@@ -119,17 +128,33 @@ crate::spellings!(HomeSequence {
     SwitchThenMarker => "switch_then_marker",
     Torque => "torque",
     TorqueThenMarker => "torque_then_marker",
+    LimitSwitch => "limit_switch",
+    LimitSwitchThenMarker => "limit_switch_then_marker",
 });
 
 impl HomeSequence {
+    /// The sequence finds a switch edge: the home switch, or for the
+    /// limit-switch sequences the limit switch in Home Direction, which then
+    /// plays the home switch's part in every leg (see `plan`).
     pub fn uses_switch(self) -> bool {
-        matches!(self, Self::Switch | Self::SwitchThenMarker)
+        matches!(
+            self,
+            Self::Switch | Self::SwitchThenMarker | Self::LimitSwitch | Self::LimitSwitchThenMarker
+        )
     }
     pub fn uses_marker(self) -> bool {
         matches!(
             self,
-            Self::Marker | Self::SwitchThenMarker | Self::TorqueThenMarker
+            Self::Marker
+                | Self::SwitchThenMarker
+                | Self::TorqueThenMarker
+                | Self::LimitSwitchThenMarker
         )
+    }
+    /// The reference is the limit switch in Home Direction (the home switch
+    /// is not used).
+    pub fn uses_limit_switch(self) -> bool {
+        matches!(self, Self::LimitSwitch | Self::LimitSwitchThenMarker)
     }
     pub fn uses_torque(self) -> bool {
         matches!(self, Self::Torque | Self::TorqueThenMarker)
@@ -259,6 +284,13 @@ pub struct AxisConfig {
     pub stream_timeout_ns: u64,
     /// The stream may drive an axis that is not homed (no soft limits then).
     pub stream_unhomed: bool,
+    /// `home_reverse_at_limit` (CiA 402 methods 7–14 / 23–30): a bidirectional
+    /// switch or switch-then-marker search that reaches the limit switch in
+    /// Home Direction before the home switch stops, runs back past the home
+    /// switch, stops and searches again, so the event is the same switch
+    /// edge approached the same way as from the near side. Validation
+    /// refuses it for every other sequence and direction (ERR 41 / EXERR 37).
+    pub home_reverse_at_limit: bool,
 }
 
 impl Default for AxisConfig {
@@ -309,6 +341,7 @@ impl Default for AxisConfig {
             stream_acceleration: 0.0,
             stream_timeout_ns: 0,
             stream_unhomed: false,
+            home_reverse_at_limit: false,
         }
     }
 }

@@ -22,10 +22,13 @@
 //!   [`op_limits`]: the bounds they run within.
 //! * [`names`]: every enum's spellings, written once next to the enum.
 //! * [`time`]: ns ↔ s conversions, exact and cheap.
+//! * [`equivalent`]: the CiA 402 homing method and PLCopen function blocks
+//!   of the limit-switch sequences and of a search that reverses at a limit.
 
 pub mod axis;
 pub mod codes;
 pub mod config;
+pub mod equivalent;
 pub mod io;
 pub mod names;
 pub mod op_limits;

@@ -133,6 +133,12 @@ mod tests {
             Some(HomeSequence::TorqueThenMarker)
         );
         assert_eq!(Phase::from_number(10), Some(Phase::Creep));
-        assert_eq!(Phase::from_number(11), None);
+        assert_eq!(Phase::from_number(11), Some(Phase::Reverse));
+        assert_eq!(Phase::from_number(12), None);
+        assert_eq!(
+            HomeSequence::from_number(7),
+            Some(HomeSequence::LimitSwitchThenMarker)
+        );
+        assert_eq!(HomeSequence::from_number(8), None);
     }
 }

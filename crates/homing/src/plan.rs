@@ -13,6 +13,9 @@
 //! | torque | seek torque (event), stop, release, move home |
 //! | torque then marker | seek torque, stop, release, return to marker (event), stop, restore, move home |
 //! | unidirectional switch / marker / switch then marker | seek event, continue (on to Home Position, or stop) |
+//! | limit switch | seek limit, stop at limit, return until clear (event), stop, move home |
+//! | limit switch then marker | seek limit, stop at limit, return until clear then marker (event), stop, move home |
+//! | bidirectional switch (then marker), after a limit (`home_reverse_at_limit`) | seek switch — limit first: stop at limit, reverse past the switch, stop, then the whole plan above again |
 //!
 //! A passive sequence watches for its event (one leg); Immediate, and the
 //! Absolute home mode (immediate only), have no legs at all.
@@ -25,6 +28,25 @@
 //! A marker found by a search leg that is followed by a creep is rough; what
 //! an earlier search leg finds (switch detected, hard stop before a marker) is
 //! a waypoint of the sequence.
+//!
+//! **Limit switch as the reference.** In the limit-switch sequences the
+//! limit switch in Home Direction plays the home switch's part: the goals
+//! `Switch*` mean that switch (the engine's "reference switch", see
+//! `Axis::reference_switch_active`), and the plan is the bidirectional
+//! switch plan with [`Leg::StopAtLimit`] after the seek: the one stop, with
+//! the seek before it, during which that limit does not abort homing.
+//!
+//! **Reversing at a limit** (`home_reverse_at_limit`, CiA 402 methods 7–14 /
+//! 23–30). A limit switch in Home Direction met by the first seek of a
+//! bidirectional switch (then marker) sequence, before the home switch,
+//! replaces the plan by its reversed form ([`after_reversal`]): the same leg
+//! 0, then stop at the limit, run back at Home Speed until the home switch
+//! has been passed entirely ([`Leg::Pass`]), stop — now on the near side —
+//! and the original plan from its seek. The event is therefore the same
+//! switch edge, approached in the same direction, as from a near-side start;
+//! leg indices only grow, so a coordinator reading `Status::leg` sees legs
+//! go by as usual. A reversal happens once: a limit in the second seek is an
+//! overtravel (12 / 43).
 //!
 //! **Switch active at start** (spec §4): a bidirectional switch sequence skips
 //! its seek and stop and starts with the return leg
@@ -58,6 +80,15 @@ pub enum Leg {
     Seek(Goal),
     /// Decelerate at Home Deceleration to rest.
     Stop,
+    /// Decelerate at Home Deceleration to rest on the limit switch in Home
+    /// Direction: after the seek of a limit-switch sequence, or where a
+    /// limit reversed the search. That limit does not abort homing in this
+    /// leg (nor in a limit-switch sequence's seek before it).
+    StopAtLimit,
+    /// After a reversal at a limit: jog against Home Direction at Home Speed
+    /// until the goal (the home switch seen actuated and then released: the
+    /// axis has passed it entirely).
+    Pass(Goal),
     /// Bring the command back onto the actual position at Home Return Speed:
     /// after a hard stop the command has run past the wall, and the torque
     /// must fall before the drive's limits are restored.
@@ -83,7 +114,7 @@ impl Leg {
     /// except a passive watch, which commands nothing).
     pub fn goal(self) -> Option<Goal> {
         match self {
-            Leg::Seek(g) | Leg::Return(g) | Leg::Watch(g) => Some(g),
+            Leg::Seek(g) | Leg::Return(g) | Leg::Watch(g) | Leg::Pass(g) => Some(g),
             Leg::Creep => Some(Goal::Marker),
             _ => None,
         }
@@ -133,6 +164,43 @@ const BI_SWITCH_MARKER_CREEP: &[Leg] = &[
     Stop,
     MoveHome,
 ];
+// The limit-switch plans: the switch plans with a stop at the limit. Laid
+// out a row per part so each reads against its switch plan.
+#[rustfmt::skip]
+const LIMIT: &[Leg] = &[
+    Seek(SwitchDetect), StopAtLimit,
+    Return(SwitchClear), Stop, MoveHome,
+];
+#[rustfmt::skip]
+const LIMIT_MARKER: &[Leg] = &[
+    Seek(SwitchDetect), StopAtLimit,
+    Return(SwitchClearThenMarker), Stop, MoveHome,
+];
+#[rustfmt::skip]
+const LIMIT_MARKER_CREEP: &[Leg] = &[
+    Seek(SwitchDetect), StopAtLimit,
+    Return(SwitchClearThenMarker), Stop, Creep, Stop, MoveHome,
+];
+// The reversed forms: leg 0, stop at the limit, back past the switch, stop
+// (first row), then the whole bidirectional plan (`BI_SWITCH`,
+// `BI_SWITCH_MARKER`, `BI_SWITCH_MARKER_CREEP`) again (second row).
+#[rustfmt::skip]
+const REV_SWITCH: &[Leg] = &[
+    Seek(SwitchDetect), StopAtLimit, Pass(SwitchClear), Stop,
+    Seek(SwitchDetect), Stop, Return(SwitchClear), Stop, MoveHome,
+];
+#[rustfmt::skip]
+const REV_SWITCH_MARKER: &[Leg] = &[
+    Seek(SwitchDetect), StopAtLimit, Pass(SwitchClear), Stop,
+    Seek(SwitchDetect), Stop, Return(SwitchClearThenMarker), Stop, MoveHome,
+];
+#[rustfmt::skip]
+const REV_SWITCH_MARKER_CREEP: &[Leg] = &[
+    Seek(SwitchDetect), StopAtLimit, Pass(SwitchClear), Stop,
+    Seek(SwitchDetect), Stop, Return(SwitchClearThenMarker), Stop, Creep, Stop, MoveHome,
+];
+/// Legs a reversed plan puts before the original one.
+const REVERSAL_LEGS: usize = 4;
 const TORQUE: &[Leg] = &[Seek(Torque), Stop, Release, MoveHome];
 const TORQUE_MARKER: &[Leg] = &[
     Seek(Torque),
@@ -172,17 +240,24 @@ pub fn plan(seq: HomeSequence, dir: HomeDirection, mode: HomeMode, creep: bool) 
             S::SwitchThenMarker => PASSIVE_SWITCH_MARKER,
             _ => PASSIVE_MARKER,
         },
-        HomeMode::Active if dir.is_unidirectional() && !seq.uses_torque() => match seq {
-            S::Switch => UNI_SWITCH,
-            S::Marker => UNI_MARKER,
-            _ => UNI_SWITCH_MARKER,
-        },
+        HomeMode::Active
+            if dir.is_unidirectional() && !seq.uses_torque() && !seq.uses_limit_switch() =>
+        {
+            match seq {
+                S::Switch => UNI_SWITCH,
+                S::Marker => UNI_MARKER,
+                _ => UNI_SWITCH_MARKER,
+            }
+        }
         HomeMode::Active => match (seq, creep) {
             (S::Switch, _) => BI_SWITCH,
             (S::Marker, false) => BI_MARKER,
             (S::Marker, true) => BI_MARKER_CREEP,
             (S::SwitchThenMarker, false) => BI_SWITCH_MARKER,
             (S::SwitchThenMarker, true) => BI_SWITCH_MARKER_CREEP,
+            (S::LimitSwitch, _) => LIMIT,
+            (S::LimitSwitchThenMarker, false) => LIMIT_MARKER,
+            (S::LimitSwitchThenMarker, true) => LIMIT_MARKER_CREEP,
             (S::Torque, _) => TORQUE,
             (_, false) => TORQUE_MARKER,
             (_, true) => TORQUE_MARKER_CREEP,
@@ -208,6 +283,16 @@ pub fn plan_for(cfg: &AxisConfig) -> &'static [Leg] {
         cfg.home_mode,
         creeps(cfg),
     )
+}
+
+/// The plan a search continues with when a limit switch ends the first seek
+/// of `plan` (see the module docs): `None` for a plan that cannot reverse
+/// (only the bidirectional switch and switch-then-marker plans can).
+/// Compares a few legs, allocates nothing.
+pub fn after_reversal(plan: &[Leg]) -> Option<&'static [Leg]> {
+    [REV_SWITCH, REV_SWITCH_MARKER, REV_SWITCH_MARKER_CREEP]
+        .into_iter()
+        .find(|r| &r[REVERSAL_LEGS..] == plan)
 }
 
 /// What a search leg's find is.
@@ -250,6 +335,8 @@ pub fn phase_of(plan: &[Leg], i: usize, to_home: bool) -> Phase {
         None => Phase::Idle,
         Some(Seek(_)) => Phase::Seek,
         Some(Stop) if i > 0 && matches!(plan[i - 1], Seek(_)) => Phase::SeekStop,
+        Some(StopAtLimit) => Phase::SeekStop,
+        Some(Pass(_)) => Phase::Reverse,
         Some(Stop) | Some(Restore) => Phase::ReturnStop,
         Some(Release) => Phase::Release,
         Some(Return(_)) => Phase::Return,
@@ -313,6 +400,54 @@ mod tests {
         assert_eq!(find_at(UNI_MARKER, 0), Find::Event);
         assert_eq!(find_at(PASSIVE_SWITCH_MARKER, 0), Find::Event);
         assert_eq!(first_return(BI_SWITCH), 2);
+    }
+
+    #[test]
+    fn limit_plans_are_the_switch_plans_stopping_at_the_limit() {
+        let with_limit_stop = |p: &[Leg]| {
+            let mut v = p.to_vec();
+            v[1] = StopAtLimit;
+            v
+        };
+        let a = HomeMode::Active;
+        for (limit, switch, creep) in [
+            (S::LimitSwitch, S::Switch, false),
+            (S::LimitSwitchThenMarker, S::SwitchThenMarker, false),
+            (S::LimitSwitchThenMarker, S::SwitchThenMarker, true),
+        ] {
+            for d in [D::BidirectionalForward, D::BidirectionalReverse] {
+                assert_eq!(
+                    plan(limit, d, a, creep),
+                    with_limit_stop(plan(switch, d, a, creep)).as_slice()
+                );
+            }
+        }
+        assert_eq!(find_at(LIMIT, 0), Find::Waypoint);
+        assert_eq!(find_at(LIMIT, 2), Find::Event);
+        assert_eq!(first_return(LIMIT), 2, "started on the limit: return leg");
+        assert_eq!(phase_of(LIMIT, 1, false), Phase::SeekStop);
+    }
+
+    #[test]
+    fn a_reversed_plan_is_the_reversal_then_the_whole_plan() {
+        for p in [BI_SWITCH, BI_SWITCH_MARKER, BI_SWITCH_MARKER_CREEP] {
+            let r = after_reversal(p).unwrap();
+            assert_eq!(r[0], p[0], "leg 0 is the seek that met the limit");
+            assert_eq!(
+                r[1..REVERSAL_LEGS],
+                [StopAtLimit, Pass(SwitchClear), Stop],
+                "stop at the limit, back past the switch, stop"
+            );
+            assert_eq!(&r[REVERSAL_LEGS..], p);
+            assert_eq!(find_at(r, 2), Find::Waypoint);
+            assert_eq!(find_at(r, 4), Find::Waypoint);
+            assert_eq!(phase_of(r, 2, false), Phase::Reverse);
+            assert_eq!(r[first_return(r)], p[first_return(p)]);
+            assert!(after_reversal(r).is_none(), "a reversal happens once");
+        }
+        for p in [LIMIT, BI_MARKER, TORQUE, UNI_SWITCH, PASSIVE_SWITCH] {
+            assert!(after_reversal(p).is_none());
+        }
     }
 
     #[test]

@@ -34,6 +34,10 @@ pub enum Phase {
     Stopping = 9,
     /// Creeping back over a marker found at speed (drives without a latch).
     Creep = 10,
+    /// `home_reverse_at_limit`: a limit switch ended the seek before the home
+    /// switch; running back at Home Speed past the home switch, to search
+    /// again from its near side.
+    Reverse = 11,
 }
 
 crate::spellings!(Phase {
@@ -48,6 +52,7 @@ crate::spellings!(Phase {
     Passive => "passive",
     Stopping => "stopping",
     Creep => "creep",
+    Reverse => "reverse",
 });
 
 /// Feedback refused as implausible, by kind, counted over the axis's life.
@@ -168,4 +173,7 @@ pub struct Status {
     /// The last accepted operation and its progress, and the refusal of
     /// the last one asked for.
     pub op: OpStatus,
+    /// `home_reverse_at_limit`: this homing met the limit switch in Home
+    /// Direction before the home switch and reversed its search.
+    pub reversed_at_limit: bool,
 }

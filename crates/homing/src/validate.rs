@@ -75,6 +75,7 @@ pub fn validate(cfg: &AxisConfig) -> Vec<ConfigError> {
     cyclic(&mut p, cfg);
     travel_limits(&mut p, cfg);
     mode_and_sequence(&mut p, cfg);
+    limit_switch_homing(&mut p, cfg, &usable);
     if moves(cfg) {
         motion(&mut p, cfg, &usable);
         above_max_speed(&mut p, cfg, &usable);
@@ -258,6 +259,119 @@ fn mode_and_sequence(p: &mut Problems, cfg: &AxisConfig) {
     }
 }
 
+/// The limit-switch sequences and `home_reverse_at_limit` (see
+/// `axis::at_limit`): active, bidirectional, on an axis with limit switches
+/// (a cyclic axis has no ends); a limit-switch home ends off the switch;
+/// only a bidirectional switch or switch-then-marker search reverses.
+fn limit_switch_homing(p: &mut Problems, cfg: &AxisConfig, ok: &Usable) {
+    let seq = cfg.home_sequence;
+    let reverse = cfg.home_reverse_at_limit;
+    if !(seq.uses_limit_switch() || reverse) {
+        return;
+    }
+    let (key, what) = if seq.uses_limit_switch() {
+        ("home_sequence", "homing on a limit switch")
+    } else {
+        ("home_reverse_at_limit", "reversing at a limit switch")
+    };
+    if !cfg.limit_switches {
+        p.add(
+            "limit_switches",
+            EX_NO_LIMIT_SWITCHES,
+            format!("{what} needs limit switches (limit_switches = false)"),
+        );
+    }
+    if cfg.travel == TravelMode::Cyclic {
+        p.add(
+            key,
+            EX_NO_LIMIT_SWITCHES,
+            format!("{what}: a cyclic axis has no ends of travel, so no limit switches"),
+        );
+    }
+    if reverse && !reverses(cfg) {
+        p.add(
+            "home_reverse_at_limit",
+            EX_REVERSE_NOT_APPLICABLE,
+            format!(
+                "only an active bidirectional switch or switch_then_marker search can \
+                 reverse at a limit, not {} {} {} (a unidirectional search cannot reverse: \
+                 it stops with ERR 12 / EXERR 43 at a limit)",
+                cfg.home_mode, cfg.home_sequence, cfg.home_direction
+            ),
+        );
+    }
+    if !seq.uses_limit_switch() {
+        return;
+    }
+    if cfg.home_mode == HomeMode::Passive {
+        p.add(
+            "home_sequence",
+            EX_SEQUENCE_INCOMPATIBLE,
+            "limit switch sequences command the motion onto the limit and off it: not valid \
+             for passive homing"
+                .into(),
+        );
+    }
+    if !moves(cfg) {
+        return;
+    }
+    if cfg.home_direction.is_unidirectional() {
+        p.add(
+            "home_direction",
+            EX_LIMIT_UNIDIRECTIONAL,
+            "a limit switch sequence comes back off the limit it seeks: only bidirectional \
+             directions are valid"
+                .into(),
+        );
+    } else if cfg.home_offset.is_finite() && ok.return_speed {
+        limit_offset(p, cfg);
+    }
+}
+
+/// `home_reverse_at_limit` applies: an active bidirectional switch or
+/// switch-then-marker sequence (the plans [`plan::after_reversal`](crate::plan::after_reversal) knows).
+fn reverses(cfg: &AxisConfig) -> bool {
+    moves(cfg)
+        && matches!(
+            cfg.home_sequence,
+            HomeSequence::Switch | HomeSequence::SwitchThenMarker
+        )
+        && !cfg.home_direction.is_unidirectional()
+}
+
+/// A limit-switch home must not park the axis on the switch: Home Position
+/// is the event (the clear point, or the marker beyond it) plus the offset,
+/// so the offset must point away from the limit, into the travel, by more
+/// than one cycle of travel at Home Return Speed — twice the worst error of
+/// a sampled clear point, so Home Position is off the switch however the
+/// edge was sampled. (The marker of `limit_switch_then_marker` lies beyond
+/// the clear point, which only adds distance.) The switch's repeatability
+/// and hysteresis are the machine's: the README asks for an offset that
+/// covers them too.
+fn limit_offset(p: &mut Problems, cfg: &AxisConfig) {
+    let dir = cfg.home_direction.sign();
+    let margin = cfg.home_return_speed * cfg.cycle_ns as f64 * 1e-9;
+    if cfg.home_offset * dir < -margin {
+        return;
+    }
+    let (limit, sign) = if dir > 0.0 {
+        ("positive", "negative")
+    } else {
+        ("negative", "positive")
+    };
+    p.add(
+        "home_offset",
+        EX_LIMIT_OFFSET,
+        format!(
+            "{} would leave the axis at (or on) the {limit} limit switch it homes on: \
+             the offset must be {sign} (away from the limit, into the travel) by more than \
+             {margin} units, one cycle of travel at home_return_speed; choose a distance that \
+             also covers the switch's repeatability",
+            cfg.home_offset
+        ),
+    );
+}
+
 /// A sequence that commands motion: a control mode that follows a
 /// position, a direction that can come back from a hard stop, and speeds,
 /// acceleration and deceleration that are not zero where a leg uses them.
@@ -400,6 +514,38 @@ pub fn effective_search_limit(cfg: &AxisConfig) -> f64 {
     }
 }
 
+/// What `check` says about a limit-switch sequence or a search that
+/// reverses at a limit: which limit, what is suspended, its CiA 402 and
+/// PLCopen names, how the search limit counts.
+fn limit_notes(cfg: &AxisConfig, out: &mut Vec<String>) {
+    let Some(e) = crate::equivalent::equivalent(cfg) else {
+        return;
+    };
+    let limit = if cfg.home_direction.sign() > 0.0 {
+        "positive"
+    } else {
+        "negative"
+    };
+    let names = format!(
+        "CiA 402 homing method {}, PLCopen {}",
+        e.cia402_method, e.plcopen
+    );
+    if cfg.home_sequence.uses_limit_switch() {
+        out.push(format!(
+            "home_sequence {}: homes on its {limit} limit switch ({names}); the overtravel stop \
+             is suspended while seeking that limit and stopping on it; an EtherCAT drive in CSP \
+             may stop at its own 0x60FD limit bits (see the README)",
+            cfg.home_sequence
+        ));
+    } else {
+        out.push(format!(
+            "home_reverse_at_limit: a search that meets the {limit} limit switch before the home \
+             switch reverses, passes the switch and searches again ({names}); search_limit \
+             bounds each leg of it (seek, run back, new seek) and home_timeout the whole"
+        ));
+    }
+}
+
 /// Things that are legal but that a controls engineer would want pointed out.
 /// `cycle_s` is the controller period.
 pub fn advisories(cfg: &AxisConfig, cycle_s: f64) -> Vec<String> {
@@ -412,15 +558,21 @@ pub fn advisories(cfg: &AxisConfig, cycle_s: f64) -> Vec<String> {
         );
     }
     let seq = cfg.home_sequence;
+    limit_notes(cfg, &mut out);
     if seq.uses_switch() && !cfg.registration {
         let v = if moves(cfg) && !cfg.home_direction.is_unidirectional() {
             cfg.home_return_speed
         } else {
             cfg.home_speed
         };
+        let switch = if seq.uses_limit_switch() {
+            "limit switch"
+        } else {
+            "home switch"
+        };
         if v > 0.0 && !seq.uses_marker() {
             out.push(format!(
-                "home switch sampled once per cycle: event uncertainty up to {:.6} units \
+                "{switch} sampled once per cycle: event uncertainty up to {:.6} units \
                  (half of {v} units/s x {cycle_s} s); registration = true or a marker sequence \
                  removes it",
                 0.5 * v * cycle_s

@@ -86,6 +86,57 @@ fn engine_step_makes_no_allocation() {
     assert_eq!(during, 0, "allocator calls inside Axis::step");
 }
 
+/// The limit-switch sequences, and a switch search that reverses at a
+/// limit (a far-side start), step without the heap too: the reversal
+/// swaps one static plan for another.
+#[test]
+fn limit_switch_homing_and_reversal_make_no_allocation() {
+    let runs = [
+        (HomeSequence::LimitSwitch, false, 0.0),
+        (HomeSequence::LimitSwitchThenMarker, false, 0.0),
+        (HomeSequence::SwitchThenMarker, true, -20.0),
+    ];
+    for (seq, reverse, start) in runs {
+        let cfg = AxisConfig {
+            marker: true,
+            home_sequence: seq,
+            home_direction: HomeDirection::BidirectionalReverse,
+            home_reverse_at_limit: reverse,
+            home_offset: 1.0,
+            home_speed: 20.0,
+            home_return_speed: 5.0,
+            home_acceleration: 500.0,
+            home_deceleration: 500.0,
+            ..AxisConfig::default()
+        };
+        let mut axis = Axis::new(cfg);
+        let mut plant = Plant::new(PlantConfig {
+            start,
+            switch: Some((0.0, 5.0)),
+            marker_every: 10.0,
+            marker_at: 2.5,
+            hard_stop: Some((-30.0, 30.0)),
+            overtravel: Some((-25.0, 25.0)),
+            ..PlantConfig::default()
+        });
+        let mut fb = plant.feedback();
+        let req = Request {
+            home: true,
+            ..Request::default()
+        };
+        let mut during = 0;
+        for k in 0..20_000u64 {
+            during += counted(|| {
+                let cmd = axis.step(k * 1_000_000, Some(&fb), &req);
+                fb = plant.step(&cmd, 0.001);
+            });
+        }
+        let st = axis.status();
+        assert!(st.pc && st.reversed_at_limit == reverse, "{seq:?}: {st:?}");
+        assert_eq!(during, 0, "{seq:?}: allocator calls inside Axis::step");
+    }
+}
+
 /// Counts allocator calls inside `f`.
 fn counted(f: impl FnOnce()) -> u64 {
     let before = calls();

@@ -192,6 +192,7 @@ fn active_row(seq: HomeSequence, dir: HomeDirection) -> Case {
         // The first marker after the switch is detected: forward detects 0,
         // reverse detects 5; the marker at 2.5 lies beyond both.
         (SwitchThenMarker, _) => ok(2.5, EXACT, past(2.5, dir.sign(), 0.0)),
+        (LimitSwitch | LimitSwitchThenMarker, _) => unreachable!("see limit_sequences.rs"),
     };
     let unidirectional_at_rest_past_event =
         dir.is_unidirectional() && !matches!(seq, Torque | TorqueThenMarker);

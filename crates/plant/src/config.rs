@@ -49,9 +49,19 @@ pub struct PlantConfig {
     /// Raw mechanical ends `[lo, hi]`: the position never leaves them, and a
     /// command beyond one makes the drive push (torque rises).
     pub hard_stop: Option<(f64, f64)>,
-    /// Raw positions beyond which the overtravel inputs trip: negative strictly
-    /// below `lo`, positive strictly above `hi`.
+    /// The overtravel limit switches (`[axis.sim] limit_switches`, formerly
+    /// `overtravel`): the negative one actuated at or below `lo`, the
+    /// positive one at or above `hi` (until the key's rename the ends
+    /// themselves did not trip; now a switch is actuated *at* its end, the
+    /// rule of the home switch's interval). An infinite end: no switch on
+    /// that side. See [`limits`](crate::limits).
     pub overtravel: Option<(f64, f64)>,
+    /// NC wiring of the limit switches (`limit_switches_normally_closed`):
+    /// both reading actuated is a wire break, and the drive faults.
+    pub limit_switches_normally_closed: bool,
+    /// What the drive's registration (probe) input is wired to: the home
+    /// switch, or the limit switch an axis homes on.
+    pub registration_input: RegistrationInput,
     /// Units/s, signed: something else moves the axis while the drive is not
     /// enabled (passive homing, a hand wheel).
     pub external_speed: f64,
@@ -67,6 +77,18 @@ pub struct PlantConfig {
     pub torque_spike: Option<TorqueSpike>,
 }
 
+/// The input the drive's registration latch (`Command::switch_arm`, probe 2
+/// on EtherCAT) is wired to. Not a key: the sim wires it to the axis's
+/// reference switch, the limit switch in Home Direction for the
+/// limit-switch sequences, the home switch otherwise.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RegistrationInput {
+    #[default]
+    HomeSwitch,
+    NegativeLimit,
+    PositiveLimit,
+}
+
 impl Default for PlantConfig {
     /// At 0, nothing connected (no switch, markers, stops or overtravel),
     /// default gains, a two-cycle enable delay.
@@ -79,6 +101,8 @@ impl Default for PlantConfig {
             marker_at: 0.0,
             hard_stop: None,
             overtravel: None,
+            limit_switches_normally_closed: false,
+            registration_input: RegistrationInput::HomeSwitch,
             external_speed: 0.0,
             push_gain: DEFAULT_PUSH_GAIN,
             inertia_gain: DEFAULT_INERTIA_GAIN,
@@ -158,6 +182,8 @@ impl PlantConfig {
             marker_at,
             hard_stop,
             overtravel: interval(self.overtravel, true),
+            limit_switches_normally_closed: self.limit_switches_normally_closed,
+            registration_input: self.registration_input,
             external_speed: finite_or(self.external_speed, 0.0),
             push_gain: finite_or(self.push_gain, DEFAULT_PUSH_GAIN),
             inertia_gain: finite_or(self.inertia_gain, DEFAULT_INERTIA_GAIN),

@@ -39,11 +39,12 @@
 pub mod config;
 mod drive;
 mod latch;
+pub mod limits;
 mod num;
 mod plant;
 pub mod sensors;
 mod torque;
 
-pub use config::{PlantConfig, TorqueSpike};
+pub use config::{PlantConfig, RegistrationInput, TorqueSpike};
 pub use plant::Plant;
 pub use sensors::{Markers, Switch, SwitchEdge};

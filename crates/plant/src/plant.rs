@@ -2,11 +2,12 @@
 
 use motion_homing::{Command, Feedback};
 
-use crate::config::PlantConfig;
+use crate::config::{PlantConfig, RegistrationInput};
 use crate::drive::Drive;
 use crate::latch::Latch;
+use crate::limits::LimitSwitches;
 use crate::num::saturate;
-use crate::sensors::{overtravel, Markers, Switch};
+use crate::sensors::{Markers, Switch};
 use crate::torque::{torque, TorqueInputs};
 
 /// A command the drive can execute: position finite, no NaN anywhere. Infinite
@@ -28,6 +29,7 @@ pub struct Plant {
     cfg: PlantConfig,
     markers: Markers,
     switch: Option<Switch>,
+    limits: LimitSwitches,
     drive: Drive,
     position: f64,
     velocity: f64,
@@ -52,6 +54,7 @@ impl Plant {
             switch: cfg
                 .switch
                 .map(|(lo, hi)| Switch::new(lo, hi, cfg.switch_normally_closed)),
+            limits: LimitSwitches::new(cfg.overtravel, cfg.limit_switches_normally_closed),
             drive: Drive::default(),
             position: cfg.start,
             velocity: 0.0,
@@ -104,6 +107,10 @@ impl Plant {
         };
 
         self.capture(old, new);
+        if self.limits.wire_break(new) {
+            // NC limit switches both open: the drive's wire-break fault.
+            self.trip();
+        }
 
         if following {
             let acceleration = if dt > 0.0 {
@@ -148,7 +155,12 @@ impl Plant {
                 .capture(self.markers.first_passed(old, new));
         }
         if self.switch_latch.waiting() {
-            if let Some(sw) = self.switch {
+            let probe = match self.cfg.registration_input {
+                RegistrationInput::HomeSwitch => self.switch,
+                RegistrationInput::NegativeLimit => self.limits.negative(),
+                RegistrationInput::PositiveLimit => self.limits.positive(),
+            };
+            if let Some(sw) = probe {
                 self.switch_latch
                     .capture(sw.first_edge(old, new, self.switch_latch.edge()));
             }
@@ -164,7 +176,7 @@ impl Plant {
     /// position, its inputs, a disabled drive).
     pub fn feedback(&self) -> Feedback {
         let x = self.position;
-        let (overtravel_negative, overtravel_positive) = overtravel(self.cfg.overtravel, x);
+        let (overtravel_negative, overtravel_positive) = self.limits.states(x);
         Feedback {
             position: x,
             velocity: self.velocity,
@@ -196,6 +208,19 @@ impl Plant {
     /// stays off until a new rising edge of `enable`.
     pub fn reset_fault(&mut self) {
         self.drive.reset_fault();
+    }
+
+    /// Tests: the common wire of the limit switches is cut. With NC wiring
+    /// both read actuated and the drive faults (while the wire stays cut);
+    /// with NO wiring both read released: the limits are silently gone.
+    pub fn break_limit_wire(&mut self) {
+        self.limits.break_wire();
+    }
+
+    /// Both NC limit inputs read actuated now: the wire-break fault's cause
+    /// (a drive model names it in its error code).
+    pub fn limit_wire_break(&self) -> bool {
+        self.limits.wire_break(self.position)
     }
 
     /// Tests: the home switch is moved by `shift` along the axis (a worn
@@ -552,8 +577,72 @@ mod tests {
         assert!(fb.overtravel_positive && !fb.overtravel_negative);
         let fb = p.step(&cmd(-5.5), DT);
         assert!(!fb.overtravel_positive && fb.overtravel_negative);
+        // Actuated at the end itself (`limit_switches`; `overtravel` tripped
+        // only strictly beyond it).
         let fb = p.step(&cmd(-5.0), DT);
+        assert!(!fb.overtravel_positive && fb.overtravel_negative);
+        let fb = p.step(&cmd(-4.999), DT);
         assert!(!fb.overtravel_positive && !fb.overtravel_negative);
+    }
+
+    #[test]
+    fn nc_limit_wire_break_faults_the_drive_while_it_lasts() {
+        for nc in [false, true] {
+            let mut p = enabled(
+                PlantConfig {
+                    overtravel: Some((-5.0, 5.0)),
+                    limit_switches_normally_closed: nc,
+                    ..PlantConfig::default()
+                },
+                0.0,
+            );
+            let fb = p.step(&cmd(1.0), DT);
+            assert!(fb.drive.enabled && !fb.overtravel_negative && !fb.overtravel_positive);
+            p.break_limit_wire();
+            let fb = p.step(&cmd(1.0), DT);
+            // NC: both read actuated, a wire break: fault. NO: both read
+            // released, nothing to see.
+            assert_eq!(fb.overtravel_negative && fb.overtravel_positive, nc);
+            assert_eq!(fb.drive.fault, nc, "NC {nc}");
+            assert_eq!(fb.drive.enabled, !nc);
+            // The reset handshake does not clear it while the wire is cut.
+            p.step(&off(), DT);
+            let fb = p.step(&cmd(1.0), DT);
+            assert_eq!(fb.drive.fault, nc);
+        }
+    }
+
+    #[test]
+    fn registration_on_the_limit_switch_latches_its_edges_as_states() {
+        let cfg = PlantConfig {
+            switch: Some((0.0, 5.0)),
+            overtravel: Some((-5.0, 20.0)),
+            limit_switches_normally_closed: true,
+            registration_input: RegistrationInput::NegativeLimit,
+            ..PlantConfig::default()
+        };
+        let mut p = enabled(cfg, -3.0);
+        // Onto the negative limit: the rising (actuated) edge at -5 exactly,
+        // whatever the NC wiring; the home switch is not the probe's input.
+        let fb = p.step(&switch_arm(cmd(-6.0), 1, Edge::Rising), DT);
+        assert_eq!(fb.switch_latch, latched(1, -5.0));
+        let fb = p.step(&switch_arm(cmd(-5.5), 2, Edge::Falling), DT);
+        assert!(!fb.switch_latch.latched);
+        let fb = p.step(&switch_arm(cmd(2.0), 2, Edge::Falling), DT);
+        assert_eq!(
+            fb.switch_latch,
+            latched(2, -5.0),
+            "released strictly past -5"
+        );
+        let mut p = enabled(
+            PlantConfig {
+                registration_input: RegistrationInput::PositiveLimit,
+                ..cfg
+            },
+            18.0,
+        );
+        let fb = p.step(&switch_arm(cmd(21.0), 3, Edge::Rising), DT);
+        assert_eq!(fb.switch_latch, latched(3, 20.0));
     }
 
     fn marker_cfg() -> PlantConfig {

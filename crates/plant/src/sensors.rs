@@ -1,5 +1,5 @@
-//! Sensors along the travel: the marker track, the home switch and the
-//! overtravel inputs, and the rules that decide what a cycle's straight
+//! Sensors along the travel: the marker track and the switches (the home
+//! switch; the limit switches are two of them, see `limits`), and the rules that decide what a cycle's straight
 //! segment `old → new` has crossed.
 //!
 //! # Crossing rules
@@ -219,15 +219,6 @@ impl Switch {
     }
 }
 
-/// Overtravel inputs at `x`: (negative, positive), tripped strictly beyond
-/// the configured ends.
-pub fn overtravel(limits: Option<(f64, f64)>, x: f64) -> (bool, bool) {
-    match limits {
-        Some((lo, hi)) => (x < lo, x > hi),
-        None => (false, false),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -331,15 +322,5 @@ mod tests {
         assert_eq!(nc.first_edge(-1.0, 6.0, Edge::Rising), Some(5.0));
         assert_eq!(nc.first_edge(6.0, -1.0, Edge::Falling), Some(5.0));
         assert_eq!(nc.first_edge(6.0, -1.0, Edge::Rising), Some(0.0));
-    }
-
-    #[test]
-    fn overtravel_trips_strictly_beyond() {
-        let lim = Some((-10.0, 10.0));
-        assert_eq!(overtravel(lim, -10.0), (false, false));
-        assert_eq!(overtravel(lim, -10.5), (true, false));
-        assert_eq!(overtravel(lim, 10.0), (false, false));
-        assert_eq!(overtravel(lim, 10.5), (false, true));
-        assert_eq!(overtravel(None, 1e300), (false, false));
     }
 }

@@ -1,7 +1,7 @@
 //! Property tests of the plant: crossing rules, latch exactness, totality.
 
 use motion_homing::{Command, Edge, Feedback, LatchArm};
-use motion_plant::{Markers, Plant, PlantConfig, Switch, TorqueSpike};
+use motion_plant::{Markers, Plant, PlantConfig, RegistrationInput, Switch, TorqueSpike};
 use proptest::prelude::*;
 
 fn assert_finite(fb: &Feedback) -> Result<(), TestCaseError> {
@@ -85,14 +85,20 @@ fn wild_config() -> impl Strategy<Value = PlantConfig> {
             wild_f64(),
             wild_f64(),
         ),
-        (wild_interval(), wild_interval(), wild_f64()),
+        (
+            wild_interval(),
+            wild_interval(),
+            wild_f64(),
+            any::<bool>(),
+            0u8..3,
+        ),
         (wild_f64(), wild_f64(), wild_f64(), 0u32..4),
         proptest::option::of((wild_f64(), wild_f64(), wild_f64())),
     )
         .prop_map(
             |(
                 (start, switch, nc, every, at),
-                (hard_stop, overtravel, external_speed),
+                (hard_stop, overtravel, external_speed, limits_nc, probe),
                 (push_gain, inertia_gain, friction, delay),
                 spike,
             )| PlantConfig {
@@ -103,6 +109,12 @@ fn wild_config() -> impl Strategy<Value = PlantConfig> {
                 marker_at: at,
                 hard_stop,
                 overtravel,
+                limit_switches_normally_closed: limits_nc,
+                registration_input: match probe {
+                    0 => RegistrationInput::HomeSwitch,
+                    1 => RegistrationInput::NegativeLimit,
+                    _ => RegistrationInput::PositiveLimit,
+                },
                 external_speed,
                 push_gain,
                 inertia_gain,

@@ -25,6 +25,18 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         (ERR_ILLEGAL_HOMING_CONFIG, EX_ABOVE_MAX_SPEED) => {
             "illegal homing configuration: a homing speed above max_speed"
         }
+        (ERR_ILLEGAL_HOMING_CONFIG, EX_LIMIT_UNIDIRECTIONAL) => {
+            "illegal homing configuration: a limit switch sequence must be bidirectional"
+        }
+        (ERR_ILLEGAL_HOMING_CONFIG, EX_LIMIT_OFFSET) => {
+            "illegal homing configuration: home_offset would leave the axis on the limit switch"
+        }
+        (ERR_ILLEGAL_HOMING_CONFIG, EX_REVERSE_NOT_APPLICABLE) => {
+            "illegal homing configuration: this sequence cannot reverse at a limit"
+        }
+        (ERR_ILLEGAL_HOMING_CONFIG, EX_NO_LIMIT_SWITCHES) => {
+            "illegal homing configuration: the axis has no limit switches"
+        }
         (ERR_ILLEGAL_HOMING_CONFIG, _) => "illegal homing configuration",
         (ERR_GANTRY_SKEW, _) => "gantry sides latched their events further apart than max_skew",
         (ERR_AMBIGUOUS_MARKER, _) => {
@@ -74,6 +86,9 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         (ERR_JOG_LEASE_EXPIRED, _) => "jog lease expired: the jog stopped (hold to run)",
         (ERR_INTERRUPTED, _) => "homing interrupted externally",
         (ERR_TIMEOUT, _) => "home timeout exceeded",
+        (ERR_SEARCH_LIMIT, EX_SEARCH_REVERSE) => {
+            "the run back past the home switch after a limit went beyond the search limit"
+        }
         (ERR_SEARCH_LIMIT, _) => "search travelled beyond the search limit",
         _ => "error",
     }

@@ -32,8 +32,9 @@ pub struct TraceRow {
     pub position: Option<f64>,
     pub velocity: Option<f64>,
     pub torque: Option<f64>,
-    /// Home switch actuated (logical), a marker passed or latched, fresh
-    /// feedback this cycle.
+    /// The sequence's reference switch actuated (logical: the home switch,
+    /// or the limit switch a limit-switch sequence homes on), a marker
+    /// passed or latched, fresh feedback this cycle.
     pub switch: bool,
     pub marker: bool,
     pub fresh: bool,

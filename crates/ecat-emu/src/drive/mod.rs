@@ -54,6 +54,10 @@ use probes::ProbeUnit;
 pub const ERR_FOLLOWING: u16 = 0x8611;
 /// Error code of the communication loss (SM watchdog expired in OP).
 pub const ERR_COMMUNICATION: u16 = 0x8130;
+/// Error code of a limit-switch wire break (both NC limit inputs open): a
+/// manufacturer-specific code (0xFF00..), as real drives report wiring
+/// faults; not 0x73xx, which the supervisor reads as an encoder fault.
+pub const ERR_LIMIT_WIRING: u16 = 0xFF01;
 
 /// Values the tests read back.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -7,7 +7,7 @@ use motion_homing::Command;
 
 use super::cia402::State;
 use super::config::TorqueObjects;
-use super::{Drive, ERR_COMMUNICATION, ERR_FOLLOWING};
+use super::{Drive, ERR_COMMUNICATION, ERR_FOLLOWING, ERR_LIMIT_WIRING};
 
 /// What a deceleration ramp ends in.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -153,10 +153,21 @@ impl Drive {
         }
         let was_enabled = self.plant.feedback().drive.enabled;
         let out = self.plant.step(&cmd, dt);
+        // The plant faults on a following error, or on a limit-switch wire
+        // break (which it keeps while the wire is cut, also while enabling).
+        let code = if self.plant.limit_wire_break() {
+            ERR_LIMIT_WIRING
+        } else {
+            ERR_FOLLOWING
+        };
         if self.enabling {
             if out.drive.enabled {
                 self.enabling = false;
                 self.state = State::OperationEnabled;
+            } else if out.drive.fault && code == ERR_LIMIT_WIRING {
+                self.enabling = false;
+                self.state = State::Fault;
+                self.od.put(0x603F, 0, u64::from(code));
             }
         } else if was_enabled
             && !out.drive.enabled
@@ -165,7 +176,7 @@ impl Drive {
         {
             self.ramp = None;
             self.state = State::Fault;
-            self.od.put(0x603F, 0, u64::from(ERR_FOLLOWING));
+            self.od.put(0x603F, 0, u64::from(code));
         }
     }
 

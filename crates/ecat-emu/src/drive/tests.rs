@@ -204,6 +204,37 @@ fn faults_and_reset() {
     assert_eq!(v.statusword & 0x2000, 0x2000);
 }
 
+/// 0x60FD bits 0 / 1 are the plant's limit switches (as states, whatever
+/// the wiring); a cut common wire of NC switches reads both actuated and
+/// faults the drive with a wiring code, also when it is enabled again.
+#[test]
+fn limit_switches_in_0x60fd_and_an_nc_wire_break() {
+    let mut d = drive();
+    let mut cfg = d.cfg.clone();
+    cfg.plant.overtravel = Some((-4.0, 4.0));
+    cfg.plant.limit_switches_normally_closed = true;
+    d.cfg = cfg.clone();
+    d.plant = Plant::new(cfg.plant);
+    enable(&mut d);
+    let di = |d: &Drive| d.od.get(0x60FD, 0) & 0b11;
+    run(&mut d, 0x000F, -4000, 0);
+    assert_eq!(di(&d), 0b01, "negative limit at -4");
+    run(&mut d, 0x000F, 4000, 0);
+    assert_eq!(di(&d), 0b10, "positive limit at 4");
+    run(&mut d, 0x000F, 0, 0);
+    assert_eq!(di(&d), 0);
+    d.plant.break_limit_wire();
+    let v = run(&mut d, 0x000F, 0, 0);
+    assert_eq!(di(&d), 0b11);
+    assert_eq!((v.state, v.error_code), (State::Fault, ERR_LIMIT_WIRING));
+    run(&mut d, 0x0080, 0, 0);
+    for cw in [0x0006, 0x0007, 0x000F, 0x000F] {
+        run(&mut d, cw, 0, 0);
+    }
+    let v = d.view();
+    assert_eq!((v.state, v.error_code), (State::Fault, ERR_LIMIT_WIRING));
+}
+
 #[test]
 fn watchdog_loss_ramps_then_faults() {
     let mut d = drive();

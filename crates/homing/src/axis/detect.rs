@@ -178,11 +178,15 @@ impl Axis {
 
     /// Arms the registration latch (if the drive has one) for the electrical
     /// edge of the switch being actuated (`true`) or released (`false`).
+    /// A limit switch as the reference is latched as the drive reports it, a
+    /// state (its probe input wired to the limit through the drive's input
+    /// polarity, as 0x60FD is): rising = becoming active.
     pub(super) fn arm_switch(&mut self, actuated: bool) {
         if self.cfg.registration {
             let at = self.last.map(|s| s.fb.position);
-            self.latches
-                .arm_switch(actuated != self.cfg.home_switch_normally_closed, at);
+            let inverted =
+                self.cfg.home_switch_normally_closed && !self.cfg.home_sequence.uses_limit_switch();
+            self.latches.arm_switch(actuated != inverted, at);
         }
     }
 }

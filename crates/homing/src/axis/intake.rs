@@ -42,7 +42,9 @@ pub(super) struct Seen {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Sample {
     pub fb: Feedback,
-    /// Logical switch state: actuated, whatever the wiring.
+    /// Logical state of the sequence's reference switch (the home switch,
+    /// or the limit switch of a limit-switch sequence): actuated, whatever
+    /// the wiring.
     pub switch_active: bool,
     /// Time since the previous usable sample, ns (0 for the first).
     pub dt_ns: u64,
@@ -115,7 +117,7 @@ impl Axis {
         });
         self.last = Some(Sample {
             fb: *fb,
-            switch_active: fb.home_switch != self.cfg.home_switch_normally_closed,
+            switch_active: self.reference_switch_active(fb),
             dt_ns: self.last_sample_ns.map_or(0, |t| now.saturating_sub(t)),
         });
         self.last_sample_ns = Some(now);

@@ -96,14 +96,20 @@ impl Axis {
                     .set(self.jog(now, self.dir * self.cfg.home_speed));
                 Run::Search(search)
             }
-            Leg::Return(goal) => {
+            Leg::Return(goal) | Leg::Pass(goal) => {
                 let mut search = self.begin_search(goal, p);
                 if goal != Goal::Marker && s.switch_active {
                     search.seen_active = true;
                     self.arm_switch(false);
                 }
-                self.profile
-                    .set(self.jog(now, -self.dir * self.cfg.home_return_speed));
+                // Back past the home switch after a limit: at Home Speed, a
+                // search like the first seek.
+                let speed = if matches!(leg, Leg::Pass(_)) {
+                    self.cfg.home_speed
+                } else {
+                    self.cfg.home_return_speed
+                };
+                self.profile.set(self.jog(now, -self.dir * speed));
                 Run::Search(search)
             }
             Leg::Creep => {
@@ -116,7 +122,7 @@ impl Axis {
                 Run::Search(search)
             }
             Leg::Watch(goal) => Run::Search(self.begin_search(goal, s.fb.position)),
-            Leg::Stop => {
+            Leg::Stop | Leg::StopAtLimit => {
                 self.profile
                     .set(Profile::stop(now, p, v, self.cfg.home_deceleration));
                 Run::Profile { to_home: false }

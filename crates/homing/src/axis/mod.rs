@@ -15,6 +15,8 @@
 //! * `detect`: finding a search leg's goal (events and their precision);
 //! * `legs`: starting each leg (or holding at a coordinator's barrier),
 //!   what its find means, what follows it;
+//! * `at_limit`: the limit switches while homing (abort, carry on on the
+//!   limit a leg means to be on, or reverse the search);
 //! * `reference`: the stored reference of an absolute axis;
 //! * this file: requests (start, stop, shutdown), aborts, completion, the
 //!   status and the command written each cycle.
@@ -35,6 +37,7 @@
 //!   if needed, then restore. A drive fault or shutdown cannot be stopped by
 //!   us: the drive is disabled and the overrides restored at once.
 
+mod at_limit;
 mod detect;
 mod followed;
 mod intake;
@@ -57,6 +60,7 @@ use crate::profile::Profile;
 use crate::status::Status;
 use crate::time::secs_to_ns;
 use crate::validate::{effective_search_limit, validate, ConfigError};
+use at_limit::AtLimit;
 use followed::Followed;
 use intake::{Sample, Seen};
 use latches::Latches;
@@ -425,10 +429,13 @@ impl Axis {
                     Abort::Disable,
                 );
             }
-            let v = self.profile.at(now).1;
-            let (neg, pos) = (s.fb.overtravel_negative, s.fb.overtravel_positive);
-            if self.cfg.limit_switches && ((v > 0.0 && pos) || (v < 0.0 && neg)) {
-                return self.fail(now, ERR_SERVO_MESSAGE, EX_OVERTRAVEL, Abort::Controlled);
+            // A limit switch in the direction of travel (`at_limit`).
+            match self.at_limit(now, s) {
+                AtLimit::Go => {}
+                AtLimit::Reverse => return self.reverse_search(now, s),
+                AtLimit::Overtravel => {
+                    return self.fail(now, ERR_SERVO_MESSAGE, EX_OVERTRAVEL, Abort::Controlled);
+                }
             }
         }
         if self.check_timeout(now) {
@@ -523,6 +530,7 @@ impl Axis {
             Leg::Seek(_) => EX_SEARCH_SEEK,
             Leg::Return(_) => EX_SEARCH_RETURN,
             Leg::Creep => EX_SEARCH_CREEP,
+            Leg::Pass(_) => EX_SEARCH_REVERSE,
             _ => return false,
         };
         let p = self.profile.at(now).0;

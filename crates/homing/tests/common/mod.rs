@@ -19,6 +19,16 @@ pub fn machine_at(start: f64) -> PlantConfig {
     }
 }
 
+/// The test machine with limit switches: the negative one actuated at or
+/// below -90, the positive one at or above 90 (10 units before the hard
+/// stops).
+pub fn limit_machine_at(start: f64) -> PlantConfig {
+    PlantConfig {
+        overtravel: Some((-90.0, 90.0)),
+        ..machine_at(start)
+    }
+}
+
 /// The test machine with the axis at -50: a forward search meets the switch.
 pub fn machine() -> PlantConfig {
     machine_at(-50.0)

@@ -58,7 +58,7 @@ impl Tracer {
                 f.position,
                 f.velocity,
                 f.torque,
-                f.home_switch != axis.config().home_switch_normally_closed,
+                axis.reference_switch_active(f),
                 f.marker_pulse || f.marker_latch.latched,
             ),
             None => (f64::NAN, f64::NAN, f64::NAN, false, false),

@@ -46,7 +46,7 @@ pub(super) fn entry(
         _ => None,
     };
     let switch_to_marker = match (e.home_sequence, s.switch_edge_raw, s.event_raw) {
-        (HomeSequence::SwitchThenMarker, Some(sw), Some(ev)) => Some(r6((ev - sw).abs())),
+        (q, Some(sw), Some(ev)) if q.uses_switch() && q.uses_marker() => Some(r6((ev - sw).abs())),
         _ => None,
     };
     let mut warnings = Vec::new();
