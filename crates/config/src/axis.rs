@@ -22,8 +22,8 @@ pub(crate) fn parse(
         .has("home_order")
         .then(|| r.u32_in("home_order", 0, 0, 1000));
     let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
-    let engine = engine(&mut r, sup);
-    let ethercat = crate::ethercat::parse::axis_keys(&mut r, &engine, ios.get(io));
+    let mut engine = engine(&mut r, sup);
+    let ethercat = crate::ethercat::parse::axis_keys(&mut r, &mut engine, ios.get(io));
     let sim_table = r.table("sim");
     r.finish();
     let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
@@ -162,6 +162,8 @@ fn engine(r: &mut Reader<'_>, sup: &SupervisorConfig) -> AxisConfig {
         max_speed: r.f64_in("max_speed", 0.0, 0.0, SPEED, "units/s"),
         marker_min_distance: 0.0,
         refuse_ambiguous_marker: r.bool("refuse_ambiguous_marker", false),
+        // set by the EtherCAT keys (`drive_homing`)
+        drive_homing: false,
     };
     // A switch edge sampled once per cycle is known to a cycle of travel at
     // return speed; a marker closer than two such cycles to it is ambiguous.

@@ -28,11 +28,12 @@
 //! * `switch_arm_edge`: 0 = rising, any other value = falling.
 //! * Latched flags: 0 = false, any other value = true.
 
-use motion_homing::{Command, DriveState, Edge, Feedback, LatchArm, LatchFeedback};
+use motion_homing::{Command, DriveHoming, DriveState, Edge, Feedback, LatchArm, LatchFeedback};
 
 use crate::frame::{
-    AxisCommand, AxisFeedback, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE,
-    DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED, SW_FAULT,
+    AxisCommand, AxisFeedback, CW_DRIVE_HOME, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE,
+    DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_DRIVE_HOMED,
+    SW_DRIVE_HOMING, SW_DRIVE_HOMING_ERROR, SW_ENABLED, SW_FAULT,
 };
 
 /// Wire value of a position that was not a number (see the module docs).
@@ -111,7 +112,8 @@ pub fn command_to_axis(cmd: &Command, counts_per_unit: f64) -> AxisCommand {
         torque_limit_negative: cmd.torque_limit_negative as f32,
         position_error_tolerance: rate_to_counts(cmd.position_error_tolerance, counts_per_unit),
         velocity_error_tolerance: rate_to_counts(cmd.velocity_error_tolerance, counts_per_unit),
-        control_word: if cmd.enable { CW_ENABLE } else { 0 },
+        control_word: if cmd.enable { CW_ENABLE } else { 0 }
+            | if cmd.drive_home { CW_DRIVE_HOME } else { 0 },
         marker_arm_id: cmd.marker_arm.id,
         switch_arm_id: cmd.switch_arm.id,
         switch_arm_edge: edge_to_wire(cmd.switch_arm.edge),
@@ -137,6 +139,7 @@ pub fn axis_to_command(ac: &AxisCommand, counts_per_unit: f64) -> Command {
             id: ac.switch_arm_id,
             edge: edge_from_wire(ac.switch_arm_edge),
         },
+        drive_home: ac.control_word & CW_DRIVE_HOME != 0,
     }
 }
 
@@ -161,6 +164,15 @@ pub fn feedback_to_axis(fb: &Feedback, counts_per_unit: f64) -> AxisFeedback {
     }
     if fb.drive.fault {
         sw |= SW_FAULT;
+    }
+    for (on, bit) in [
+        (fb.drive_homing.active, SW_DRIVE_HOMING),
+        (fb.drive_homing.attained, SW_DRIVE_HOMED),
+        (fb.drive_homing.error, SW_DRIVE_HOMING_ERROR),
+    ] {
+        if on {
+            sw |= bit;
+        }
     }
     AxisFeedback {
         position: units_to_counts(fb.position, counts_per_unit),
@@ -202,6 +214,11 @@ pub fn axis_to_feedback(af: &AxisFeedback, counts_per_unit: f64) -> Feedback {
             enabled: af.status_word & SW_ENABLED != 0,
             fault: af.status_word & SW_FAULT != 0,
         },
+        drive_homing: DriveHoming {
+            active: af.status_word & SW_DRIVE_HOMING != 0,
+            attained: af.status_word & SW_DRIVE_HOMED != 0,
+            error: af.status_word & SW_DRIVE_HOMING_ERROR != 0,
+        },
     }
 }
 
@@ -228,6 +245,7 @@ mod tests {
                 id: 200,
                 edge: Edge::Falling,
             },
+            drive_home: true,
         }
     }
 
@@ -253,6 +271,11 @@ mod tests {
             drive: DriveState {
                 enabled: true,
                 fault: true,
+            },
+            drive_homing: DriveHoming {
+                active: true,
+                attained: true,
+                error: false,
             },
         }
     }
@@ -328,7 +351,7 @@ mod tests {
         assert_eq!(w.torque_limit_negative, 80.25);
         assert_eq!(w.position_error_tolerance, 500.0);
         assert_eq!(w.velocity_error_tolerance, 3000.0);
-        assert_eq!(w.control_word, CW_ENABLE);
+        assert_eq!(w.control_word, CW_ENABLE | CW_DRIVE_HOME);
         assert_eq!(w.marker_arm_id, 7);
         assert_eq!(w.switch_arm_id, 200);
         assert_eq!(w.switch_arm_edge, EDGE_FALLING);
@@ -379,7 +402,10 @@ mod tests {
             w.digital_inputs,
             DI_HOME_SWITCH | DI_OVERTRAVEL_NEGATIVE | DI_MARKER_PULSE
         );
-        assert_eq!(w.status_word, SW_ENABLED | SW_FAULT);
+        assert_eq!(
+            w.status_word,
+            SW_ENABLED | SW_FAULT | SW_DRIVE_HOMING | SW_DRIVE_HOMED
+        );
         assert_eq!((w.marker_latch_id, w.marker_latched), (3, 1));
         assert_eq!((w.switch_latch_id, w.switch_latched), (9, 0));
         assert_eq!(w.marker_latch_position, 2500);

@@ -235,6 +235,12 @@ pub struct AxisConfig {
     /// An ambiguous marker fails homing (ERR 1018) instead of completing with
     /// the `Status::ambiguous_marker` warning.
     pub refuse_ambiguous_marker: bool,
+    /// The drive homes the axis itself (EtherCAT: CiA 402 homing mode 6,
+    /// the `[[axis]]` key `drive_homing`): an active sequence's plan is then
+    /// one leg "the drive homes" and the move to Home Position (see
+    /// `axis::drive_homing`). The drive's homing method and speeds are the
+    /// I/O process's to set; the engine only asks and watches.
+    pub drive_homing: bool,
 }
 
 impl Default for AxisConfig {
@@ -279,6 +285,7 @@ impl Default for AxisConfig {
             max_speed: 0.0,
             marker_min_distance: 0.0,
             refuse_ambiguous_marker: false,
+            drive_homing: false,
         }
     }
 }

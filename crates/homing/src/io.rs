@@ -48,6 +48,23 @@ pub struct Feedback {
     /// config); the engine then knows the marker to one cycle of travel.
     pub marker_pulse: bool,
     pub drive: DriveState,
+    /// The drive's own homing (`drive_homing` axes), as it reports it.
+    pub drive_homing: DriveHoming,
+}
+
+/// The drive's own homing (CiA 402 homing mode), as the drive reports it
+/// while the engine asks for it (`Command::drive_home`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DriveHoming {
+    /// The drive runs its homing for this request (or has just finished it,
+    /// or is still leaving homing mode): the drive, not the command, moves
+    /// the axis, and the command follows the actual position.
+    pub active: bool,
+    /// Homing attained: the drive found its home and redefined its
+    /// position (the home point is its position 0), and is at rest.
+    pub attained: bool,
+    /// The drive reports a homing error (or did not take homing mode).
+    pub error: bool,
 }
 
 /// Which electrical edge of the home switch input a registration latch takes.
@@ -89,6 +106,9 @@ pub struct Command {
     pub velocity_error_tolerance: f64,
     pub marker_arm: LatchArm,
     pub switch_arm: LatchArm,
+    /// Ask the drive to home the axis itself (a `drive_homing` axis in its
+    /// drive-homing leg): set for the whole leg, cleared to end it.
+    pub drive_home: bool,
 }
 
 /// Control inputs for one cycle, as a PLC program would drive the MAH rung.
@@ -123,4 +143,9 @@ pub struct Request {
     /// missing sample is excused, within a bound, by the feedback-loss rule
     /// (see `axis::loss`).
     pub stalled: bool,
+    /// The I/O process reports the axis's drive lost (its fieldbus device
+    /// stopped answering or left operation) while motion-io itself is
+    /// alive: the loss of feedback that follows names the drive (ERR 12 /
+    /// EXERR 45) instead of the I/O process, and the status shows it.
+    pub drive_lost: bool,
 }

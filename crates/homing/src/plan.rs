@@ -76,6 +76,10 @@ pub enum Leg {
     Continue,
     /// Passive: wait for the goal while something else moves the axis.
     Watch(Goal),
+    /// The drive homes the axis itself (`drive_homing`): asked for, then
+    /// watched until the drive reports home attained (or an error); the
+    /// command follows the drive (see `axis::drive_homing`).
+    DriveHomes,
 }
 
 impl Leg {
@@ -202,6 +206,9 @@ pub fn creeps(cfg: &AxisConfig) -> bool {
 
 /// The plan of `cfg`'s sequence.
 pub fn plan_for(cfg: &AxisConfig) -> &'static [Leg] {
+    if let Some(p) = crate::axis::drive_homing::plan(cfg) {
+        return p;
+    }
     plan(
         cfg.home_sequence,
         cfg.home_direction,
@@ -258,6 +265,7 @@ pub fn phase_of(plan: &[Leg], i: usize, to_home: bool) -> Phase {
         Some(Continue) if to_home => Phase::MoveHome,
         Some(Continue) => Phase::SeekStop,
         Some(Watch(_)) => Phase::Passive,
+        Some(DriveHomes) => Phase::DriveHoming,
     }
 }
 

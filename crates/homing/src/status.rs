@@ -31,6 +31,8 @@ pub enum Phase {
     Stopping = 9,
     /// Creeping back over a marker found at speed (drives without a latch).
     Creep = 10,
+    /// The drive runs its own homing (`drive_homing`, CiA 402 mode 6).
+    DriveHoming = 11,
 }
 
 crate::spellings!(Phase {
@@ -45,6 +47,7 @@ crate::spellings!(Phase {
     Passive => "passive",
     Stopping => "stopping",
     Creep => "creep",
+    DriveHoming => "drive_homing",
 });
 
 /// Feedback refused as implausible, by kind, counted over the axis's life.
@@ -138,4 +141,7 @@ pub struct Status {
     pub lost_after_ns: Option<u64>,
     /// Implausible feedback refused so far.
     pub implausible: Implausible,
+    /// The I/O process reports the axis's drive lost (`Request::drive_lost`):
+    /// not a reading, not enabled, whatever the last feedback said.
+    pub drive_lost: bool,
 }

@@ -146,7 +146,13 @@ impl Axis {
             self.prev = None;
             self.last = None;
             if self.status.ip {
-                self.fail(now, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, Abort::Controlled);
+                // a lost drive is named as such, not as its I/O process
+                let exerr = if self.status.drive_lost {
+                    EX_DRIVE_LOST
+                } else {
+                    EX_FEEDBACK_LOST
+                };
+                self.fail(now, ERR_SERVO_MESSAGE, exerr, Abort::Controlled);
             }
         }
     }

@@ -36,6 +36,7 @@
 //!   us: the drive is disabled and the overrides restored at once.
 
 mod detect;
+pub mod drive_homing;
 mod followed;
 mod intake;
 mod latches;
@@ -233,6 +234,7 @@ impl Axis {
     }
 
     pub fn step(&mut self, now_ns: u64, feedback: Option<&Feedback>, request: &Request) -> Command {
+        self.drive_presence(request.drive_lost);
         let fresh = self.intake(now_ns, feedback, request.stalled);
         self.requests(now_ns, request);
         // A fresh sample is the newest one (requests never drop it).
@@ -266,7 +268,7 @@ impl Axis {
             (Run::Search(search), _) => {
                 self.status.search_travel = (self.profile.at(now).0 - search.start).abs();
             }
-            (Run::Profile { .. }, _) => {}
+            (Run::Profile { .. } | Run::Drive(_), _) => {}
         }
     }
 
@@ -362,6 +364,7 @@ impl Axis {
     fn advance(&mut self, now: u64, s: &Sample) {
         let moving = self.state.commands_motion();
         let stopping = matches!(self.state, State::Stopping { .. });
+        self.follow_the_drive(now, s);
         if !moving && !stopping && !s.fb.drive.enabled {
             // Nobody holds the axis: follow it, so enabling never jumps.
             self.profile.set(Profile::hold(now, s.fb.position));
@@ -422,6 +425,7 @@ impl Axis {
                 Run::Profile { .. } => {}
                 Run::Waiting { .. } if !self.request.hold => self.start_leg(now, s),
                 Run::Waiting { .. } => {}
+                Run::Drive(d) => self.drive_homing_step(now, s, d),
             },
             &State::Stopping { released } if done => {
                 if self.overrides && !released {
@@ -568,6 +572,7 @@ impl Axis {
                 id: self.latches.switch_id,
                 edge: self.latches.switch_edge,
             },
+            drive_home: self.drive_home_requested(),
         };
         self.last_command = cmd;
         self.plausible.commanded(cmd.position);
