@@ -58,6 +58,10 @@ pub struct SubDeviceReport {
     /// Output / input bytes of its process data.
     pub output_bytes: usize,
     pub input_bytes: usize,
+    /// Its set-up for the log: the mapping in force (objects, offsets,
+    /// bits), sync mode and cycle, SM watchdog, stop, brake, homing, and
+    /// what is unavailable.
+    pub lines: Vec<String>,
 }
 
 impl fmt::Display for SubDeviceReport {

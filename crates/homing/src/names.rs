@@ -131,6 +131,7 @@ mod tests {
             Some(HomeSequence::TorqueThenMarker)
         );
         assert_eq!(Phase::from_number(10), Some(Phase::Creep));
-        assert_eq!(Phase::from_number(11), None);
+        assert_eq!(Phase::from_number(11), Some(Phase::DriveHoming));
+        assert_eq!(Phase::from_number(12), None);
     }
 }

@@ -176,7 +176,7 @@ fn a_drive_homing_error_or_refused_homing_mode_is_12_46() {
         ..Feedback::default()
     };
     let mut k = 0;
-    while axis.status().ip || k < 5 {
+    while axis.status().ip || k < 6 {
         let req = if k < 5 { Request::default() } else { home() };
         axis.step(k * MS, Some(&fb), &req);
         k += 1;

@@ -16,6 +16,7 @@
 
 use motion_io::cli;
 mod ethercat;
+mod ethercat_log;
 mod run;
 mod say;
 mod sim;
@@ -184,7 +185,7 @@ fn start_ethercat(
             bus.keys.dc,
             bus.sm_watchdog().as_millis()
         ));
-        ethercat::EthercatIo::start(bus, map, names)
+        ethercat::EthercatIo::start(bus, map, names, say, &cfg.ios[io].name)
     });
     match started {
         Ok(b) => {

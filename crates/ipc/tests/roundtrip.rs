@@ -117,6 +117,7 @@ fn engine_command(i: u64) -> Command {
             id: 3,
             edge: Edge::Falling,
         },
+        drive_home: false,
     }
 }
 

@@ -140,6 +140,7 @@ fn wild_command() -> impl Strategy<Value = (Command, f64)> {
                             id: si,
                             edge: edge(se),
                         },
+                        drive_home: false,
                     },
                     dt,
                 )
