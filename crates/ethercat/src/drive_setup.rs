@@ -30,7 +30,7 @@ use crate::io::Until;
 use crate::mapping;
 use crate::objects::*;
 use crate::pdo::PdoLayout;
-use crate::report::StartupError;
+use crate::report::{Sd, StartupError};
 use crate::wants::{unavailable, Wants};
 
 /// How long 0x6061 is awaited at PRE-OP before the check moves to SAFE-OP.
@@ -53,21 +53,6 @@ pub(crate) struct DriveSetup {
     pub homing: Option<DriveHomingPlan>,
     /// For the start-up log.
     pub lines: Vec<String>,
-}
-
-/// A SubDevice as messages name it.
-pub(crate) struct Sd<'a> {
-    pub position: usize,
-    pub name: &'a str,
-}
-
-impl Sd<'_> {
-    pub fn err(&self, what: String) -> StartupError {
-        StartupError(format!(
-            "SubDevice {} ({}): {what}",
-            self.position, self.name
-        ))
-    }
 }
 
 async fn write<S, T>(

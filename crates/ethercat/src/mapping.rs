@@ -24,10 +24,9 @@ use ethercrab::error::Error;
 use ethercrab::{SubDevice, SubDeviceRef};
 
 use crate::dictionary::abort_code;
-use crate::drive_setup::Sd;
 use crate::objects::*;
 use crate::pdo::{PdoLayout, MAX_PDOS};
-use crate::report::StartupError;
+use crate::report::{Sd, StartupError};
 use crate::wants::Wants;
 
 /// How the layout in force came about.

@@ -31,10 +31,10 @@ use ethercrab::{Command, MainDevice, SubDevice, SubDeviceRef};
 use motion_config::{EthercatBus, EthercatDc};
 use motion_rt::now_ns;
 
-use crate::drive_setup::{await_mode, configure_drive, Sd, MODE_SAFEOP_WAIT};
+use crate::drive_setup::{await_mode, configure_drive, MODE_SAFEOP_WAIT};
 use crate::group::{OpGroup, Pdi};
 use crate::objects::MODE_CSP;
-use crate::report::SyncMode;
+use crate::report::{Sd, SyncMode};
 use crate::startup::AxisPlan;
 use crate::status::{Health, Shared};
 

@@ -17,6 +17,21 @@ impl fmt::Display for StartupError {
 
 impl std::error::Error for StartupError {}
 
+/// A SubDevice as messages name it.
+pub(crate) struct Sd<'a> {
+    pub position: usize,
+    pub name: &'a str,
+}
+
+impl Sd<'_> {
+    pub fn err(&self, what: String) -> StartupError {
+        StartupError(format!(
+            "SubDevice {} ({}): {what}",
+            self.position, self.name
+        ))
+    }
+}
+
 /// How a SubDevice is synchronised.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SyncMode {

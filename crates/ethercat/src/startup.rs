@@ -23,11 +23,11 @@ use ethercrab::{DcSync, MainDevice};
 use motion_config::{EthercatBus, EthercatDrive};
 
 use crate::capacity::{MAX_PDI, MAX_SUBDEVICES};
-use crate::drive_setup::{await_mode, configure_drive, Sd, MODE_SAFEOP_WAIT};
+use crate::drive_setup::{await_mode, configure_drive, MODE_SAFEOP_WAIT};
 use crate::group::{Group, OpGroup};
 use crate::objects::MODE_CSP;
 use crate::pdo::PdoLayout;
-use crate::report::{StartupError, SubDeviceReport, SyncMode};
+use crate::report::{Sd, StartupError, SubDeviceReport, SyncMode};
 
 /// Per axis, what the bus thread needs.
 #[derive(Clone, Debug, PartialEq)]

@@ -104,6 +104,9 @@ impl Leg {
 use Goal::*;
 use Leg::*;
 
+/// A sequence the drive homes by itself (`drive_homing`).
+pub const DRIVE_HOMES: &[Leg] = &[DriveHomes, MoveHome];
+
 const PASSIVE_SWITCH: &[Leg] = &[Watch(SwitchDetect)];
 const PASSIVE_MARKER: &[Leg] = &[Watch(Marker)];
 const PASSIVE_SWITCH_MARKER: &[Leg] = &[Watch(SwitchDetectThenMarker)];
@@ -206,8 +209,12 @@ pub fn creeps(cfg: &AxisConfig) -> bool {
 
 /// The plan of `cfg`'s sequence.
 pub fn plan_for(cfg: &AxisConfig) -> &'static [Leg] {
-    if let Some(p) = crate::axis::drive_homing::plan(cfg) {
-        return p;
+    if cfg.drive_homing
+        && cfg.home_mode == HomeMode::Active
+        && cfg.home_sequence != HomeSequence::Immediate
+    {
+        // the drive homes (see `axis::drive_homing`), then the move home
+        return DRIVE_HOMES;
     }
     plan(
         cfg.home_sequence,

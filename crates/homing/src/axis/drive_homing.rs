@@ -2,7 +2,7 @@
 //! 6), and the drive's presence as its I/O process reports it.
 //!
 //! **The plan.** An active, non-immediate sequence of a `drive_homing` axis
-//! runs [`PLAN`]: one leg "the drive homes" ([`Leg::DriveHomes`]), then the
+//! runs `plan::DRIVE_HOMES`: one leg "the drive homes" ([`Leg::DriveHomes`]), then the
 //! ordinary move to Home Position. The sequence and direction chose the
 //! drive's method (or `drive_homing_method` did); the I/O process wrote it
 //! with the speeds at start-up. The engine only asks and watches:
@@ -43,12 +43,8 @@ use super::plausible::Plausibility;
 use super::state::{Run, State};
 use super::{Abort, Axis};
 use crate::codes::{ERR_SERVO_MESSAGE, EX_DRIVE_HOMING_ERROR};
-use crate::config::{AxisConfig, HomeMode, HomeSequence};
 use crate::plan::Leg;
 use crate::profile::Profile;
-
-/// The plan of a sequence the drive homes.
-pub const PLAN: &[Leg] = &[Leg::DriveHomes, Leg::MoveHome];
 
 /// The drive must report homing mode in force this long after it was asked
 /// for, or the leg fails (12 / 46): a drive that never takes homing mode is
@@ -65,15 +61,6 @@ pub(super) struct DriveRun {
     /// The drive reported home attained; the request has dropped and the
     /// leg waits for the drive to hand back.
     pub attained: bool,
-}
-
-/// [`PLAN`] for an active, non-immediate sequence of a `drive_homing` axis;
-/// `None` for every other axis (their plans are `plan::plan`'s).
-pub fn plan(cfg: &AxisConfig) -> Option<&'static [Leg]> {
-    (cfg.drive_homing
-        && cfg.home_mode == HomeMode::Active
-        && cfg.home_sequence != HomeSequence::Immediate)
-        .then_some(PLAN)
 }
 
 impl Axis {
