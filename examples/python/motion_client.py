@@ -12,7 +12,7 @@ homes an axis through the control service and follows it until it is done.
 The supervisor is found through its session file ({runtime_dir}/{prefix}.session,
 readable only by the supervisor's user): it names the iceoryx2 domain and the
 session key every request must carry. The message layouts mirror
-crates/control/src/message.rs (layout 2); iceoryx2 checks type name, size and
+crates/control/src/message.rs (layout 2; the status frame @3); iceoryx2 checks type name, size and
 alignment when the services are opened, so a wrong mirror fails loudly.
 
 Exit codes: 0 done (with --home: the axis homed with PC set), 1 refused or
@@ -139,6 +139,9 @@ class IoStatusEntry(ctypes.Structure):
         ("gaps", ctypes.c_uint64 * 4),
         ("longest_gap_cycles", ctypes.c_uint64),
         ("gap_cycles", ctypes.c_uint64),
+        ("spawn_restarts", ctypes.c_uint32),
+        ("spawn_retry_s", ctypes.c_float),
+        ("start_error", ctypes.c_uint8 * 128),
     ]
 
 
@@ -159,7 +162,7 @@ class StatusFrame(ctypes.Structure):
 
     @staticmethod
     def type_name() -> str:
-        return "motion_control::StatusFrame@2"
+        return "motion_control::StatusFrame@3"
 
 
 def text(arr) -> str:

@@ -180,9 +180,10 @@ impl ControlThread {
         };
         let uptime = hub.started.elapsed().as_nanos() as u64;
         let notes = self.keeper.notes();
-        if let Err(e) =
-            server.publish_status(|f| status_fill::fill(&self.s.machine, snap, notes, uptime, f))
-        {
+        if let Err(e) = server.publish_status(|f| {
+            status_fill::fill(&self.s.machine, snap, notes, uptime, f);
+            crate::io_child::note_spawns(&hub.spawns, f);
+        }) {
             log::warn!("status service: {e}");
         }
     }

@@ -29,6 +29,7 @@ impl ControlThread {
                 let uptime = hub.started.elapsed().as_nanos() as u64;
                 let notes = self.keeper.notes();
                 status_fill::fill(&self.s.machine, s, notes, uptime, &mut frame);
+                crate::io_child::note_spawns(&hub.spawns, &mut frame);
             }
         }
         let json = serde_json::to_vec(&frame.to_report()).unwrap_or_default();

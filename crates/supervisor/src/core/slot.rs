@@ -7,7 +7,7 @@
 //! setpoint stream — are per-axis state too: they belong here, beside the
 //! rung, and their requests beside `control.rs`'s.)
 
-use motion_frames::{axis_to_feedback, AxisFeedback, SW_NO_DATA};
+use motion_frames::{axis_to_feedback, AxisFeedback, SW_DRIVE_LOST, SW_NO_DATA};
 use motion_homing::{Axis, Command, Feedback, Phase, Request, Status};
 
 use super::link::LinkCycle;
@@ -200,6 +200,11 @@ impl AxisSlot {
         };
         if c.reconnected {
             self.engine.reconnected(now_ns);
+        }
+        // the I/O process says the axis's drive is gone (it is alive)
+        if c.fresh {
+            self.rung.request.drive_lost =
+                entry.is_some_and(|a| a.status_word & SW_DRIVE_LOST != 0);
         }
         self.feedback = match entry {
             Some(a) if c.fresh && a.status_word & SW_NO_DATA == 0 => {
