@@ -515,3 +515,74 @@ fn limit_switches_are_reported_where_the_drive_has_them() {
         "unavailable: 0x60FD digital inputs not in the process data",
     );
 }
+
+#[test]
+fn the_scan_lists_every_subdevice_what_it_can_home_and_a_config_skeleton() {
+    let _t = turn();
+    let Some(pair) = ecat_emu::VethPair::or_skip() else {
+        return;
+    };
+    let mut m6 = drive("EMU-M6");
+    m6.homing_methods = vec![19, 21, 34, 37];
+    let mut bare = drive("EMU-NOTP");
+    bare.touch_probe = false;
+    bare.homing_methods = Vec::new();
+    bare.dc = false;
+    let mut fixed_drive = drive("EMU-FIXED");
+    fixed_drive.pdo = fixed();
+    let _emu = emulator(&pair, vec![drive("EMU-ALL"), m6, bare, fixed_drive]);
+    let r = motion_ethercat::scan::scan(&pair.master, Duration::from_secs(30)).expect("scan");
+    eprintln!("{}", r.text());
+    assert_eq!(r.subdevices.len(), 4);
+    let all = &r.subdevices[0];
+    assert!(all.cia402 && all.dc && all.touch_probe, "{all:#?}");
+    assert_eq!(all.device_name.as_deref(), Some("EMU-ALL"));
+    assert!(all.objects.contains(&"0x60B8".to_string()));
+    assert_eq!(
+        all.sequences.controller,
+        [
+            "immediate",
+            "switch",
+            "marker",
+            "switch_then_marker",
+            "torque",
+            "torque_then_marker",
+            "registration (a switch latched by touch probe 2)"
+        ]
+    );
+    assert!(all
+        .sequences
+        .drive
+        .contains(&"switch_then_marker bidirectional_forward (method 3)".to_string()));
+    assert_eq!(all.rx_pdos[0].index, "0x1600");
+    assert_eq!(all.rx_pdos[0].entries[0], "0x6040:00/16 controlword");
+    let m6 = &r.subdevices[1];
+    assert_eq!(m6.homing_methods, Some(vec![19, 21, 34, 37]));
+    assert_eq!(
+        m6.sequences.drive,
+        [
+            "switch bidirectional_forward (method 19)",
+            "switch bidirectional_reverse (method 21)",
+            "marker bidirectional_forward (method 34)",
+            "marker unidirectional_forward (method 34)"
+        ]
+    );
+    let bare = &r.subdevices[2];
+    assert!(!bare.touch_probe && !bare.dc && bare.homing_methods.is_none());
+    assert_eq!(bare.sequences.controller, ["immediate", "switch", "torque"]);
+    assert!(bare.sequences.drive.is_empty());
+    let fixed = &r.subdevices[3];
+    assert_eq!(
+        fixed.tx_pdos[0].entries[2],
+        "0x60F4:00/32 following error actual value"
+    );
+    // the skeleton is a config
+    let m = motion_config::parse(&r.config).unwrap_or_else(|p| panic!("{p:#?}\n{}", r.config));
+    assert_eq!(m.axes.len(), 4);
+    assert!(r.config.contains(
+        "# drive-side homing (drive_homing = true): switch bidirectional_forward (method 19)"
+    ));
+    // JSON
+    let v: serde_json::Value = serde_json::to_value(&r).unwrap();
+    assert_eq!(v["subdevices"][1]["homing_methods"][0], 19);
+}

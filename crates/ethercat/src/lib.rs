@@ -24,6 +24,7 @@
 //!   bus thread, [`words`] — its layout; [`status`] — counters.
 //! * [`io`] — the bus thread's executor over [`socket`], the raw socket.
 //! * [`capacity`] — the fixed capacities (SubDevices, process image, frames).
+//! * [`scan`] — the bus as it is (`motion-io scan`) and a config skeleton.
 
 pub mod axis;
 pub mod backend;
@@ -44,6 +45,7 @@ pub mod pdo;
 pub mod probe;
 pub mod reconfigure;
 pub mod report;
+pub mod scan;
 pub mod shared;
 pub mod socket;
 pub mod startup;

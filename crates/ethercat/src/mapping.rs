@@ -52,9 +52,9 @@ impl fmt::Display for Source {
 
 /// One PDO object and its entries.
 #[derive(Clone, Debug, PartialEq, Eq)]
-struct Pdo {
-    index: u16,
-    entries: Vec<PdoEntry>,
+pub(crate) struct Pdo {
+    pub index: u16,
+    pub entries: Vec<PdoEntry>,
 }
 
 impl Pdo {
@@ -95,7 +95,7 @@ where
 }
 
 /// The PDOs assigned in `assign` (0x1C12 / 0x1C13), with their entries.
-async fn assigned<S>(sd: &SubDeviceRef<'_, S>, assign: u16) -> Result<Vec<Pdo>, Error>
+pub(crate) async fn assigned<S>(sd: &SubDeviceRef<'_, S>, assign: u16) -> Result<Vec<Pdo>, Error>
 where
     S: Deref<Target = SubDevice>,
 {

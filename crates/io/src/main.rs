@@ -19,6 +19,7 @@ mod ethercat;
 mod ethercat_log;
 mod run;
 mod say;
+mod scan;
 mod sim;
 
 use std::path::Path;
@@ -57,6 +58,9 @@ fn real_main() -> i32 {
     let say = Say { quiet: opts.quiet };
     if opts.quiet {
         log::set_max_level(log::LevelFilter::Warn);
+    }
+    if let Some(cli::Sub::Scan { interface, json }) = &opts.command {
+        return scan::run(interface, *json);
     }
 
     let (cfg, label) = match motion_config::load(opts.config.as_deref()) {
