@@ -139,6 +139,8 @@ pub struct AxisLogic {
     /// The command's target is not followed until it is near the actual
     /// position again (after the drive's homing handed back).
     resync: bool,
+    /// Its SubDevice was lost since the last valid inputs.
+    was_lost: bool,
     pos64: Option<i64>,
     pos32: i32,
     /// Cycles since the last valid inputs (derived velocity).
@@ -176,6 +178,7 @@ impl AxisLogic {
             last_reset: false,
             fault_latch: false,
             resync: false,
+            was_lost: false,
             pos64: None,
             pos32: 0,
             since_inputs: 1,
@@ -231,13 +234,13 @@ impl AxisLogic {
     }
 
     /// Its SubDevice is lost this cycle (not answering, out of OP,
-    /// power-cycled): an axis that was enabled gets the backend's fault,
-    /// so that the drive is not enabled again by itself when it is back;
-    /// state machines start afresh when it is.
+    /// power-cycled): the state machines start afresh when it is back, and
+    /// a drive that comes back no longer enabled while enable is still
+    /// asked for gets the backend's fault — it is never enabled again by
+    /// itself (a short loss the drive rode out in Operation enabled just
+    /// goes on).
     pub fn lost(&mut self) {
-        if self.last_enable || self.state.is_enabled() {
-            self.fault_latch = true;
-        }
+        self.was_lost = true;
         self.cia = Cia402::new();
         if let Some(h) = &mut self.homing {
             h.forget();
@@ -275,6 +278,9 @@ impl AxisLogic {
         };
         self.since_inputs = 1;
         self.state = State::from_statusword(inp.statusword);
+        if std::mem::take(&mut self.was_lost) && enable && !self.state.is_enabled() {
+            self.fault_latch = true;
+        }
         let set = self.check_setpoint(cmd, mode, enable, pos64);
         self.window = following_error_window(cmd.position_error_tolerance);
         let at_rest = velocity.abs() < self.rest_velocity;

@@ -379,6 +379,7 @@ fn the_fault_reset_request_is_controlword_bit_7_and_enables_nothing() {
 }
 
 /// A lost drive that was enabled comes back faulted: not enabled by itself.
+/// One that rode the loss out still enabled goes on.
 #[test]
 fn a_lost_drive_is_not_enabled_again_by_itself() {
     let mut a = logic();
@@ -387,6 +388,11 @@ fn a_lost_drive_is_not_enabled_again_by_itself() {
     a.lost();
     let (_, fb) = a.step(&cmd(true, 0), Mode::Normal, None);
     assert_eq!(fb.status_word & SW_ENABLED, 0, "not reported enabled");
+    let mut b = logic();
+    b.step(&cmd(true, 0), Mode::Normal, Some(&on));
+    b.lost();
+    let (o, fb) = b.step(&cmd(true, 0), Mode::Normal, Some(&on));
+    assert_eq!((o.controlword, fb.status_word), (0x000F, SW_ENABLED));
     // back, power-cycled: Switch on disabled
     let back = inputs(State::SwitchOnDisabled, 5);
     for _ in 0..5 {

@@ -8,8 +8,9 @@
 //!   stop (nothing can be done there: its SM watchdog stops it), and an
 //!   axis that was enabled is not enabled again by itself when it is back
 //!   (`AxisLogic::lost`). After [`SILENT_FRAMES`] frames in a row that came
-//!   back from nobody (the first cable pulled, the interface down) every
-//!   SubDevice counts as not answering.
+//!   back from nobody (the first cable pulled, its power gone, the interface
+//!   down) every SubDevice counts as not answering: sooner than any
+//!   feedback-loss bound, so the loss is named after the drives.
 //! * **Back to OP**, without restarting anything: one that answers out of
 //!   OP gets its AL error acknowledged and SAFE-OP → OP requested
 //!   ([`Job::Recover`], every [`RECOVERY_INTERVAL_NS`]); one found in INIT
@@ -35,7 +36,7 @@ pub const RECOVERY_INTERVAL_NS: u64 = 20_000_000;
 pub const PROBE_INTERVAL_NS: u64 = 200_000_000;
 /// Frames in a row that nobody answered before every SubDevice counts as
 /// not answering.
-pub const SILENT_FRAMES: u32 = 20;
+pub const SILENT_FRAMES: u32 = 3;
 
 /// The SubDevices of the group.
 pub(crate) struct Devices {

@@ -137,7 +137,12 @@ fn real_main() -> i32 {
     loop {
         let domain = match wait_for_supervisor(&settings, &runtime_dir) {
             Ok(d) => d,
-            Err(code) => return code,
+            Err(code) => {
+                if let Some(s) = backend.summary() {
+                    say.notice(format_args!("{s}"));
+                }
+                return code;
+            }
         };
         let outcome = serve(&domain, &io_name, backend.as_mut(), &settings, &label);
         // node and ports are gone: tidy the domain (dead peers), and the
