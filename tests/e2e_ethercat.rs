@@ -546,8 +546,7 @@ fn sigterm_ends_motion_io_within_the_bound_with_drives_lost() {
 /// again when asked.
 #[test]
 fn a_drive_power_cycled_mid_homing_is_reconfigured_without_restarting_motion_io() {
-    let _serial = serial();
-    let Some(b) = slow("ecat_powercycle", |_| {}) else {
+    let (_serial, Some(b)) = (serial(), slow("ecat_powercycle", |_| {})) else {
         return;
     };
     let d = Daemon::start(&b.cfg, &["bus0"]);

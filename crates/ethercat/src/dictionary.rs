@@ -12,36 +12,7 @@ use ethercrab::{SubDevice, SubDeviceRef};
 use crate::objects::*;
 
 /// Every object the backend may use, probed at start-up (and by the scan).
-pub const PROBED: [PdoEntry; 28] = [
-    CONTROLWORD,
-    STATUSWORD,
-    MODES_OF_OPERATION,
-    MODES_OF_OPERATION_DISPLAY,
-    TARGET_POSITION,
-    POSITION_ACTUAL,
-    VELOCITY_ACTUAL,
-    TORQUE_ACTUAL,
-    DIGITAL_INPUTS,
-    ERROR_CODE,
-    TOUCH_PROBE_FUNCTION,
-    TOUCH_PROBE_STATUS,
-    TOUCH_PROBE_1_POSITIVE,
-    TOUCH_PROBE_1_NEGATIVE,
-    TOUCH_PROBE_2_POSITIVE,
-    TOUCH_PROBE_2_NEGATIVE,
-    POSITIVE_TORQUE_LIMIT,
-    NEGATIVE_TORQUE_LIMIT,
-    MAX_TORQUE,
-    FOLLOWING_ERROR_WINDOW,
-    QUICK_STOP_OPTION_CODE,
-    HOME_OFFSET,
-    HOMING_METHOD,
-    HOMING_SPEED_SWITCH,
-    HOMING_SPEED_ZERO,
-    HOMING_ACCELERATION,
-    SUPPORTED_HOMING_METHODS,
-    SUPPORTED_DRIVE_MODES,
-];
+pub const PROBED: [PdoEntry; 28] = USED;
 
 /// The SDO abort code of a mailbox error, if it is one.
 pub fn abort_code(e: &Error) -> Option<u32> {

@@ -117,8 +117,9 @@ pub const MODE_CSP: i8 = 8;
 /// Homing mode (0x6060).
 pub const MODE_HOMING: i8 = 6;
 
-/// Every object above, for names.
-const ALL: [PdoEntry; 31] = [
+/// Every object the backend may use (probed in a drive's dictionary at
+/// start-up and by the scan).
+pub const USED: [PdoEntry; 28] = [
     CONTROLWORD,
     STATUSWORD,
     MODES_OF_OPERATION,
@@ -147,13 +148,20 @@ const ALL: [PdoEntry; 31] = [
     HOMING_ACCELERATION,
     SUPPORTED_HOMING_METHODS,
     SUPPORTED_DRIVE_MODES,
+];
+
+/// Objects of fixed mappings the backend does not use, for names.
+const FOREIGN: [PdoEntry; 3] = [
     entry(0x6062, 32, "position demand value"),
     entry(0x60F4, 32, "following error actual value"),
     entry(0x60FF, 32, "target velocity"),
 ];
 
 fn known_name(index: u16) -> &'static str {
-    ALL.iter().find(|e| e.index == index).map_or("", |e| e.name)
+    USED.iter()
+        .chain(&FOREIGN)
+        .find(|e| e.index == index)
+        .map_or("", |e| e.name)
 }
 
 /// Name of an object, for messages ("object" if unknown).

@@ -87,6 +87,16 @@ fn run(axis: &mut Axis, drive: &mut Drive, from: u64, cycles: u64, req: &Request
     cmd
 }
 
+/// A drive at raw `raw`, disabled, not homing.
+fn drive_at(raw: f64) -> Drive {
+    Drive {
+        raw,
+        enabled: false,
+        homing: DriveHoming::default(),
+        cycles: 0,
+    }
+}
+
 fn home() -> Request {
     Request {
         home: true,
@@ -106,12 +116,7 @@ fn the_drive_homes_then_the_engine_moves_to_home_position() {
         "{:?}",
         axis.config_errors()
     );
-    let mut d = Drive {
-        raw: 40.0,
-        enabled: false,
-        homing: DriveHoming::default(),
-        cycles: 0,
-    };
+    let mut d = drive_at(40.0);
     run(&mut axis, &mut d, 0, 5, &Request::default());
     // start: enable, then the drive's leg asks the drive to home
     let mut asked = None;
@@ -150,12 +155,7 @@ fn the_drive_homes_then_the_engine_moves_to_home_position() {
 fn a_drive_homing_error_or_refused_homing_mode_is_12_46() {
     // error bit
     let mut axis = Axis::new(axis_cfg());
-    let mut d = Drive {
-        raw: 0.0,
-        enabled: false,
-        homing: DriveHoming::default(),
-        cycles: 0,
-    };
+    let mut d = drive_at(0.0);
     run(&mut axis, &mut d, 0, 5, &Request::default());
     run(&mut axis, &mut d, 5, 50, &home());
     d.homing.error = true;
@@ -190,12 +190,7 @@ fn a_drive_homing_error_or_refused_homing_mode_is_12_46() {
 #[test]
 fn a_stop_drops_the_request_and_the_command_follows_the_drive_to_rest() {
     let mut axis = Axis::new(axis_cfg());
-    let mut d = Drive {
-        raw: 0.0,
-        enabled: false,
-        homing: DriveHoming::default(),
-        cycles: 0,
-    };
+    let mut d = drive_at(0.0);
     run(&mut axis, &mut d, 0, 5, &Request::default());
     run(&mut axis, &mut d, 5, 100, &home());
     let stop = Request {

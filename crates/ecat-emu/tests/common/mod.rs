@@ -69,26 +69,9 @@ pub fn emulator(pair: &VethPair, drives: Vec<DriveConfig>) -> Emulator {
 
 /// Pair + emulator + backend, or `None` (skipped, reason printed).
 pub fn rig_with(drives: Vec<DriveConfig>, tweak: impl FnOnce(&mut EthercatBus)) -> Option<Rig> {
-    let pair = VethPair::or_skip()?;
     let n = drives.len();
-    let emu = emulator(&pair, drives);
-    let mut cfg = EthercatBus::new(&pair.master, CYCLE_US, mapping(n));
-    tweak(&mut cfg);
-    let backend = EthercatBackend::new(cfg).unwrap_or_else(|e| panic!("start-up: {e}"));
-    let mut cmd = CommandFrame::ZERO;
-    cmd.header.axis_count = n as u32;
-    for a in &mut cmd.axes[..n] {
-        a.torque_limit_positive = 100.0;
-        a.torque_limit_negative = 100.0;
-    }
-    Some(Rig {
-        backend,
-        emu: Some(emu),
-        _pair: Some(pair),
-        cmd,
-        fb: FeedbackFrame::ZERO,
-        next: Instant::now(),
-    })
+    let r = start(drives, mapping(n), tweak)?;
+    Some(r.unwrap_or_else(|e| panic!("start-up: {e}")))
 }
 
 pub fn rig(n: usize) -> Option<Rig> {
