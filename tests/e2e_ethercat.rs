@@ -31,7 +31,7 @@ use std::time::{Duration, Instant};
 use ecat_emu::State;
 use motion_harness::ecat::Bus;
 use motion_harness::{assert_close, *};
-use motion_report::{AxisResult, AxisStatus, CtlHomeReport, ErrorReport, HomeReport};
+use motion_report::{AxisResult, AxisStatus, CtlHomeReport, HomeReport};
 use nix::sys::signal::Signal;
 
 /// `home --json` on the bus: exit 0, latency measured, nothing left behind.
@@ -324,8 +324,24 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
     emu.unplug(1);
     let s = wait_ended(&d, "S");
     eprintln!("S ended {:?} after the cable was pulled", pulled.elapsed());
-    assert_eq!((s.err, s.exerr), (12, 40), "feedback lost: {s:#?}");
+    assert_eq!((s.err, s.exerr), (12, 45), "its drive lost: {s:#?}");
     assert!(!s.homed, "{s:#?}");
+    // the status says the drive is lost, not enabled; motion-io says which
+    assert!(s.drive_lost && !s.enabled, "{s:#?}");
+    assert!(
+        s.error
+            .as_deref()
+            .is_some_and(|e| e.starts_with("drive lost")),
+        "{s:#?}"
+    );
+    assert!(
+        d.wait_line(
+            "EtherCAT: SubDevice 1 \"EMU-S\" (axis S) lost: it does not answer",
+            Duration::from_secs(5)
+        ),
+        "{}",
+        d.stderr()
+    );
     let t = d.axis("T");
     assert!(!t.homed, "HomedStatus cleared by the feedback loss: {t:#?}");
     let r = wait_ended(&d, "R");
@@ -348,10 +364,15 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
         "not back in OP: {:?}",
         b.drive(1)
     );
-    assert!(wait_for(Duration::from_secs(5), || d
-        .axis("S")
-        .raw
-        .is_some()));
+    assert!(wait_for(Duration::from_secs(5), || {
+        let s = d.axis("S");
+        s.raw.is_some() && !s.drive_lost
+    }));
+    assert!(
+        d.wait_line("(axis S) back in OP", Duration::from_secs(5)),
+        "{}",
+        d.stderr()
+    );
     // the axis faults (feedback lost in motion, the drives' own faults after
     // their watchdog) need a reset before the next homing (issue 15)
     d.ctl(&["reset", "S", "T"]).expect_code(0);
@@ -424,37 +445,286 @@ fn killed_motion_io_the_drives_watchdog_stops_the_axis() {
     assert_clean(&b.cfg.prefix);
 }
 
+/// From the moment the supervisor is killed (motion-io alive, its watchdog
+/// the only one left) until the drive reports Switch on disabled (power
+/// stage off): the interface promises 1 s by default.
+fn killed_supervisor_stop_time(
+    tag: &str,
+    tweak: impl FnOnce(&mut [ecat_emu::DriveConfig]),
+) -> Option<Duration> {
+    let b = slow(tag, tweak)?;
+    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
+    assert!(
+        w.wait_line("home S: accepted", Duration::from_secs(20))
+            .is_some(),
+        "homing never started"
+    );
+    assert!(wait_for(Duration::from_secs(10), || b
+        .drive(0)
+        .drive
+        .velocity
+        > 4.0));
+    signal_pid(w.pid() as i32, Signal::SIGKILL);
+    let killed = Instant::now();
+    let mut off = None;
+    while killed.elapsed() < Duration::from_secs(5) {
+        let v = b.drive(0).drive;
+        if v.state == State::SwitchOnDisabled && !v.enabled {
+            off = Some(killed.elapsed());
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let off = off.unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
+    let io = find_process("motion-io", &b.cfg.prefix);
+    // motion-io outlives its supervisor by the stop and a second, then
+    // leaves (it was spawned with --exit-with-supervisor)
+    assert!(wait_for(Duration::from_secs(10), || find_process(
+        "motion-io",
+        &b.cfg.prefix
+    )
+    .is_none()));
+    let run = w.finish();
+    eprintln!("motion-io ({io:?}):\n{}", run.stderr);
+    assert_clean(&b.cfg.prefix);
+    Some(off)
+}
+
 #[test]
-fn a_drive_without_touch_probe_is_refused_with_the_object_named() {
+fn killed_supervisor_every_drive_ends_switched_off_within_the_bound() {
     let _serial = serial();
-    let Some(b) = slow("ecat_notp", |d| d[0].touch_probe = false) else {
+    let Some(honours) = killed_supervisor_stop_time("ecat_killsup", |_| {}) else {
         return;
     };
-    let run = supervisor(&["home", "--json", "--config", b.cfg.arg()]);
-    let want = "SubDevice 0 (EMU-S): object 0x60B8 touch probe function not supported \
-                (SDO abort 0x06020000)";
-    let v: ErrorReport = run.expect_code(1).report();
-    assert!(run.stderr.contains(want), "{}", run.stderr);
-    let e = v
-        .errors
-        .first()
-        .map(|e| e.message.as_str())
-        .unwrap_or_default();
-    assert!(
-        e.contains("I/O process bus0") && e.contains("exit status: 1"),
-        "{v:#?}"
+    let Some(ignores) =
+        killed_supervisor_stop_time("ecat_killsup_noqs", |d| d[0].ignores_quick_stop = true)
+    else {
+        return;
+    };
+    eprintln!(
+        "supervisor killed → drive in Switch on disabled: {:.1} ms (quick stop honoured), \
+         {:.1} ms (quick stop ignored); io_watchdog 50 cycles of 1 ms, quick stop bound 500 ms",
+        honours.as_secs_f64() * 1e3,
+        ignores.as_secs_f64() * 1e3
     );
-    // motion-io alone says the same and exits 1
-    let io = spawn_io(&[
-        "--config",
-        b.cfg.arg(),
-        "--backend",
-        "ethercat",
-        "--interface",
-        b.rig.interface(),
-    ]);
-    let out = io.finish();
+    assert!(honours < Duration::from_secs(1), "{honours:?}");
+    assert!(ignores < Duration::from_secs(1), "{ignores:?}");
+}
+
+/// R on the first drive, S and T behind it: S's and T's drives are lost
+/// (cable pulled) while motion-io serves the daemon; SIGTERM to motion-io
+/// still ends it within its stated bound (quick stop bound 500 ms + 200 ms
+/// margin + leaving OP ≤ 1 s).
+#[test]
+fn sigterm_ends_motion_io_within_the_bound_with_drives_lost() {
+    let _serial = serial();
+    let Some(b) = family("unplug") else {
+        return;
+    };
+    let d = Daemon::start(&b.cfg, &["bus0"]);
+    let io = find_process("motion-io", &b.cfg.prefix).expect("motion-io");
+    d.ctl(&["home", "R"]).expect_code(0);
+    b.rig.emulator().unplug(1);
+    assert!(
+        d.wait_line("(axis S) lost", Duration::from_secs(5)),
+        "{}",
+        d.stderr()
+    );
+    signal_pid(io, Signal::SIGTERM);
+    let t0 = Instant::now();
+    let alive = |pid: i32| nix::sys::signal::kill(nix::unistd::Pid::from_raw(pid), None).is_ok();
+    assert!(wait_for(Duration::from_secs(10), || !alive(io)));
+    let took = t0.elapsed();
+    assert!(
+        d.wait_line("2 drive loss(es)", Duration::from_secs(5)),
+        "{}",
+        d.stderr()
+    );
+    eprintln!(
+        "SIGTERM with two of three drives lost: motion-io (pid {io}) gone after {:.0} ms",
+        took.as_secs_f64() * 1e3
+    );
+    assert!(
+        took < Duration::from_millis(2500),
+        "{took:?}\n{}",
+        d.stderr()
+    );
+    d.stop();
+    assert_clean(&b.cfg.prefix);
+}
+
+/// S's drive loses its power mid-homing and gets it back: its axis ends
+/// ERR 12 / EXERR 45 (its drive lost), the drive is re-configured and back
+/// in OP without restarting motion-io, not enabled by itself, and homes
+/// again when asked.
+#[test]
+fn a_drive_power_cycled_mid_homing_is_reconfigured_without_restarting_motion_io() {
+    let (_serial, Some(b)) = (serial(), slow("ecat_powercycle", |_| {})) else {
+        return;
+    };
+    let d = Daemon::start(&b.cfg, &["bus0"]);
+    let io = find_process("motion-io", &b.cfg.prefix).expect("motion-io");
+    d.ctl(&["home", "S", "--no-wait"]).expect_code(0);
+    wait_phase(&d, "S", "seek");
+    std::thread::sleep(Duration::from_millis(300));
+    let emu = b.rig.emulator();
+    emu.power_off(0);
+    let s = wait_ended(&d, "S");
+    assert_eq!((s.err, s.exerr), (12, 45), "{s:#?}");
+    assert!(s.drive_lost && !s.enabled, "{s:#?}");
+    std::thread::sleep(Duration::from_millis(500));
+    emu.power_on(0);
+    for line in [
+        "(axis S) was power-cycled (found at its bus position without its station address): \
+         re-configuring it",
+        "(axis S) back in OP",
+    ] {
+        assert!(
+            d.wait_line(line, Duration::from_secs(10)),
+            "no {line:?} in\n{}",
+            d.stderr()
+        );
+    }
+    assert!(wait_for(Duration::from_secs(5), || !d.axis("S").drive_lost));
+    // not enabled by itself
+    std::thread::sleep(Duration::from_millis(300));
+    let v = b.drive(0).drive;
+    assert_eq!(v.state, State::SwitchOnDisabled, "{v:?}");
+    assert!(!d.axis("S").enabled);
+    assert_eq!(
+        find_process("motion-io", &b.cfg.prefix),
+        Some(io),
+        "the same motion-io"
+    );
+    let r = home_again(&d, &["S"]);
+    assert!(named(&r.axes, "S").pc);
+    let end = d.stop().expect_code(0).stderr.clone();
+    assert!(end.contains("1 re-configured after a power cycle"), "{end}");
+    assert_clean(&b.cfg.prefix);
+}
+
+/// S homed by its drive (CiA 402 mode 6, method 19 for a bidirectional
+/// forward switch): the drive finds the switch edge at 0 (its position 0
+/// from then on), stops past it; the engine moves to Home Position, the
+/// edge + Home Offset 1.
+#[test]
+fn drive_side_homing_in_mode_6() {
+    let _serial = serial();
+    let machine = Machine::fixture("slow_switch")
+        .set("axis.S.sim.start", -10.0)
+        .set("axis.S.drive_homing", true)
+        .set("axis.S.home_offset", 1.0)
+        .set("axis.S.home_position", 10.0);
+    let Some(b) = Bus::start("ecat_drivehome", &machine, |_| {}) else {
+        return;
+    };
+    let (v, stderr) = home(&b);
+    assert!(
+        stderr.contains("drive homing: method 19 (positive home switch)"),
+        "{stderr}"
+    );
+    let s = homed(&v, "S");
+    assert!(s.pc, "{s:#?}");
+    // the drive's home point is its position 0: the switch edge, exact
+    assert_close!(s, event_raw, 0.0, 1e-9);
+    ended_at(&b, 0, s, 1.0, 10.0);
+    assert_eq!(b.drive(0).drive.mode, 8, "back in cyclic position mode");
+}
+
+/// A drive that lacks what its axis needs: motion-io names every missing
+/// object at once and exits 1; the daemon starts it again with growing
+/// delays, says so without repeating itself, and its status shows the
+/// restarts and the error.
+#[test]
+fn a_drive_lacking_objects_is_refused_with_every_one_named_and_restarted_with_back_off() {
+    let _serial = serial();
+    let machine = Machine::fixture("slow_switch")
+        .set("axis.S.registration", true)
+        .set("supervisor.io_watchdog_cycles", 50);
+    let Some(b) = Bus::start("ecat_bare", &machine, |d| {
+        d[0].touch_probe = false;
+        d[0].digital_inputs = false;
+    }) else {
+        return;
+    };
+    // motion-io alone: every missing object, at once
+    let out = spawn_io(&["--config", b.cfg.arg(), "--interface", b.rig.interface()]).finish();
     out.expect_code(1);
-    assert!(out.stderr.contains(want), "{}", out.stderr);
+    for want in [
+        "SubDevice 0 (EMU-S): 5 problem(s) for axis S:",
+        "missing 0x60B8 touch probe function — arms the touch probes — needed by axis S: \
+         registration = true",
+        "missing 0x60B9 touch probe status",
+        "missing 0x60BC touch probe 2 positive edge",
+        "missing 0x60BD touch probe 2 negative edge",
+        "missing 0x60FD digital inputs — reports the home switch, limit switch and index inputs \
+         — needed by axis S: home_sequence = \"switch\"",
+    ] {
+        assert!(out.stderr.contains(want), "no {want:?} in\n{}", out.stderr);
+    }
+    // the daemon starts it again and again, 1 s, 2 s, 4 s …, saying so
+    // once; its status shows the restarts and the error
+    let mut d = Daemon::spawn(&b.cfg);
+    let ok = wait_for(Duration::from_secs(20), || {
+        motion_harness::daemon::status(&motion_harness::bins::test_bin("motionctl"), &b.cfg.prefix)
+            .is_some_and(|s| s.io[0].restarts >= 2)
+    });
+    let st = d.status();
+    assert!(ok, "{:#?}\n{}", st.io, d.stderr());
+    let row = &st.io[0];
+    assert!(
+        row.start_error
+            .as_deref()
+            .is_some_and(|e| e.starts_with("EtherCAT start-up on")),
+        "{row:#?}"
+    );
+    assert!(row.retry_in_s.is_some_and(|s| s > 0.0), "{row:#?}");
+    let err = d.stderr();
+    assert!(
+        err.contains("starting it again in 1 s (restart 1)"),
+        "{err}"
+    );
+    assert!(
+        err.contains("starting it again in 2 s (restart 2)"),
+        "{err}"
+    );
+    assert!(err.contains("failed at start-up again, as before"), "{err}");
+    assert_eq!(
+        err.matches("missing 0x60B8 touch probe function").count(),
+        1,
+        "said once: {err}"
+    );
+    d.wait_ready(Attached::These(&[]));
+    d.stop();
+    assert_clean(&b.cfg.prefix);
+}
+
+#[test]
+fn scan_from_the_command_line() {
+    let _serial = serial();
+    let Some(b) = family("unplug") else {
+        return;
+    };
+    let out = spawn_io(&["scan", "--interface", b.rig.interface(), "--json"]).finish();
+    out.expect_code(0);
+    let v = out.json();
+    let subs = v["subdevices"].as_array().expect("subdevices");
+    assert_eq!(subs.len(), 3, "{v:#}");
+    assert_eq!(subs[1]["name"], "EMU-S");
+    assert!(v["config"]
+        .as_str()
+        .unwrap()
+        .contains("ethercat_position = 2"));
+    let text = spawn_io(&["scan", "--interface", b.rig.interface()]).finish();
+    text.expect_code(0);
+    assert!(
+        text.stdout.contains("SubDevice 0 \"EMU-R\""),
+        "{}",
+        text.stdout
+    );
+    // nothing there
+    let out = spawn_io(&["scan", "--interface", "nonexistent0", "--json"]).finish();
+    out.expect_code(1);
+    assert!(out.stdout.contains("\"errors\""), "{}", out.stdout);
     assert_clean(&b.cfg.prefix);
 }

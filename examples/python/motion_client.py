@@ -180,6 +180,9 @@ class IoStatusEntry(ctypes.Structure):
         ("gaps", ctypes.c_uint64 * 4),
         ("longest_gap_cycles", ctypes.c_uint64),
         ("gap_cycles", ctypes.c_uint64),
+        ("spawn_restarts", ctypes.c_uint32),
+        ("spawn_retry_s", ctypes.c_float),
+        ("start_error", ctypes.c_uint8 * 128),
     ]
 
 

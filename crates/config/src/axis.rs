@@ -25,7 +25,7 @@ pub(crate) fn parse(
     let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
     let mut engine = engine(&mut r, sup);
     crate::operations::keys(&mut r, &mut engine);
-    let ethercat = crate::ethercat::parse::axis_keys(&mut r, &engine, ios.get(io));
+    let ethercat = crate::ethercat::parse::axis_keys(&mut r, &mut engine, ios.get(io));
     let sim_table = r.table("sim");
     r.finish();
     let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
@@ -178,6 +178,8 @@ fn engine(r: &mut Reader<'_>, sup: &SupervisorConfig) -> AxisConfig {
         stream_timeout_ns: d.stream_timeout_ns,
         stream_unhomed: d.stream_unhomed,
         home_reverse_at_limit: r.bool("home_reverse_at_limit", false),
+        // set by the EtherCAT keys (`drive_homing`)
+        drive_homing: false,
     };
     // A switch edge sampled once per cycle is known to a cycle of travel at
     // return speed; a marker closer than two such cycles to it is ambiguous.

@@ -53,6 +53,13 @@ pub const ETHERCAT_POSITION: (u32, u32) = (0, 65_535);
 pub const INDEX_PULSE_BIT: (u32, u32) = (16, 31);
 /// EtherCAT: most axes (SubDevices) one EtherCAT I/O process drives.
 pub const ETHERCAT_MAX_AXES: usize = 32;
+/// EtherCAT: the quick stop's bound before disable voltage, ms.
+pub const QUICK_STOP_TIMEOUT_MS: (u32, u32) = (10, 10_000);
+/// EtherCAT: a vertical axis's brake delay (disable operation → disable
+/// voltage), ms.
+pub const BRAKE_DELAY_MS: (u32, u32) = (0, 2_000);
+/// EtherCAT: CiA 402 homing methods (0x6098, a signed byte; 0 = none).
+pub const DRIVE_HOMING_METHOD: (i32, i32) = (-128, 127);
 
 /// The table as the README prints it.
 pub const TABLE: &[Range] = &[
@@ -128,4 +135,8 @@ pub const TABLE: &[Range] = &[
         "units/s²",
     ),
     ("stream_timeout_ms", 1.0, 1000.0, "ms"),
+    ("[[io]] quick_stop_timeout_ms (EtherCAT)", 10.0, 10_000.0, "ms"),
+    ("ethercat_home_switch_bit", 16.0, 31.0, "bit of 0x60FD"),
+    ("ethercat_brake_delay_ms", 0.0, 2_000.0, "ms"),
+    ("drive_homing_method", -128.0, 127.0, "CiA 402 method, not 0"),
 ];

@@ -343,6 +343,7 @@ io = "sim0"
             startup_timeout_s: 5,
             mode_in_pdo: true,
             dc_static_sync_iterations: 0,
+            quick_stop_timeout_ms: 500,
         }
     );
     assert_eq!(
@@ -353,14 +354,20 @@ io = "sim0"
         m.axes[0].ethercat,
         Some(AxisEthercat {
             drive: EthercatDrive::Position(0),
-            index_pulse_bit: None
+            index_pulse_bit: None,
+            home_switch_bit: None,
+            brake_delay_ms: 0,
+            drive_homing_method: None,
         })
     );
     assert_eq!(
         m.axes[1].ethercat,
         Some(AxisEthercat {
             drive: EthercatDrive::Name("X5-Servo 2".into()),
-            index_pulse_bit: Some(17)
+            index_pulse_bit: Some(17),
+            home_switch_bit: None,
+            brake_delay_ms: 0,
+            drive_homing_method: None,
         })
     );
     assert_eq!(m.axes[2].ethercat, None, "virtual: no drive");

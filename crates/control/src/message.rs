@@ -22,6 +22,8 @@ pub const MAX_AXES: usize = 64;
 pub const MAX_IOS: usize = 16;
 /// Bytes of a response's message.
 pub const MESSAGE_LEN: usize = 256;
+/// Bytes of `IoStatusEntry::start_error`.
+pub const START_ERROR_LEN: usize = 128;
 /// Bytes of a response's data (a page of a report, a trace or a log).
 pub const DATA_LEN: usize = 32 * 1024;
 /// Bytes of a phase name.
@@ -326,6 +328,10 @@ pub const SX_LOST_RECONNECT: u8 = 1 << 4;
 /// HomedStatus comes from the stored reference of an absolute axis,
 /// applied without motion (not from a homing run since start-up).
 pub const SX_RESTORED: u8 = 1 << 5;
+/// The I/O process reports the axis's drive lost (it stopped answering on
+/// its fieldbus, left operation, or was power-cycled): not a reading, not
+/// enabled.
+pub const SX_DRIVE_LOST: u8 = 1 << 6;
 
 /// `AxisStatusEntry::warnings`: the last homing's marker lay closer to the
 /// switch edge than `marker_min_distance` (which marker is taken is a
@@ -422,7 +428,7 @@ pub struct AxisStatusEntry {
 
 /// One I/O process of the status frame.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, ZeroCopySend, PlacementDefault)]
+#[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
 pub struct IoStatusEntry {
     pub name: [u8; NAME_LEN],
     /// 1 = fresh feedback arrives (within the feedback-loss rule).
@@ -439,6 +445,34 @@ pub struct IoStatusEntry {
     pub longest_gap_cycles: u64,
     /// Cycles without a fresh answer right now.
     pub gap_cycles: u64,
+    /// A spawned I/O process: times the supervisor started it again.
+    pub spawn_restarts: u32,
+    /// A spawned I/O process: seconds until its next start (0: running).
+    pub spawn_retry_s: f32,
+    /// A spawned I/O process: the error it ended with at its last failed
+    /// start (its first line), NUL-padded; empty when none.
+    pub start_error: [u8; START_ERROR_LEN],
+}
+
+impl Default for IoStatusEntry {
+    /// All zero (every field is an integer, a float or a byte array).
+    fn default() -> Self {
+        Self {
+            name: [0; NAME_LEN],
+            attached: 0,
+            reserved: [0; 7],
+            frames_received: 0,
+            frames_missing: 0,
+            frames_refused: 0,
+            attachments: 0,
+            gaps: [0; 4],
+            longest_gap_cycles: 0,
+            gap_cycles: 0,
+            spawn_restarts: 0,
+            spawn_retry_s: 0.0,
+            start_error: [0; START_ERROR_LEN],
+        }
+    }
 }
 
 /// The setpoint stream's intake as the status frame shows it: frames taken,
@@ -624,18 +658,21 @@ const _: () = {
     assert!(offset_of!(AxisStatusEntry, position) == 64);
     assert!(offset_of!(AxisStatusEntry, search_limit) == 128);
 
-    assert!(size_of::<IoStatusEntry>() == 120);
+    assert!(size_of::<IoStatusEntry>() == 256);
     assert!(offset_of!(IoStatusEntry, frames_received) == 40);
     assert!(offset_of!(IoStatusEntry, gaps) == 72);
     assert!(offset_of!(IoStatusEntry, gap_cycles) == 112);
+    assert!(offset_of!(IoStatusEntry, spawn_restarts) == 120);
+    assert!(offset_of!(IoStatusEntry, spawn_retry_s) == 124);
+    assert!(offset_of!(IoStatusEntry, start_error) == 128);
 
     assert!(size_of::<StreamStatusEntry>() == 72);
     assert!(offset_of!(StreamStatusEntry, acquired) == 64);
 
     assert!(offset_of!(StatusFrame, axes) == 48);
     assert!(offset_of!(StatusFrame, ios) == 48 + 232 * MAX_AXES);
-    assert!(offset_of!(StatusFrame, stream) == 48 + 232 * MAX_AXES + 120 * MAX_IOS);
-    assert!(size_of::<StatusFrame>() == 48 + 232 * MAX_AXES + 120 * MAX_IOS + 72);
+    assert!(offset_of!(StatusFrame, stream) == 48 + 232 * MAX_AXES + 256 * MAX_IOS);
+    assert!(size_of::<StatusFrame>() == 48 + 232 * MAX_AXES + 256 * MAX_IOS + 72);
 };
 
 #[cfg(test)]

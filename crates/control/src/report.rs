@@ -234,6 +234,7 @@ impl StatusFrame {
                         drive_error_code: a.drive_error_code,
                         skew: finite(a.skew).map(|x| motion_report::round(x, 6)),
                         restored: a.extra & SX_RESTORED != 0,
+                        drive_lost: a.extra & SX_DRIVE_LOST != 0,
                         error: a.error_text(&names),
                         warnings: a.warning_texts(),
                         ..a.motion_report()
@@ -258,6 +259,10 @@ impl StatusFrame {
                         longest_cycles: i.longest_gap_cycles,
                     },
                     gap_cycles: i.gap_cycles,
+                    restarts: i.spawn_restarts,
+                    retry_in_s: (i.spawn_retry_s > 0.0)
+                        .then(|| motion_report::round(f64::from(i.spawn_retry_s), 1)),
+                    start_error: Some(get_str(&i.start_error)).filter(|e| !e.is_empty()),
                 })
                 .collect(),
             stream: self.stream.to_report(),

@@ -359,6 +359,23 @@ impl Emulator {
         self.chain().set_plugged(position, true);
     }
 
+    /// SubDevice `position` loses its power: it (and everything behind it)
+    /// no longer answers; its mechanics coast where they are.
+    pub fn power_off(&self, position: usize) {
+        self.chain().set_plugged(position, false);
+    }
+
+    /// Its power returns: the ESC and the drive start from power-on (INIT,
+    /// station address 0, default dictionary, the encoder at its start
+    /// value), the mechanics where they were.
+    pub fn power_on(&self, position: usize) {
+        let mut c = self.chain();
+        if let Some(e) = c.escs.get_mut(position) {
+            e.power_cycle();
+        }
+        c.set_plugged(position, true);
+    }
+
     /// Nothing answers at all (all frames lost).
     pub fn set_silent(&self, silent: bool) {
         self.chain().set_silent(silent);

@@ -196,10 +196,12 @@ impl Esc {
         m[0x0502..0x0504].copy_from_slice(&SII_CONTROL_READ_SIZE_8.to_le_bytes());
     }
 
-    /// Power cycle: everything back to power-on (the drive too: a new plant
-    /// at its start position).
+    /// Power cycle: everything back to power-on — registers, AL state,
+    /// station address 0, the drive's dictionary and state machine — but
+    /// the mechanics stay where they are; the drive's encoder restarts at
+    /// its start value (an incremental encoder's position is lost).
     pub fn power_cycle(&mut self) {
-        let drive = Drive::new(self.drive.cfg.clone());
+        let drive = self.drive.power_cycled();
         let epoch = self.epoch;
         let position = self.position;
         *self = Esc::new(drive, position, epoch);
@@ -267,6 +269,8 @@ impl Esc {
     }
 
     fn refresh(&mut self, now: Instant) {
+        self.drive
+            .set_operational(matches!(self.al_state, al::SAFEOP | al::OP));
         let mut dl: u16 = 0x0003 | 0x0010 | 0x0200 | 0x5000;
         if self.port1_open {
             dl |= 0x0020 | 0x0800;

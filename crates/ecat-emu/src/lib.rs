@@ -26,5 +26,7 @@ pub mod od;
 pub mod sii;
 
 pub use chain::{Chain, Emulator, EmulatorConfig, SubDeviceView};
-pub use drive::{DriveConfig, DriveView, State, TorqueObjects};
+pub use drive::{
+    DriveConfig, DriveView, ModeDisplay, PdoProfile, State, TorqueObjects, SUPPORTED_METHODS,
+};
 pub use netns::{Skip, VethPair};

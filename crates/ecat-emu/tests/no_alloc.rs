@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use ecat_emu::{DriveConfig, Emulator, EmulatorConfig, VethPair};
 use motion_config::ethercat::BusAxis;
-use motion_config::{AxisEthercat, EthercatBus, EthercatDrive};
+use motion_config::EthercatBus;
 use motion_ethercat::EthercatBackend;
 use motion_frames::backend::Backend;
 use motion_frames::{CommandFrame, FeedbackFrame, CW_ENABLE, SW_ENABLED};
@@ -26,15 +26,7 @@ fn exchange_and_bus_cycle_do_not_allocate() {
         priority: Some(60),
     })
     .unwrap();
-    let axes = (0..2)
-        .map(|i| BusAxis {
-            name: format!("A{i}"),
-            ethercat: AxisEthercat {
-                drive: EthercatDrive::Position(i),
-                index_pulse_bit: None,
-            },
-        })
-        .collect();
+    let axes = (0..2).map(|i| BusAxis::at(&format!("A{i}"), i)).collect();
     let mut b = EthercatBackend::new(EthercatBus::new(&pair.master, 1000, axes)).expect("start-up");
     let mut cmd = CommandFrame::ZERO;
     cmd.header.axis_count = 2;

@@ -6,194 +6,23 @@
 //! command loop, and two of those on two vCPUs would measure each other.
 //! Timing checks assert behaviour with generous bounds, never microseconds.
 
+mod common;
+
 use std::io::{BufRead, BufReader};
 use std::os::unix::process::CommandExt;
 use std::process::{Command, Stdio};
-use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use ecat_emu::{DriveConfig, DriveView, Emulator, EmulatorConfig, State, TorqueObjects, VethPair};
-use motion_config::ethercat::BusAxis;
-use motion_config::{AxisEthercat, EthercatBus, EthercatDc, EthercatDrive};
+use common::*;
+use ecat_emu::{State, TorqueObjects, VethPair};
+use motion_config::{EthercatBus, EthercatDc};
 use motion_ethercat::{EthercatBackend, SyncMode};
 use motion_frames::backend::Backend;
 use motion_frames::{
-    AxisCommand, AxisFeedback, CommandFrame, FeedbackFrame, CW_ENABLE, DI_HOME_SWITCH,
-    DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING,
-    SW_ENABLED, SW_FAULT, SW_NO_DATA,
+    CommandFrame, FeedbackFrame, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE,
+    DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED,
+    SW_FAULT, SW_NO_DATA,
 };
-
-const CYCLE: Duration = Duration::from_millis(1);
-const CYCLE_US: u32 = 1000;
-
-static TURN: Mutex<()> = Mutex::new(());
-
-fn turn() -> MutexGuard<'static, ()> {
-    TURN.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// A drive with markers every 10 units at 2.5, a switch on [5, 8] and hard
-/// stops at ±50.
-fn drive(name: &str) -> DriveConfig {
-    let mut d = DriveConfig::new(name);
-    d.plant.marker_every = 10.0;
-    d.plant.marker_at = 2.5;
-    d.plant.switch = Some((5.0, 8.0));
-    d.plant.hard_stop = Some((-50.0, 50.0));
-    d.plant.overtravel = Some((-45.0, 45.0));
-    d
-}
-
-struct Rig {
-    backend: EthercatBackend,
-    emu: Option<Emulator>,
-    _pair: Option<VethPair>,
-    cmd: CommandFrame,
-    fb: FeedbackFrame,
-    next: Instant,
-}
-
-/// Axes A0.. on the drives at positions 0.., the index pulse on bit 16.
-fn mapping(n: usize) -> Vec<BusAxis> {
-    (0..n)
-        .map(|i| BusAxis {
-            name: format!("A{i}"),
-            ethercat: AxisEthercat {
-                drive: EthercatDrive::Position(i as u16),
-                index_pulse_bit: Some(16),
-            },
-        })
-        .collect()
-}
-
-fn emulator(pair: &VethPair, drives: Vec<DriveConfig>) -> Emulator {
-    Emulator::start(EmulatorConfig {
-        interface: pair.subdevice.clone(),
-        netns: Some(pair.netns.clone()),
-        drives,
-        priority: Some(60),
-    })
-    .expect("emulator")
-}
-
-/// Pair + emulator + backend, or `None` (skipped, reason printed).
-fn rig_with(drives: Vec<DriveConfig>, tweak: impl FnOnce(&mut EthercatBus)) -> Option<Rig> {
-    let pair = VethPair::or_skip()?;
-    let n = drives.len();
-    let emu = emulator(&pair, drives);
-    let mut cfg = EthercatBus::new(&pair.master, CYCLE_US, mapping(n));
-    tweak(&mut cfg);
-    let backend = EthercatBackend::new(cfg).unwrap_or_else(|e| panic!("start-up: {e}"));
-    let mut cmd = CommandFrame::ZERO;
-    cmd.header.axis_count = n as u32;
-    for a in &mut cmd.axes[..n] {
-        a.torque_limit_positive = 100.0;
-        a.torque_limit_negative = 100.0;
-    }
-    Some(Rig {
-        backend,
-        emu: Some(emu),
-        _pair: Some(pair),
-        cmd,
-        fb: FeedbackFrame::ZERO,
-        next: Instant::now(),
-    })
-}
-
-fn rig(n: usize) -> Option<Rig> {
-    rig_with((0..n).map(|i| drive(&format!("EMU-{i}"))).collect(), |_| {})
-}
-
-impl Rig {
-    fn emu(&self) -> &Emulator {
-        self.emu.as_ref().expect("emulator")
-    }
-
-    /// One supervisor cycle: wait for the next 1 ms tick, exchange.
-    fn tick(&mut self) {
-        let now = Instant::now();
-        if self.next > now {
-            std::thread::sleep(self.next - now);
-        }
-        self.next += CYCLE;
-        if self.next + CYCLE * 20 < Instant::now() {
-            self.next = Instant::now(); // a long stall: do not catch up
-        }
-        self.backend
-            .exchange(&self.cmd, &mut self.fb)
-            .expect("exchange");
-    }
-
-    fn axis(&mut self, i: usize) -> &mut AxisCommand {
-        &mut self.cmd.axes[i]
-    }
-
-    /// What emulated drive `i` does.
-    fn drive(&self, i: usize) -> DriveView {
-        self.emu().view(i).expect("drive").drive
-    }
-
-    /// Ticks until axis `i`'s feedback satisfies `pred`, at most 2 s.
-    fn until_axis(&mut self, i: usize, what: &str, pred: impl Fn(&AxisFeedback) -> bool) -> usize {
-        self.until(what, Duration::from_secs(2), |r| pred(&r.fb.axes[i]))
-    }
-
-    /// Ticks until `pred` holds (returns the ticks taken) or panics after
-    /// `max`.
-    fn until(&mut self, what: &str, max: Duration, mut pred: impl FnMut(&Rig) -> bool) -> usize {
-        let t0 = Instant::now();
-        let mut n = 0;
-        loop {
-            self.tick();
-            n += 1;
-            if pred(self) {
-                return n;
-            }
-            assert!(
-                t0.elapsed() < max,
-                "{what}: not within {max:?}; feedback {:?}; drive {:?}",
-                &self.fb.axes[..self.fb.header.axis_count as usize],
-                self.emu.as_ref().and_then(|e| e.view(0)).map(|v| v.drive)
-            );
-        }
-    }
-
-    fn ticks(&mut self, n: usize) {
-        for _ in 0..n {
-            self.tick();
-        }
-    }
-
-    /// Enables axis `i` the way the engine does: target = actual.
-    fn enable(&mut self, i: usize) {
-        self.until_axis(i, "feedback", |a| a.status_word & SW_NO_DATA == 0);
-        let at = self.fb.axes[i].position;
-        let a = self.axis(i);
-        a.target_position = at;
-        a.control_word = CW_ENABLE;
-        self.until_axis(i, "enabled", |a| a.status_word & SW_ENABLED != 0);
-    }
-
-    /// Moves axis `i` to `to` counts at `speed` counts per cycle.
-    fn move_to(&mut self, i: usize, to: i64, speed: i64) {
-        loop {
-            let t = self.cmd.axes[i].target_position;
-            if t == to {
-                break;
-            }
-            let step = (to - t).clamp(-speed, speed);
-            self.axis(i).target_position = t + step;
-            self.tick();
-        }
-    }
-
-    fn settle(&mut self, i: usize) {
-        let to = self.cmd.axes[i].target_position;
-        self.until_axis(i, "settled", |a| {
-            a.position == to && a.status_word & SW_NO_DATA == 0
-        });
-    }
-}
 
 #[test]
 fn startup_maps_pdos_and_reports_dc_and_free_run() {
@@ -412,8 +241,11 @@ fn max_torque_only_drive_gets_the_larger_limit_through_0x6072() {
     let Some(mut r) = rig_with(vec![d], |_| {}) else {
         return;
     };
-    let w = &r.backend.report().warnings;
-    assert!(w.iter().any(|w| w.contains("0x6072")), "{w:?}");
+    let lines = &r.backend.report().subdevices[0].lines;
+    assert!(
+        lines.iter().any(|l| l.contains("0x6072 max torque @")),
+        "the limit travels in 0x6072: {lines:#?}"
+    );
     r.enable(0);
     r.axis(0).torque_limit_positive = 30.0;
     r.axis(0).torque_limit_negative = 20.0;
@@ -598,24 +430,6 @@ fn following_error_window_follows_the_tolerance() {
         },
     );
     assert_eq!(r.backend.bus_status().axes[0].following_window_writes, 2);
-}
-
-#[test]
-fn a_drive_without_touch_probe_is_refused_with_the_object_named() {
-    let _t = turn();
-    let Some(pair) = VethPair::or_skip() else {
-        return;
-    };
-    let mut d = drive("NOTP");
-    d.touch_probe = false;
-    let _emu = emulator(&pair, vec![d]);
-    let cfg = EthercatBus::new(&pair.master, CYCLE_US, mapping(1));
-    let e = EthercatBackend::new(cfg).err().expect("must be refused");
-    eprintln!("{e}");
-    assert_eq!(
-        e.to_string(),
-        "SubDevice 0 (NOTP): object 0x60B8 touch probe function not supported (SDO abort 0x06020000)"
-    );
 }
 
 /// The master in a child process (this test binary again), killed with

@@ -6,9 +6,16 @@
 //! Rules:
 //!
 //! * **Enable** (`CW_ENABLE`) walks the drive to Operation enabled through
-//!   [`Cia402`]; a rising edge of the request also asks for a fault reset
-//!   (the frames' handshake: a fault stays reported, also while disabled,
-//!   until enable goes false → true).
+//!   [`Cia402`].
+//! * **Faults.** A drive fault (CiA 402 Fault) and the backend's own fault
+//!   (a bounded stop after the watchdog, a refused set-point, a drive that
+//!   was lost) stay reported until a reset: the rising edge of
+//!   `CW_FAULT_RESET` (MAFR; CiA 402 controlword bit 7 on the drive). The
+//!   rising edge of `CW_ENABLE` does the same — the frames' older handshake,
+//!   kept because the `Backend` contract promises it; an engine that
+//!   refuses to enable a faulted axis (issue 15) never raises it on one, so
+//!   it never clears a fault behind the operator's back. Nothing is ever
+//!   enabled by a reset.
 //! * **Set-points**: while the drive is not in Operation enabled the target
 //!   follows the actual position (no jump on enabling); in Operation enabled
 //!   it is the command's `target_position`. Positions are 64-bit in the
@@ -16,52 +23,103 @@
 //!   every cycle's difference (so it never wraps), targets are sent modulo
 //!   2³² and must lie within ±2³⁰ counts of the actual position. A target
 //!   outside that, the invalid-position sentinel or a NaN torque limit is
-//!   refused: the last good target stays, the axis quick-stops on the
-//!   drive's ramp, is disabled and reports a fault until the enable handshake
-//!   (a real drive faults on a bad set-point).
+//!   refused: the last good target stays, the axis stops (the bounded stop
+//!   below), is disabled and reports a fault until a reset.
 //! * **Torque limits** (% rated, f32) → per mille (u16), clamped to
-//!   0..=65535.
+//!   0..=65535, where the layout carries a limit.
 //! * **Position error tolerance** (counts, 0 = off) → the following error
 //!   window 0x6065 wanted (u32::MAX = off); the bus thread writes it over SDO
-//!   when it changes. The velocity error tolerance has no CiA 402 object in
-//!   CSP and is not applied.
-//! * **Watchdog stop**: an enabled axis gets a quick stop (the drive's own
-//!   ramp, 0x6085); at rest (|v| below one count per cycle, or the drive has
-//!   left Quick stop active by itself) it is disabled and reports a
-//!   communication fault. **Emergency stop**: "disable voltage" at once and a
-//!   fault. Both faults clear with the enable handshake.
+//!   when it changes.
+//! * **Watchdog stop** ([`Mode::WatchdogStop`]) and a refused set-point: the
+//!   bounded stop of [`crate::stop`] — quick stop, then disable voltage at
+//!   rest, after `quick_stop_timeout_ms`, or at once when the drive ignores
+//!   quick stop (a brake gets its delay first); the axis ends in Switch on
+//!   disabled and reports a fault. **Emergency stop**: disable voltage at
+//!   once and a fault.
+//! * **The drive's homing** (`CW_DRIVE_HOME`, [`crate::drive_homing`]): mode
+//!   6, started, watched, handed back to cyclic position mode at the actual
+//!   position; after the hand-back the command's target is followed again
+//!   only once it lies within a few counts of the actual position (the
+//!   engine follows the drive; a stale target is never jumped to).
+//! * **A lost drive** ([`AxisLogic::lost`]): the backend latches a fault
+//!   for an axis that was enabled, so the drive is not re-enabled by itself
+//!   when it comes back.
 //! * **No data this cycle**: the outputs stay what they were (the state
 //!   machines are not stepped blind) and the feedback is the last good one
 //!   with `SW_NO_DATA`.
+//! * **Objects the layout lacks**: without 0x606C the velocity is the
+//!   position's change per cycle; without 0x6077 the torque is 0; without
+//!   0x60FD no input is ever reported; without touch probes no latch.
 
 use motion_frames::{
-    AxisCommand, AxisFeedback, CW_ENABLE, DI_HOME_SWITCH, DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE,
-    DI_OVERTRAVEL_POSITIVE, EDGE_RISING, INVALID_COUNTS, SW_ENABLED, SW_FAULT, SW_NO_DATA,
+    AxisCommand, AxisFeedback, CW_DRIVE_HOME, CW_ENABLE, CW_FAULT_RESET, DI_HOME_SWITCH,
+    DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_RISING, INVALID_COUNTS,
+    SW_DRIVE_HOMED, SW_DRIVE_HOMING, SW_DRIVE_HOMING_ERROR, SW_ENABLED, SW_FAULT, SW_NO_DATA,
 };
 
 use crate::cia402::{Cia402, State, Target};
-use crate::pdo::{di, DriveInputs, DriveOutputs, PdoLayout, MODE_CSP};
+use crate::drive_homing::{self, DriveHoming};
+use crate::objects::{di, MODE_CSP};
+use crate::pdo::{DriveInputs, DriveOutputs, PdoLayout};
 use crate::probe::{Edge, ProbeInputs, TouchProbes};
+use crate::stop::Stopper;
 
 /// Largest distance between target and actual position, counts.
 pub const MAX_TARGET_DISTANCE: i64 = 1 << 30;
+/// After the drive's homing handed back, the command's target is followed
+/// again once it is this close to the actual position (plus four cycles of
+/// its velocity), counts.
+pub const RESYNC_COUNTS: i64 = 16;
 
 /// What the caller wants from all axes this cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
     /// Follow the command frame.
     Normal,
-    /// Commands stopped: controlled stop, then disable with a fault.
+    /// Commands stopped: the bounded stop, then disabled with a fault.
     WatchdogStop,
     /// Power off now, fault.
     Emergency,
 }
 
-/// Per-axis counters of refused set-points.
+/// Per-axis counters.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct AxisCounters {
     pub rejected_setpoints: u64,
     pub fault_resets: u64,
+}
+
+/// How one axis is set up.
+#[derive(Clone, Debug)]
+pub struct AxisSetup {
+    pub layout: PdoLayout,
+    pub cycle_s: f64,
+    /// Manufacturer bit of 0x60FD that reports the index pulse per cycle.
+    pub index_pulse_bit: Option<u8>,
+    /// Bit of 0x60FD wired to the home switch (default 2).
+    pub home_switch_bit: Option<u8>,
+    /// The bounded stop: quick stop at most this long.
+    pub quick_stop_ms: u32,
+    /// Disable operation this long before disable voltage (0: no brake).
+    pub brake_ms: u32,
+    /// The drive homes the axis itself when asked.
+    pub drive_homing: bool,
+}
+
+impl AxisSetup {
+    /// An axis on `layout` with the defaults (bit 2 home switch, no index
+    /// bit, 500 ms quick stop, no brake, no drive homing).
+    pub fn new(layout: PdoLayout, cycle_s: f64) -> AxisSetup {
+        AxisSetup {
+            layout,
+            cycle_s,
+            index_pulse_bit: None,
+            home_switch_bit: None,
+            quick_stop_ms: 500,
+            brake_ms: 0,
+            drive_homing: false,
+        }
+    }
 }
 
 /// The logic of one axis.
@@ -70,36 +128,60 @@ pub struct AxisLogic {
     layout: PdoLayout,
     cia: Cia402,
     probes: TouchProbes,
-    /// `CW_ENABLE` of the previous command (edge detection).
+    stopper: Stopper,
+    homing: Option<DriveHoming>,
+    /// `CW_ENABLE` / `CW_FAULT_RESET` of the previous command (edges).
     last_enable: bool,
-    /// The backend's own fault (watchdog / emergency stop, refused
-    /// set-point), cleared by the enable handshake.
+    last_reset: bool,
+    /// The backend's own fault (bounded stop, refused set-point, lost
+    /// drive), cleared by a reset.
     fault_latch: bool,
+    /// The command's target is not followed until it is near the actual
+    /// position again (after the drive's homing handed back).
+    resync: bool,
+    /// Its SubDevice was lost since the last valid inputs.
+    was_lost: bool,
     pos64: Option<i64>,
     pos32: i32,
+    /// Cycles since the last valid inputs (derived velocity).
+    since_inputs: u32,
     state: State,
     outputs: DriveOutputs,
     last_feedback: AxisFeedback,
     kept_error: u16,
-    /// Digital-input bit that carries the index pulse (manufacturer range).
     index_pulse_bit: Option<u8>,
+    home_switch: u32,
     /// 0x6065 the command asks for.
     window: u32,
+    cycle_s: f64,
     /// Counts/s below which an axis counts as at rest (one count per cycle).
     rest_velocity: f64,
     pub counters: AxisCounters,
 }
 
 impl AxisLogic {
-    pub fn new(layout: PdoLayout, cycle_s: f64, index_pulse_bit: Option<u8>) -> AxisLogic {
+    pub fn new(setup: AxisSetup) -> AxisLogic {
+        let cycle_s = if setup.cycle_s > 0.0 {
+            setup.cycle_s
+        } else {
+            0.001
+        };
+        let halt_s = f64::from(setup.quick_stop_ms) * 1e-3;
         AxisLogic {
-            layout,
             cia: Cia402::new(),
             probes: TouchProbes::new(),
+            stopper: Stopper::new(cycle_s, setup.quick_stop_ms, setup.brake_ms),
+            homing: setup
+                .drive_homing
+                .then(|| DriveHoming::new(cycle_s, halt_s)),
             last_enable: false,
+            last_reset: false,
             fault_latch: false,
+            resync: false,
+            was_lost: false,
             pos64: None,
             pos32: 0,
+            since_inputs: 1,
             state: State::NotReadyToSwitchOn,
             outputs: DriveOutputs {
                 mode: MODE_CSP,
@@ -107,10 +189,13 @@ impl AxisLogic {
             },
             last_feedback: AxisFeedback::ZERO,
             kept_error: 0,
-            index_pulse_bit,
+            index_pulse_bit: setup.index_pulse_bit,
+            home_switch: 1u32 << (setup.home_switch_bit.unwrap_or(2) & 31),
             window: u32::MAX,
-            rest_velocity: if cycle_s > 0.0 { 1.0 / cycle_s } else { 1000.0 },
+            cycle_s,
+            rest_velocity: 1.0 / cycle_s,
             counters: AxisCounters::default(),
+            layout: setup.layout,
         }
     }
 
@@ -138,10 +223,31 @@ impl AxisLogic {
         self.last_feedback
     }
 
-    /// A controlled stop asked for by [`Mode::WatchdogStop`] is complete:
-    /// the drive is not enabled.
+    /// The stop asked for by [`Mode::WatchdogStop`] is complete: the drive
+    /// is in Switch on disabled (or was never enabled).
     pub fn at_rest_and_disabled(&self) -> bool {
-        !self.state.is_enabled() && self.state != State::QuickStopActive
+        !self.state.is_enabled()
+            && !matches!(
+                self.state,
+                State::QuickStopActive | State::FaultReactionActive | State::SwitchedOn
+            )
+    }
+
+    /// Its SubDevice is lost this cycle (not answering, out of OP,
+    /// power-cycled): the state machines start afresh when it is back, and
+    /// a drive that comes back no longer enabled while enable is still
+    /// asked for gets the backend's fault — it is never enabled again by
+    /// itself (a short loss the drive rode out in Operation enabled just
+    /// goes on).
+    pub fn lost(&mut self) {
+        self.was_lost = true;
+        self.cia = Cia402::new();
+        if let Some(h) = &mut self.homing {
+            h.forget();
+        }
+        self.stopper.reset();
+        self.state = State::NotReadyToSwitchOn;
+        self.last_feedback.status_word &= !(SW_ENABLED | SW_DRIVE_HOMING | SW_DRIVE_HOMED);
     }
 
     /// One cycle. `inputs`: this cycle's process data, `None` if it did not
@@ -154,33 +260,38 @@ impl AxisLogic {
     ) -> (DriveOutputs, AxisFeedback) {
         let enable = cmd.control_word & CW_ENABLE != 0;
         if mode == Mode::Normal {
-            if enable && !self.last_enable {
-                self.fault_latch = false;
-                self.cia.request_fault_reset();
-                self.counters.fault_resets += 1;
-            }
-            self.last_enable = enable;
+            self.resets(cmd, enable);
         }
         let Some(inp) = inputs else {
+            self.since_inputs = self.since_inputs.saturating_add(1);
             let mut fb = self.last_feedback;
             fb.status_word |= SW_NO_DATA;
             return (self.outputs, fb);
         };
+        let prev = self.pos64;
         let pos64 = self.extend(inp.position);
+        let velocity = if self.layout.present.velocity {
+            f64::from(inp.velocity)
+        } else {
+            let dt = self.cycle_s * f64::from(self.since_inputs.max(1));
+            prev.map_or(0.0, |p| (pos64 - p) as f64 / dt)
+        };
+        self.since_inputs = 1;
         self.state = State::from_statusword(inp.statusword);
+        if std::mem::take(&mut self.was_lost) && enable && !self.state.is_enabled() {
+            self.fault_latch = true;
+        }
         let set = self.check_setpoint(cmd, mode, enable, pos64);
         self.window = following_error_window(cmd.position_error_tolerance);
-        let target = self.cia_target(mode, enable, inp.velocity);
-        let controlword = self.cia.step(inp.statusword, target);
-
-        let following = self.state.is_enabled() && target == Target::Enabled;
-        let target_position = if following && set.target_ok {
-            cmd.target_position as i32 // modulo 2^32, consistent with the extension
-        } else if following {
-            self.outputs.target_position // refused: hold the last good one
-        } else {
-            inp.position
-        };
+        let at_rest = velocity.abs() < self.rest_velocity;
+        let target = self.cia_target(mode, enable, at_rest);
+        let home = self.drive_homing(cmd, mode, target, inp, at_rest);
+        let mut controlword = self.cia.step(inp.statusword, target);
+        if self.state.is_enabled() && target == Target::Enabled {
+            controlword |= home.controlword;
+        }
+        let target_position =
+            self.target_position(cmd, target, set.target_ok, pos64, inp, home.hold_actual);
         let function = self.probe_function(cmd, inp, pos64);
         self.outputs = DriveOutputs {
             controlword,
@@ -188,11 +299,101 @@ impl AxisLogic {
             touch_probe_function: function,
             torque_limit_positive: set.tpos.unwrap_or(self.outputs.torque_limit_positive),
             torque_limit_negative: set.tneg.unwrap_or(self.outputs.torque_limit_negative),
-            mode: MODE_CSP,
+            mode: home.mode,
         };
-        let fb = self.feedback(inp, pos64);
+        let mut fb = self.feedback(inp, pos64, velocity);
+        for (on, bit) in [
+            (home.active, SW_DRIVE_HOMING),
+            (home.attained, SW_DRIVE_HOMED),
+            (home.error, SW_DRIVE_HOMING_ERROR),
+        ] {
+            if on {
+                fb.status_word |= bit;
+            }
+        }
         self.last_feedback = fb;
         (self.outputs, fb)
+    }
+
+    /// The rising edges of `CW_FAULT_RESET` and `CW_ENABLE` reset the
+    /// backend's fault and ask the drive for a fault reset.
+    fn resets(&mut self, cmd: &AxisCommand, enable: bool) {
+        let reset = cmd.control_word & CW_FAULT_RESET != 0;
+        if (enable && !self.last_enable) || (reset && !self.last_reset) {
+            self.fault_latch = false;
+            self.cia.request_fault_reset();
+            self.counters.fault_resets += 1;
+        }
+        self.last_enable = enable;
+        self.last_reset = reset;
+    }
+
+    /// The set-point this cycle: the command's while following, the last
+    /// good one after a refusal, else (and while the drive homes, or until
+    /// the command has caught up after it) the actual position.
+    fn target_position(
+        &mut self,
+        cmd: &AxisCommand,
+        target: Target,
+        target_ok: bool,
+        pos64: i64,
+        inp: &DriveInputs,
+        hold_actual: bool,
+    ) -> i32 {
+        if hold_actual {
+            self.resync = true;
+            return inp.position;
+        }
+        if !(self.state.is_enabled() && target == Target::Enabled) {
+            return inp.position;
+        }
+        if self.resync {
+            let window = RESYNC_COUNTS as f64 + cmd.target_velocity.abs() * 4.0 * self.cycle_s;
+            let near = ((cmd.target_position - pos64) as f64).abs() <= window;
+            if !(target_ok && near) {
+                return inp.position;
+            }
+            self.resync = false;
+        }
+        if target_ok {
+            cmd.target_position as i32 // modulo 2^32, consistent with the extension
+        } else {
+            self.outputs.target_position // refused: hold the last good one
+        }
+    }
+
+    /// The drive's homing this cycle (idle, CSP, when not configured).
+    fn drive_homing(
+        &mut self,
+        cmd: &AxisCommand,
+        mode: Mode,
+        target: Target,
+        inp: &DriveInputs,
+        at_rest: bool,
+    ) -> drive_homing::Out {
+        let asked = cmd.control_word & CW_DRIVE_HOME != 0;
+        let Some(h) = &mut self.homing else {
+            return drive_homing::Out {
+                mode: MODE_CSP,
+                controlword: 0,
+                hold_actual: false,
+                active: false,
+                attained: false,
+                // asked of a drive that cannot: say so
+                error: asked && mode == Mode::Normal,
+                failed_handback: false,
+            };
+        };
+        let can = mode == Mode::Normal && target == Target::Enabled && self.state.is_enabled();
+        if !can {
+            h.abort();
+        }
+        let out = h.step(asked && can, inp.statusword, inp.mode_display, at_rest);
+        if out.failed_handback {
+            // the drive stays in homing mode: it does not follow set-points
+            self.fault_latch = true;
+        }
+        out
     }
 
     /// The drive's 32-bit position extended to 64 bits by every cycle's
@@ -233,28 +434,26 @@ impl AxisLogic {
         set
     }
 
-    /// Where the CiA 402 machine walks the drive this cycle (`velocity`:
-    /// the drive's, counts/s).
-    fn cia_target(&mut self, mode: Mode, enable: bool, velocity: i32) -> Target {
-        let moving_in_qs =
-            self.state == State::QuickStopActive && f64::from(velocity).abs() >= self.rest_velocity;
+    /// Where the CiA 402 machine walks the drive this cycle.
+    fn cia_target(&mut self, mode: Mode, enable: bool, at_rest: bool) -> Target {
         match mode {
-            Mode::Normal if enable && !self.fault_latch => Target::Enabled,
-            // a refused set-point while enabled: stop on the drive's ramp
-            // first, then disable
-            Mode::Normal if self.fault_latch && (self.state.is_enabled() || moving_in_qs) => {
-                Target::QuickStop
+            Mode::Normal if enable && !self.fault_latch => {
+                self.stopper.reset();
+                Target::Enabled
             }
-            Mode::Normal => Target::Disabled,
+            // a refused set-point (or a drive back after a loss) while
+            // enabled: the bounded stop
+            Mode::Normal if self.fault_latch => self.stopper.step(self.state, at_rest),
+            Mode::Normal => {
+                self.stopper.reset();
+                Target::Disabled
+            }
             Mode::WatchdogStop => {
-                if self.state.is_enabled() || moving_in_qs {
-                    Target::QuickStop
-                } else {
-                    if self.last_enable {
-                        self.fault_latch = true;
-                    }
-                    Target::Disabled
+                let t = self.stopper.step(self.state, at_rest);
+                if t == Target::Off && self.last_enable {
+                    self.fault_latch = true;
                 }
+                t
             }
             Mode::Emergency => {
                 if self.last_enable || self.state.is_enabled() {
@@ -285,10 +484,13 @@ impl AxisLogic {
             .step(cmd.marker_arm_id, cmd.switch_arm_id, edge, &probe_inputs)
     }
 
-    /// The frame's digital inputs from 0x60FD.
+    /// The frame's digital inputs from 0x60FD (none without it).
     fn digital_inputs(&self, raw: u32) -> u32 {
+        if !self.layout.present.digital_inputs {
+            return 0;
+        }
         let mut dio = 0;
-        if raw & di::HOME_SWITCH != 0 {
+        if raw & self.home_switch != 0 {
             dio |= DI_HOME_SWITCH;
         }
         if raw & di::POSITIVE_LIMIT_SWITCH != 0 {
@@ -307,7 +509,7 @@ impl AxisLogic {
 
     /// This cycle's feedback: the drive's values, its state and fault (or
     /// the backend's), the latches.
-    fn feedback(&mut self, inp: &DriveInputs, pos64: i64) -> AxisFeedback {
+    fn feedback(&mut self, inp: &DriveInputs, pos64: i64, velocity: f64) -> AxisFeedback {
         let drive_fault = self.state.is_fault();
         let mut status = 0;
         if self.state.is_enabled() {
@@ -325,7 +527,7 @@ impl AxisLogic {
         let s = self.probes.switch();
         AxisFeedback {
             position: pos64,
-            velocity: f64::from(inp.velocity),
+            velocity,
             torque: f32::from(inp.torque) / 10.0,
             digital_inputs: self.digital_inputs(inp.digital_inputs),
             status_word: status,
@@ -371,307 +573,5 @@ fn following_error_window(tol: f64) -> u32 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::pdo::TorqueLimits;
-
-    fn logic() -> AxisLogic {
-        AxisLogic::new(
-            PdoLayout::new(TorqueLimits::PerDirection, false),
-            0.001,
-            Some(16),
-        )
-    }
-
-    fn cmd(enable: bool, target: i64) -> AxisCommand {
-        AxisCommand {
-            target_position: target,
-            torque_limit_positive: 100.0,
-            torque_limit_negative: 50.0,
-            control_word: if enable { CW_ENABLE } else { 0 },
-            ..AxisCommand::ZERO
-        }
-    }
-
-    fn inputs(state: State, pos: i32) -> DriveInputs {
-        DriveInputs {
-            statusword: state.statusword() | 0x0200,
-            position: pos,
-            ..DriveInputs::default()
-        }
-    }
-
-    #[test]
-    fn enabling_walks_the_state_machine_and_target_tracks_actual() {
-        let mut a = logic();
-        let (o, fb) = a.step(
-            &cmd(true, 500),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, 123)),
-        );
-        assert_eq!(o.controlword, 0x0006);
-        assert_eq!(o.target_position, 123, "not enabled: follows actual");
-        assert_eq!(o.torque_limit_positive, 1000);
-        assert_eq!(o.torque_limit_negative, 500);
-        assert_eq!(o.mode, 8);
-        assert_eq!(fb.status_word, 0);
-        assert_eq!(fb.position, 123);
-        let (o, _) = a.step(
-            &cmd(true, 500),
-            Mode::Normal,
-            Some(&inputs(State::ReadyToSwitchOn, 123)),
-        );
-        assert_eq!(o.controlword, 0x0007);
-        let (o, _) = a.step(
-            &cmd(true, 500),
-            Mode::Normal,
-            Some(&inputs(State::SwitchedOn, 123)),
-        );
-        assert_eq!(o.controlword, 0x000F);
-        assert_eq!(o.target_position, 123);
-        let (o, fb) = a.step(
-            &cmd(true, 500),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 124)),
-        );
-        assert_eq!(o.target_position, 500);
-        assert_eq!(fb.status_word, SW_ENABLED);
-        // disable
-        let (o, fb) = a.step(
-            &cmd(false, 500),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 500)),
-        );
-        assert_eq!(o.controlword, 0x0006);
-        assert_eq!(o.target_position, 500);
-        assert_eq!(fb.status_word, SW_ENABLED, "reports the drive's state");
-    }
-
-    #[test]
-    fn positions_extend_over_the_32_bit_wrap() {
-        let mut a = logic();
-        let mut p = i32::MAX - 5;
-        let (_, fb) = a.step(
-            &cmd(false, 0),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, p)),
-        );
-        assert_eq!(fb.position, i64::from(i32::MAX) - 5);
-        for _ in 0..10 {
-            p = p.wrapping_add(3);
-            a.step(
-                &cmd(false, 0),
-                Mode::Normal,
-                Some(&inputs(State::SwitchOnDisabled, p)),
-            );
-        }
-        assert_eq!(a.last_feedback().position, i64::from(i32::MAX) + 25);
-        // a target beyond 2^31 goes out modulo 2^32
-        let t = i64::from(i32::MAX) + 30;
-        for s in [State::OperationEnabled, State::OperationEnabled] {
-            let (o, _) = a.step(&cmd(true, t), Mode::Normal, Some(&inputs(s, p)));
-            assert_eq!(o.target_position, t as i32);
-        }
-    }
-
-    #[test]
-    fn bad_setpoints_are_refused_with_a_fault_until_the_handshake() {
-        let mut a = logic();
-        a.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        let (o, _) = a.step(
-            &cmd(true, 10),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        assert_eq!(o.target_position, 10);
-        let (o, fb) = a.step(
-            &cmd(true, INVALID_COUNTS),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 10)),
-        );
-        assert_eq!(o.target_position, 10, "last good target held");
-        assert_eq!(o.controlword, 0x0002, "quick stop on the drive's ramp");
-        assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
-        assert_eq!(a.counters.rejected_setpoints, 1);
-        // too far away
-        let mut b = logic();
-        b.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        b.step(
-            &cmd(true, MAX_TARGET_DISTANCE + 1),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        assert_eq!(b.counters.rejected_setpoints, 1);
-        // NaN torque limit
-        let mut c = logic();
-        let mut n = cmd(true, 0);
-        n.torque_limit_positive = f32::NAN;
-        c.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        c.step(&n, Mode::Normal, Some(&inputs(State::OperationEnabled, 0)));
-        assert_eq!(c.counters.rejected_setpoints, 1);
-        // fault stays while enable stays; drive now disabled
-        let (o, fb) = a.step(
-            &cmd(true, 10),
-            Mode::Normal,
-            Some(&inputs(State::ReadyToSwitchOn, 10)),
-        );
-        assert_eq!(o.controlword, 0x0006);
-        assert_eq!(fb.status_word, SW_FAULT);
-        // handshake
-        a.step(
-            &cmd(false, 10),
-            Mode::Normal,
-            Some(&inputs(State::ReadyToSwitchOn, 10)),
-        );
-        let (o, fb) = a.step(
-            &cmd(true, 10),
-            Mode::Normal,
-            Some(&inputs(State::ReadyToSwitchOn, 10)),
-        );
-        assert_eq!(o.controlword, 0x0007);
-        assert_eq!(fb.status_word, 0);
-    }
-
-    #[test]
-    fn drive_fault_code_kept_and_reset_on_the_edge() {
-        let mut a = logic();
-        let mut f = inputs(State::Fault, 0);
-        f.error_code = 0x2310;
-        let (o, fb) = a.step(&cmd(true, 0), Mode::Normal, Some(&f));
-        // the first command's rising edge asks for a reset at once
-        assert_eq!(o.controlword, 0x0080);
-        assert_eq!(fb.status_word, SW_FAULT);
-        assert_eq!(fb.error_code, 0x2310);
-        // the drive stays in fault (cause persists), the code is kept even if
-        // the drive clears 0x603F early
-        f.error_code = 0;
-        let (_, fb) = a.step(&cmd(true, 0), Mode::Normal, Some(&f));
-        assert_eq!(fb.error_code, 0x2310);
-        // out of fault: code 0
-        let (_, fb) = a.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, 0)),
-        );
-        assert_eq!((fb.status_word, fb.error_code), (0, 0));
-    }
-
-    #[test]
-    fn watchdog_stop_quick_stops_then_disables_with_a_fault() {
-        let mut a = logic();
-        a.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        let mut moving = inputs(State::OperationEnabled, 100);
-        moving.velocity = 50_000;
-        let (o, _) = a.step(&cmd(true, 0), Mode::WatchdogStop, Some(&moving));
-        assert_eq!(o.controlword, 0x0002);
-        assert_eq!(o.target_position, 100);
-        let mut qs = inputs(State::QuickStopActive, 200);
-        qs.velocity = 20_000;
-        let (o, fb) = a.step(&cmd(true, 0), Mode::WatchdogStop, Some(&qs));
-        assert_eq!(o.controlword, 0x0002);
-        assert_eq!(fb.status_word & SW_FAULT, 0, "no fault while stopping");
-        assert!(!a.at_rest_and_disabled());
-        qs.velocity = 0;
-        let (o, fb) = a.step(&cmd(true, 0), Mode::WatchdogStop, Some(&qs));
-        assert_eq!(o.controlword, 0x0000, "quick stop active → disable voltage");
-        assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
-        let (_, fb) = a.step(
-            &cmd(true, 0),
-            Mode::WatchdogStop,
-            Some(&inputs(State::SwitchOnDisabled, 210)),
-        );
-        assert!(a.at_rest_and_disabled());
-        assert_eq!(fb.status_word, SW_FAULT);
-        // commands again: enable still true → no edge → fault stays
-        let (o, fb) = a.step(
-            &cmd(true, 210),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, 210)),
-        );
-        assert_eq!(o.controlword, 0x0006);
-        assert_eq!(fb.status_word, SW_FAULT);
-        a.step(
-            &cmd(false, 210),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, 210)),
-        );
-        let (_, fb) = a.step(
-            &cmd(true, 210),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, 210)),
-        );
-        assert_eq!(fb.status_word, 0);
-
-        // an axis that never asked to be enabled: no fault
-        let mut b = logic();
-        let (_, fb) = b.step(
-            &cmd(false, 0),
-            Mode::WatchdogStop,
-            Some(&inputs(State::SwitchOnDisabled, 0)),
-        );
-        assert_eq!(fb.status_word, 0);
-        assert!(b.at_rest_and_disabled());
-    }
-
-    #[test]
-    fn emergency_is_disable_voltage_and_a_fault() {
-        let mut a = logic();
-        a.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        let (o, fb) = a.step(
-            &cmd(true, 0),
-            Mode::Emergency,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
-        assert_eq!(o.controlword, 0x0000);
-        assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
-    }
-
-    #[test]
-    fn no_data_keeps_outputs_and_reports_last_values() {
-        let mut a = logic();
-        let mut i = inputs(State::OperationEnabled, 42);
-        i.digital_inputs = di::HOME_SWITCH | (1 << 16);
-        i.torque = -125;
-        let (o1, fb1) = a.step(&cmd(true, 42), Mode::Normal, Some(&i));
-        assert_eq!(fb1.digital_inputs, DI_HOME_SWITCH | DI_MARKER_PULSE);
-        assert_eq!(fb1.torque, -12.5);
-        let (o2, fb2) = a.step(&cmd(true, 99), Mode::Normal, None);
-        assert_eq!(o2, o1);
-        assert_eq!(fb2.status_word, fb1.status_word | SW_NO_DATA);
-        assert_eq!(fb2.position, 42);
-    }
-
-    #[test]
-    fn tolerance_becomes_the_following_error_window() {
-        let mut a = logic();
-        let mut c = cmd(true, 0);
-        a.step(&c, Mode::Normal, Some(&inputs(State::OperationEnabled, 0)));
-        assert_eq!(a.following_error_window(), u32::MAX);
-        c.position_error_tolerance = 1234.4;
-        a.step(&c, Mode::Normal, Some(&inputs(State::OperationEnabled, 0)));
-        assert_eq!(a.following_error_window(), 1234);
-        c.position_error_tolerance = f64::NAN;
-        a.step(&c, Mode::Normal, Some(&inputs(State::OperationEnabled, 0)));
-        assert_eq!(a.following_error_window(), u32::MAX);
-    }
-}
+#[path = "axis_tests.rs"]
+mod tests;

@@ -21,13 +21,15 @@ use motion_rt::now_ns;
 
 use crate::bus;
 use crate::report::{StartupError, StartupReport};
-use crate::status::{BusStatus, Shared};
+use crate::status::{BusStatus, Shared, SubDeviceHealth};
 use crate::words::{self, FLAG_RUNNING, MODE_EMERGENCY, MODE_NORMAL, MODE_WATCHDOG_STOP};
 
 /// Feedback older than this many bus cycles counts as missing.
 pub const STALE_CYCLES: u64 = 3;
-/// Upper bound of a paced [`EthercatBackend::shutdown`].
-pub const MAX_SHUTDOWN: Duration = Duration::from_secs(30);
+/// What a paced [`EthercatBackend::shutdown`] adds to the stop's own bound
+/// (`quick_stop_timeout_ms` + the longest brake delay) before it falls back
+/// to the emergency stop: the drives' answers to disable voltage.
+pub const SHUTDOWN_MARGIN: Duration = Duration::from_millis(200);
 
 /// The EtherCAT drive backend.
 pub struct EthercatBackend {
@@ -42,6 +44,11 @@ pub struct EthercatBackend {
     fb_words: RefCell<Vec<u64>>,
     /// Bus cycle at which the current watchdog stop was asked for.
     stop_from_cycle: Option<u64>,
+    /// The bounded stop, whole: quick stop bound + longest brake delay +
+    /// [`SHUTDOWN_MARGIN`].
+    stop_bound: Duration,
+    /// The SubDevices that drive axes: position, name, axes.
+    devices: Vec<(usize, String, Vec<String>)>,
 }
 
 impl EthercatBackend {
@@ -53,6 +60,10 @@ impl EthercatBackend {
         let names = cfg.axes.iter().map(|a| a.name.clone()).collect();
         let shared = Arc::new(Shared::new(n));
         let cycle_ns = cfg.cycle().as_nanos() as u64;
+        let brake = cfg.axes.iter().map(|a| a.ethercat.brake_delay_ms).max();
+        let stop_bound = Duration::from_millis(u64::from(
+            cfg.keys.quick_stop_timeout_ms + brake.unwrap_or(0),
+        )) + SHUTDOWN_MARGIN;
         let (tx, rx) = mpsc::channel();
         let thread = {
             let shared = shared.clone();
@@ -64,6 +75,8 @@ impl EthercatBackend {
         };
         match rx.recv() {
             Ok(Ok(report)) => Ok(EthercatBackend {
+                devices: devices_of(&report),
+                stop_bound,
                 names,
                 shared,
                 thread: Some(thread),
@@ -94,6 +107,32 @@ impl EthercatBackend {
     /// Counters and round-trip statistics.
     pub fn bus_status(&self) -> BusStatus {
         self.shared.snapshot()
+    }
+
+    /// How the SubDevices that drive axes are doing (off the bus thread;
+    /// allocates). Poll [`health_events`](Self::health_events) to know when
+    /// it changed.
+    pub fn health(&self) -> Vec<SubDeviceHealth> {
+        self.shared.health(&self.devices)
+    }
+
+    /// Bumped on every change of a SubDevice's health.
+    pub fn health_events(&self) -> u64 {
+        self.shared.health_events.load(Ordering::Acquire)
+    }
+
+    /// A handle that reads the SubDevices' health from another thread
+    /// (motion-io's log).
+    pub fn health_watch(&self) -> HealthWatch {
+        HealthWatch {
+            shared: self.shared.clone(),
+            devices: self.devices.clone(),
+        }
+    }
+
+    /// The bounded stop, whole (the shutdown's bound before its fallback).
+    pub fn stop_bound(&self) -> Duration {
+        self.stop_bound
     }
 
     fn publish(&mut self) {
@@ -201,21 +240,23 @@ impl Backend for EthercatBackend {
         }
     }
 
-    /// Controlled stop of every axis, paced by the bus cycle, at most
-    /// [`MAX_SHUTDOWN`] (or [`MAX_STOP_CYCLES`] of `dt_s`, the smaller); falls
-    /// back to [`emergency_stop`](Self::emergency_stop). `true` if the
-    /// controlled stop completed. The bus keeps running (drives disabled)
-    /// until the backend is dropped.
+    /// Controlled stop of every axis, paced by the bus cycle, at most the
+    /// bounded stop's own bound ([`stop_bound`](Self::stop_bound); or
+    /// [`MAX_STOP_CYCLES`] of `dt_s`, the smaller); falls back to
+    /// [`emergency_stop`](Self::emergency_stop). Axes of lost SubDevices do
+    /// not hold it up. `true` if the controlled stop completed. The bus
+    /// keeps running (drives disabled) until the backend is dropped, which
+    /// leaves OP within `bus::EXIT_TIMEOUT_NS`.
     fn shutdown(&mut self, dt_s: f64, fb: &mut FeedbackFrame) -> bool {
         let pace = Duration::from_nanos(self.cycle_ns);
         let by_dt = if dt_s.is_finite() && dt_s > 0.0 {
             Duration::from_secs_f64(
-                (dt_s * f64::from(MAX_STOP_CYCLES)).min(MAX_SHUTDOWN.as_secs_f64()),
+                (dt_s * f64::from(MAX_STOP_CYCLES)).min(self.stop_bound.as_secs_f64()),
             )
         } else {
-            MAX_SHUTDOWN
+            self.stop_bound
         };
-        let until = now_ns() + by_dt.min(MAX_SHUTDOWN).as_nanos() as u64;
+        let until = now_ns() + by_dt.min(self.stop_bound).as_nanos() as u64;
         while now_ns() < until {
             if self.watchdog_stop(dt_s, fb) {
                 return true;
@@ -230,5 +271,42 @@ impl Backend for EthercatBackend {
 impl Drop for EthercatBackend {
     fn drop(&mut self) {
         self.stop_thread();
+    }
+}
+
+/// The SubDevices that drive axes: position, name, the axes.
+fn devices_of(r: &StartupReport) -> Vec<(usize, String, Vec<String>)> {
+    r.subdevices
+        .iter()
+        .filter_map(|s| {
+            s.axis
+                .as_ref()
+                .map(|a| (s.position, s.name.clone(), vec![a.clone()]))
+        })
+        .collect()
+}
+
+/// Reads the SubDevices' health from any thread (see
+/// [`EthercatBackend::health_watch`]).
+#[derive(Clone)]
+pub struct HealthWatch {
+    shared: Arc<Shared>,
+    devices: Vec<(usize, String, Vec<String>)>,
+}
+
+impl HealthWatch {
+    /// Bumped on every change of a SubDevice's health.
+    pub fn events(&self) -> u64 {
+        self.shared.health_events.load(Ordering::Acquire)
+    }
+
+    /// How the SubDevices that drive axes are doing.
+    pub fn health(&self) -> Vec<SubDeviceHealth> {
+        self.shared.health(&self.devices)
+    }
+
+    /// The bus thread still runs.
+    pub fn running(&self) -> bool {
+        self.shared.running.load(Ordering::Acquire)
     }
 }

@@ -19,10 +19,11 @@
 //!    counted per cause);
 //! 5. publish the feedback (seqlock).
 //!
-//! A SubDevice out of OP is brought back when it answers again: an AL error
-//! is acknowledged, SAFE-OP is asked for OP (every 20 ms, one register
-//! access per cycle at most). A SubDevice found in INIT/PRE-OP has lost its
-//! configuration (power cycle): counted in `needs_restart`, left alone.
+//! A lost SubDevice ([`crate::health`]) is brought back when it answers
+//! again: an AL error is acknowledged, SAFE-OP is asked for OP (every 20 ms,
+//! one register access per cycle at most); one that lost its configuration
+//! (power-cycled) is re-configured ([`crate::reconfigure`]). Leaving at exit
+//! is bounded by [`EXIT_TIMEOUT_NS`], lost SubDevices or not.
 
 use std::pin::pin;
 use std::sync::atomic::Ordering;
@@ -39,6 +40,7 @@ use crate::cycle::Engine;
 use crate::group::OpGroup;
 use crate::io::BusIo;
 use crate::jobs::{self, Job};
+use crate::reconfigure::{self, Recovery};
 use crate::report::{StartupError, StartupReport};
 use crate::startup::{self, Started};
 use crate::status::Shared;
@@ -46,8 +48,9 @@ use crate::status::Shared;
 const STARTUP_IDLE_NS: u64 = 200_000;
 const JOB_IDLE_NS: u64 = 100_000;
 const OP_TIMEOUT_NS: u64 = 10_000_000_000;
-const JOB_TIMEOUT_NS: u64 = 500_000_000;
-const EXIT_TIMEOUT_NS: u64 = 3_000_000_000;
+/// Leaving OP (OP → SAFE-OP → PRE-OP → INIT) at exit takes at most this
+/// long: SubDevices that do not answer any more are not waited for.
+pub const EXIT_TIMEOUT_NS: u64 = 1_000_000_000;
 /// Cycles after which the bus thread's allocations are counted.
 pub const WARM_UP_CYCLES: u64 = 200;
 
@@ -106,14 +109,14 @@ pub(crate) fn thread_main(
             return;
         }
     };
-    let (mut engine, group, mut report) = match bring_up(&cfg, &shared, &md, &mut io, t0, warnings)
-    {
-        Ok(x) => x,
-        Err(e) => {
-            let _ = started.send(Err(e));
-            return;
-        }
-    };
+    let (mut engine, group, mut report, recovery) =
+        match bring_up(&cfg, &shared, &md, &mut io, t0, warnings) {
+            Ok(x) => x,
+            Err(e) => {
+                let _ = started.send(Err(e));
+                return;
+            }
+        };
     shared.running.store(true, Ordering::Release);
     engine.counting = true;
     report.rt = rt.to_string();
@@ -122,7 +125,7 @@ pub(crate) fn thread_main(
         shared.stop.store(true, Ordering::Relaxed);
     }
 
-    run_cycles(&mut engine, &mut io, &group, &md);
+    run_cycles(&mut engine, &mut io, &group, &md, &recovery);
     shared.running.store(false, Ordering::Release);
     let fut = pin!(group.leave(&md));
     let _ = io.run(fut, Some(now_ns() + EXIT_TIMEOUT_NS), STARTUP_IDLE_NS);
@@ -138,7 +141,7 @@ fn bring_up(
     io: &mut BusIo<'_>,
     t0: u64,
     mut warnings: Vec<String>,
-) -> Result<(Engine, OpGroup, StartupReport), StartupError> {
+) -> Result<(Engine, OpGroup, StartupReport, Recovery), StartupError> {
     let deadline = t0 + cfg.startup_timeout().as_nanos() as u64;
     let result = {
         let fut = pin!(startup::startup(md, cfg, &mut warnings));
@@ -156,7 +159,7 @@ fn bring_up(
         reports,
         syncs,
     } = started?;
-    let mut engine = Engine::new(shared.clone(), plans, cfg, &group, md);
+    let mut engine = Engine::new(shared.clone(), plans.clone(), cfg, &group, md);
     let op_deadline = now_ns() + OP_TIMEOUT_NS;
     let mut next = now_ns();
     loop {
@@ -167,6 +170,7 @@ fn bring_up(
         }
         if now_ns() > op_deadline {
             let stuck: Vec<String> = engine
+                .devices
                 .not_op_since
                 .iter()
                 .enumerate()
@@ -182,6 +186,19 @@ fn bring_up(
         next += engine.period_ns;
         io.receive(next);
     }
+    let snapshots = {
+        let fut = pin!(reconfigure::snapshot(&group, md, &engine.sd_of_axis));
+        io.run(fut, Some(now_ns() + 1_000_000_000), STARTUP_IDLE_NS)
+            .unwrap_or_default()
+    };
+    let recovery = Recovery {
+        cfg: cfg.clone(),
+        plans,
+        syncs: syncs.clone(),
+        names: reports.iter().map(|r| r.name.clone()).collect(),
+        snapshots,
+        shared: shared.clone(),
+    };
     let report = StartupReport {
         axes: engine.sd_of_axis.iter().copied().zip(syncs).collect(),
         subdevices: reports,
@@ -189,15 +206,21 @@ fn bring_up(
         warnings,
         duration: Duration::ZERO,
     };
-    Ok((engine, group, report))
+    Ok((engine, group, report, recovery))
 }
 
 /// The cycle loop, until `shared.stop`: wait for the deadline (a background
 /// job progressing meanwhile), one cycle, the next deadline, the next job.
-fn run_cycles(engine: &mut Engine, io: &mut BusIo<'_>, group: &OpGroup, md: &MainDevice<'_>) {
+fn run_cycles(
+    engine: &mut Engine,
+    io: &mut BusIo<'_>,
+    group: &OpGroup,
+    md: &MainDevice<'_>,
+    recovery: &Recovery,
+) {
     let shared = engine.shared.clone();
     let sd_of_axis = engine.sd_of_axis.clone();
-    let make = |job: Job| jobs::run(job, &sd_of_axis, group, md);
+    let make = |job: Job| jobs::run(job, &sd_of_axis, recovery, group, md);
     let mut slot = pin!(if false {
         Some(make(Job::Recover(0)))
     } else {
@@ -225,7 +248,7 @@ fn run_cycles(engine: &mut Engine, io: &mut BusIo<'_>, group: &OpGroup, md: &Mai
                 if let Some(r) = io.poll_once(f) {
                     slot.set(None);
                     engine.job_done(slot_job, Some(r));
-                } else if now_ns().saturating_sub(slot_started) > JOB_TIMEOUT_NS {
+                } else if now_ns().saturating_sub(slot_started) > slot_job.timeout_ns() {
                     slot.set(None);
                     engine.job_done(slot_job, None);
                 }

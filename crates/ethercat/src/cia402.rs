@@ -184,6 +184,12 @@ pub enum Target {
     /// "Disable voltage" from every state: power stage off at once, no ramp
     /// (the emergency stop).
     Off,
+    /// "Disable operation" (transition 5, Operation enabled → Switched on):
+    /// the drive stops following and closes its holding brake (0x605C) with
+    /// the power stage still on — the step before disable voltage on an
+    /// axis with a brake. Quick stop active stays there (at rest it holds);
+    /// states without a running drive function stay where they are.
+    DisableOperation,
 }
 
 /// Fault-reset handshake progress.
@@ -285,6 +291,13 @@ impl Cia402 {
             (Target::QuickStop, _) => cw::CMD_QUICK_STOP,
 
             (Target::Off, _) => cw::CMD_DISABLE_VOLTAGE,
+
+            (Target::DisableOperation, State::OperationEnabled | State::SwitchedOn) => {
+                cw::CMD_SWITCH_ON
+            }
+            (Target::DisableOperation, State::QuickStopActive) => cw::CMD_QUICK_STOP,
+            (Target::DisableOperation, State::ReadyToSwitchOn) => cw::CMD_SHUTDOWN,
+            (Target::DisableOperation, _) => cw::CMD_DISABLE_VOLTAGE,
 
             (_, State::Fault | State::FaultReactionActive) => cw::CMD_DISABLE_VOLTAGE,
         }
@@ -580,6 +593,26 @@ mod tests {
             0x0006
         );
         assert!(!m.fault_reset_pending());
+    }
+
+    #[test]
+    fn disable_operation_keeps_the_power_stage_for_the_brake() {
+        use State::*;
+        for (state, word) in [
+            (OperationEnabled, 0x0007), // 5
+            (SwitchedOn, 0x0007),
+            (QuickStopActive, 0x0002), // holds at rest
+            (ReadyToSwitchOn, 0x0006),
+            (SwitchOnDisabled, 0x0000),
+        ] {
+            assert_eq!(
+                Cia402::new().step(state.statusword(), Target::DisableOperation),
+                word,
+                "{state:?}"
+            );
+        }
+        let s = drive(OperationEnabled, 0x0007, 0x000F);
+        assert_eq!(s, SwitchedOn);
     }
 
     #[test]

@@ -15,18 +15,18 @@ use motion_config::EthercatBus;
 use motion_frames::AxisCommand;
 use motion_rt::now_ns;
 
-use crate::axis::{AxisLogic, Mode};
+use crate::axis::{AxisLogic, AxisSetup, Mode};
 use crate::capacity::MAX_SUBDEVICES;
 use crate::group::{Exchanged, OpGroup};
+use crate::health::Devices;
 use crate::io::BusIo;
 use crate::jobs::{Done, Job};
-use crate::pdo::{DriveOutputs, MODE_CSP};
+use crate::objects::MODE_CSP;
+use crate::pdo::DriveOutputs;
 use crate::startup::AxisPlan;
 use crate::status::Shared;
 use crate::words::{self, FLAG_RUNNING, MODE_EMERGENCY, MODE_WATCHDOG_STOP};
-
-/// A SubDevice out of OP is looked at again after this long.
-const RECOVERY_INTERVAL_NS: u64 = 20_000_000;
+use motion_frames::{SW_DRIVE_LOST, SW_ENABLED};
 
 /// Per-cycle state of the bus.
 pub(crate) struct Engine {
@@ -44,13 +44,8 @@ pub(crate) struct Engine {
     mode: Mode,
     window_written: Vec<Option<u32>>,
     window_pending: Vec<bool>,
-    /// Per SubDevice: not in OP since (ns).
-    pub not_op_since: Vec<Option<u64>>,
-    /// Per SubDevice: answered its AL status read last cycle.
-    answering: Vec<bool>,
-    /// Per SubDevice: last recovery attempt (ns).
-    last_recovery: Vec<u64>,
-    given_up: Vec<bool>,
+    /// The SubDevices: answering, in OP, lost, their recovery.
+    pub devices: Devices,
     pub period_ns: u64,
     reply_ns: u64,
     pub cycle: u64,
@@ -82,7 +77,17 @@ impl Engine {
         let axes = plans
             .iter()
             .zip(&cfg.axes)
-            .map(|(p, a)| AxisLogic::new(p.layout, cycle_s, a.ethercat.index_pulse_bit))
+            .map(|(p, a)| {
+                AxisLogic::new(AxisSetup {
+                    layout: p.layout.clone(),
+                    cycle_s,
+                    index_pulse_bit: a.ethercat.index_pulse_bit,
+                    home_switch_bit: a.ethercat.home_switch_bit,
+                    quick_stop_ms: cfg.keys.quick_stop_timeout_ms,
+                    brake_ms: a.ethercat.brake_delay_ms,
+                    drive_homing: p.homing.is_some(),
+                })
+            })
             .collect();
         let count = group.len();
         let mut contrib = vec![0u16; count];
@@ -96,9 +101,10 @@ impl Engine {
             .iter()
             .map(|p| p.has_window.then_some(u32::MAX))
             .collect();
+        let sd_of_axis: Vec<usize> = plans.iter().map(|p| p.sd).collect();
         Engine {
             axes,
-            sd_of_axis: plans.iter().map(|p| p.sd).collect(),
+            sd_of_axis: sd_of_axis.clone(),
             outputs: plans
                 .iter()
                 .map(|_| DriveOutputs {
@@ -115,10 +121,7 @@ impl Engine {
             mode: Mode::Normal,
             window_written,
             window_pending: vec![false; n],
-            not_op_since: vec![None; count],
-            answering: vec![true; count],
-            last_recovery: vec![0; count],
-            given_up: vec![false; count],
+            devices: Devices::new(count, &sd_of_axis),
             period_ns: cfg.cycle().as_nanos() as u64,
             reply_ns: cfg.reply_timeout().as_nanos() as u64,
             cycle: 0,
@@ -129,7 +132,7 @@ impl Engine {
 
     /// Every SubDevice is in OP.
     pub fn all_in_op(&self) -> bool {
-        self.not_op_since.iter().all(Option::is_none)
+        self.devices.all_in_op()
     }
 
     /// Takes the newest commands from `motion-io` (never blocks; a failed
@@ -212,6 +215,8 @@ impl Engine {
             if self.counting {
                 sh.lost_frames.fetch_add(1, Ordering::Relaxed);
             }
+            self.devices.frame_lost(done);
+            self.devices.update(sh, self.counting);
             return v;
         };
         v.frame_ok = true;
@@ -228,19 +233,12 @@ impl Engine {
             sh.wkc_errors.fetch_add(1, Ordering::Relaxed);
         }
         for i in 0..count {
-            self.answering[i] = state(i) != SubDeviceState::None;
             let op = state(i) == SubDeviceState::Op;
             v.not_op[i] = !op;
             v.valid[i] = op && (all_ok || explained);
-            match (op, self.not_op_since[i]) {
-                (true, Some(_)) => {
-                    self.not_op_since[i] = None;
-                    self.given_up[i] = false;
-                }
-                (false, None) => self.not_op_since[i] = Some(done),
-                _ => {}
-            }
+            self.devices.observe(i, state(i), done);
         }
+        self.devices.update(sh, self.counting);
         v
     }
 
@@ -270,9 +268,18 @@ impl Engine {
                 }
                 None
             };
-            let (out, fb) = self.axes[k].step(&self.cmds[k], self.mode, inputs.as_ref());
+            let lost = self.devices.lost(sdi);
+            if lost {
+                self.axes[k].lost();
+            }
+            let (out, mut fb) = self.axes[k].step(&self.cmds[k], self.mode, inputs.as_ref());
             self.outputs[k] = out;
-            if self.axes[k].at_rest_and_disabled() {
+            if lost {
+                // named as the drive's loss; nothing to stop there (its SM
+                // watchdog stops it)
+                fb.status_word = (fb.status_word | SW_DRIVE_LOST) & !SW_ENABLED;
+                rest_mask |= 1 << k;
+            } else if self.axes[k].at_rest_and_disabled() {
                 rest_mask |= 1 << k;
             }
             sh.axis[k]
@@ -285,24 +292,15 @@ impl Engine {
 
     /// The next background job, if one is due.
     pub fn next_job(&mut self, now: u64) -> Option<Job> {
-        for i in 0..self.contrib.len() {
-            if let Some(since) = self.not_op_since[i] {
-                if !self.given_up[i]
-                    && self.answering[i]
-                    && now.saturating_sub(since) >= RECOVERY_INTERVAL_NS / 4
-                    && now.saturating_sub(self.last_recovery[i]) >= RECOVERY_INTERVAL_NS
-                {
-                    self.last_recovery[i] = now;
-                    return Some(Job::Recover(i));
-                }
-            }
+        if let Some(job) = self.devices.next_job(now) {
+            return Some(job);
         }
         for (k, a) in self.axes.iter().enumerate() {
             if let Some(written) = self.window_written[k] {
                 let want = a.following_error_window();
                 if want != written
                     && !self.window_pending[k]
-                    && self.not_op_since[self.sd_of_axis[k]].is_none()
+                    && self.devices.not_op_since[self.sd_of_axis[k]].is_none()
                 {
                     self.window_pending[k] = true;
                     return Some(Job::Window {
@@ -319,17 +317,6 @@ impl Engine {
     pub fn job_done(&mut self, job: Job, r: Option<Result<Done, Error>>) {
         let sh = &self.shared;
         match (job, r) {
-            (Job::Recover(_), Some(Ok(Done::OpRequested))) => {
-                sh.recoveries.fetch_add(1, Ordering::Relaxed);
-            }
-            (Job::Recover(i), Some(Ok(Done::LostConfiguration))) => {
-                sh.needs_restart.fetch_add(1, Ordering::Relaxed);
-                self.given_up[i] = true;
-            }
-            (Job::Recover(_), Some(Ok(_))) => {}
-            (Job::Recover(_), _) => {
-                sh.recovery_failures.fetch_add(1, Ordering::Relaxed);
-            }
             (Job::Window { axis, value }, Some(Ok(_))) => {
                 self.window_written[axis] = Some(value);
                 self.window_pending[axis] = false;
@@ -339,6 +326,7 @@ impl Engine {
                 self.window_pending[axis] = false;
                 sh.window_write_failures.fetch_add(1, Ordering::Relaxed);
             }
+            (job, r) => self.devices.job_done(sh, job, r.and_then(Result::ok)),
         }
     }
 }

@@ -1,20 +1,43 @@
-//! One mapped SubDevice's set-up over CoE at PRE-OP: the objects the layout
-//! needs (an SDO abort names the SubDevice and the object), the PDO mapping
-//! and assignment, cyclic synchronous position, and its synchronisation (DC
-//! SYNC0 or free run).
+//! One mapped SubDevice's set-up over CoE at PRE-OP:
+//!
+//! 1. its dictionary is read ([`crate::dictionary`]) and checked against
+//!    what its axis needs ([`crate::wants`]): every missing object at once;
+//! 2. the PDO mapping is settled ([`crate::mapping`]: written, predefined
+//!    or fixed);
+//! 3. 0x6060 = 8 (cyclic synchronous position), 0x6061 awaited for
+//!    [`MODE_PREOP_WAIT`] — a drive that shows its mode only later is
+//!    checked again in SAFE-OP ([`await_mode`], by `startup`);
+//! 4. the following error window off, the drive's own homing parameters
+//!    (0x6098 method, 0x6099 speeds, 0x609A acceleration, 0x607C = 0);
+//! 5. its synchronisation: DC SYNC0 where the drive and `dc` allow it
+//!    (0x1C32:01 = 2), free run otherwise (0); 0x1C32:02 = the cycle.
+//!
+//! What was set up is kept as lines for the start-up log
+//! ([`DriveSetup::lines`]): the mapping in force (objects, offsets, bits),
+//! the sync mode and cycle, the stop, the brake, the homing, and what is
+//! unavailable.
 
 use std::ops::Deref;
+use std::time::Duration;
 
-use ethercrab::error::{Error, MailboxError};
 use ethercrab::{EtherCrabWireWrite, SubDevice, SubDeviceRef};
+use motion_config::ethercat::{BusAxis, DriveHomingPlan};
 use motion_config::{EthercatBus, EthercatDc};
+use motion_rt::now_ns;
 
-use crate::pdo::{
-    object_name, PdoEntry, PdoLayout, TorqueLimits, FOLLOWING_ERROR_WINDOW, MAX_TORQUE, MODE_CSP,
-    NEGATIVE_TORQUE_LIMIT, POSITIVE_TORQUE_LIMIT, RXPDO_ASSIGN, RXPDO_INDEX, TXPDO_ASSIGN,
-    TXPDO_INDEX,
-};
-use crate::report::StartupError;
+use crate::dictionary::{abort_code, probe, Dictionary};
+use crate::io::Until;
+use crate::mapping;
+use crate::objects::*;
+use crate::pdo::PdoLayout;
+use crate::report::{Sd, StartupError};
+use crate::wants::{unavailable, Wants};
+
+/// How long 0x6061 is awaited at PRE-OP before the check moves to SAFE-OP.
+pub const MODE_PREOP_WAIT: Duration = Duration::from_millis(200);
+/// How long 0x6061 is awaited in SAFE-OP (a drive that updates its mode
+/// display only there).
+pub const MODE_SAFEOP_WAIT: Duration = Duration::from_secs(2);
 
 /// What [`configure_drive`] set up.
 pub(crate) struct DriveSetup {
@@ -23,63 +46,13 @@ pub(crate) struct DriveSetup {
     pub has_window: bool,
     /// It runs on DC SYNC0 (else free run).
     pub dc: bool,
-}
-
-fn abort_code(e: &Error) -> Option<u32> {
-    match e {
-        Error::Mailbox(MailboxError::Aborted { code, .. }) => Some(u32::from(*code)),
-        _ => None,
-    }
-}
-
-/// A SubDevice as messages name it.
-pub(crate) struct Sd<'a> {
-    pub position: usize,
-    pub name: &'a str,
-}
-
-impl Sd<'_> {
-    pub fn err(&self, what: String) -> StartupError {
-        StartupError(format!(
-            "SubDevice {} ({}): {what}",
-            self.position, self.name
-        ))
-    }
-
-    fn missing(&self, e: &PdoEntry, err: &Error) -> StartupError {
-        match abort_code(err) {
-            Some(code) => self.err(format!(
-                "object {:#06X} {} not supported (SDO abort {code:#010X})",
-                e.index,
-                if e.name.is_empty() {
-                    object_name(e.index)
-                } else {
-                    e.name
-                }
-            )),
-            None => self.err(format!(
-                "reading object {:#06X} {} failed: {err}",
-                e.index,
-                object_name(e.index)
-            )),
-        }
-    }
-
-    /// A warning about this SubDevice.
-    fn warning(&self, what: &str) -> String {
-        format!("SubDevice {} ({}): {what}", self.position, self.name)
-    }
-}
-
-async fn read_entry<S>(sd: &SubDeviceRef<'_, S>, e: &PdoEntry) -> Result<u32, Error>
-where
-    S: Deref<Target = SubDevice>,
-{
-    Ok(match e.bits {
-        8 => u32::from(sd.sdo_read::<u8>(e.index, e.sub).await?),
-        16 => u32::from(sd.sdo_read::<u16>(e.index, e.sub).await?),
-        _ => sd.sdo_read::<u32>(e.index, e.sub).await?,
-    })
+    /// 0x6061 showed cyclic synchronous position at PRE-OP (else it is
+    /// awaited again in SAFE-OP).
+    pub mode_shown: bool,
+    /// The drive's own homing, if its axis's drive homes.
+    pub homing: Option<DriveHomingPlan>,
+    /// For the start-up log.
+    pub lines: Vec<String>,
 }
 
 async fn write<S, T>(
@@ -105,130 +78,124 @@ where
     })
 }
 
-/// Per mapped SubDevice: objects, mapping, mode, sync.
+/// Per mapped SubDevice: dictionary, needs, mapping, mode, homing, sync.
 pub(crate) async fn configure_drive<S>(
     sd: &SubDeviceRef<'_, S>,
     who: &Sd<'_>,
+    axis: &BusAxis,
     cfg: &EthercatBus,
-    warnings: &mut Vec<String>,
 ) -> Result<DriveSetup, StartupError>
 where
     S: Deref<Target = SubDevice>,
 {
-    let torque = torque_limits(sd, who, warnings).await?;
-    let layout = PdoLayout::new(torque, cfg.keys.mode_in_pdo);
-    for e in layout.required_objects() {
-        if let Err(err) = read_entry(sd, &e).await {
-            return Err(who.missing(&e, &err));
-        }
+    let dict = probe(sd)
+        .await
+        .map_err(|e| who.err(format!("reading its object dictionary failed: {e}")))?;
+    let wants = Wants::of(&axis.name, &axis.needs, &dict, cfg.keys.mode_in_pdo);
+    if !wants.missing.is_empty() {
+        return Err(who.err(format!(
+            "{} problem(s) for axis {}:\n    {}",
+            wants.missing.len(),
+            axis.name,
+            wants.missing.join("\n    ")
+        )));
     }
-    let has_window = match read_entry(sd, &FOLLOWING_ERROR_WINDOW).await {
-        Ok(_) => true,
-        Err(_) => {
-            warnings.push(who.warning(
-                "no 0x6065 following error window, the position error tolerance is not applied",
-            ));
-            false
-        }
-    };
-    map_pdos(sd, who, &layout).await?;
-    set_csp(sd, who).await?;
+    let (layout, source) = mapping::settle(sd, who, &wants).await?;
+    write(sd, who, 0x6060, 0, MODE_CSP as u8).await?;
+    let mode_shown = await_mode(sd, MODE_CSP, MODE_PREOP_WAIT).await;
+    let has_window = dict.has(0x6065);
     if has_window {
         write(sd, who, FOLLOWING_ERROR_WINDOW.index, 0, u32::MAX).await?;
     }
-    let dc = synchronisation(sd, who, cfg, warnings).await?;
+    if let Some(h) = &wants.drive_homing {
+        write(sd, who, 0x6098, 0, h.method as u8).await?;
+        write(sd, who, 0x6099, 1, h.speed_switch).await?;
+        write(sd, who, 0x6099, 2, h.speed_zero).await?;
+        write(sd, who, 0x609A, 0, h.acceleration).await?;
+        write(sd, who, 0x607C, 0, 0u32).await?;
+    }
+    let mut lines = vec![format!("mapping {source}")];
+    lines.extend(layout.describe());
+    let (dc, sync) = synchronisation(sd, who, cfg).await?;
+    lines.push(sync);
+    lines.extend(stop_lines(&dict, axis, cfg));
+    if let Some(h) = &wants.drive_homing {
+        lines.push(format!(
+            "drive homing: method {} ({}), 0x6099 speeds {} / {} counts/s, 0x609A {} \
+             counts/s², 0x607C home offset 0; 0x6060/0x6061 in the process data",
+            h.method,
+            motion_config::ethercat::homing::method_name(h.method),
+            h.speed_switch,
+            h.speed_zero,
+            h.acceleration
+        ));
+    }
+    if !mode_shown {
+        lines.push(format!(
+            "0x6061 did not show mode 8 within {} ms at PRE-OP: awaited again in SAFE-OP",
+            MODE_PREOP_WAIT.as_millis()
+        ));
+    }
+    lines.extend(unavailable(&layout, &dict));
     Ok(DriveSetup {
         layout,
         has_window,
         dc,
+        mode_shown,
+        homing: wants.drive_homing,
+        lines,
     })
 }
 
-/// Torque limits per direction (0x60E0 / 0x60E1), else through 0x6072 max
-/// torque.
-async fn torque_limits<S>(
-    sd: &SubDeviceRef<'_, S>,
-    who: &Sd<'_>,
-    warnings: &mut Vec<String>,
-) -> Result<TorqueLimits, StartupError>
+/// The stop as this drive does it: quick stop option code, the bound,
+/// the brake.
+fn stop_lines(dict: &Dictionary, axis: &BusAxis, cfg: &EthercatBus) -> Vec<String> {
+    let qs = match dict.value(0x605A) {
+        Some(v) => format!("0x605A quick stop option code {}", v as u16 as i16),
+        None => "no 0x605A quick stop option code".into(),
+    };
+    let mut out = vec![format!(
+        "stop: quick stop ({qs}), then disable voltage once at rest or after {} ms",
+        cfg.keys.quick_stop_timeout_ms
+    )];
+    if axis.needs.brake_delay_ms > 0 {
+        out.push(format!(
+            "brake: every stop ends with disable operation (the drive closes its brake, \
+             0x605C), {} ms with the power stage on, then disable voltage",
+            axis.needs.brake_delay_ms
+        ));
+    }
+    out
+}
+
+/// Waits up to `bound` for 0x6061 to show `mode` (read over SDO every
+/// 10 ms); true once it does.
+pub(crate) async fn await_mode<S>(sd: &SubDeviceRef<'_, S>, mode: i8, bound: Duration) -> bool
 where
     S: Deref<Target = SubDevice>,
 {
-    match read_entry(sd, &POSITIVE_TORQUE_LIMIT).await {
-        Ok(_) => match read_entry(sd, &NEGATIVE_TORQUE_LIMIT).await {
-            Ok(_) => Ok(TorqueLimits::PerDirection),
-            Err(e) => Err(who.missing(&NEGATIVE_TORQUE_LIMIT, &e)),
-        },
-        Err(e1) if abort_code(&e1).is_some() => match read_entry(sd, &MAX_TORQUE).await {
-            Ok(_) => {
-                warnings.push(who.warning(
-                    "no 0x60E0/0x60E1, torque limits through 0x6072 max torque (the larger \
-                     limit for both directions)",
-                ));
-                Ok(TorqueLimits::MaxTorque)
+    let until = now_ns() + bound.as_nanos() as u64;
+    loop {
+        if let Ok(shown) = sd.sdo_read::<u8>(0x6061, 0).await {
+            if shown as i8 == mode {
+                return true;
             }
-            Err(_) => Err(who.missing(&POSITIVE_TORQUE_LIMIT, &e1)),
-        },
-        Err(e) => Err(who.missing(&POSITIVE_TORQUE_LIMIT, &e)),
-    }
-}
-
-/// PDO assignment 0x1C12/0x1C13 cleared, mappings 0x1600/0x1A00 written
-/// (sub-index 0 = 0, entries, count), assignment written.
-async fn map_pdos<S>(
-    sd: &SubDeviceRef<'_, S>,
-    who: &Sd<'_>,
-    layout: &PdoLayout,
-) -> Result<(), StartupError>
-where
-    S: Deref<Target = SubDevice>,
-{
-    write(sd, who, RXPDO_ASSIGN, 0, 0u8).await?;
-    write(sd, who, TXPDO_ASSIGN, 0, 0u8).await?;
-    for (pdo, entries) in [
-        (RXPDO_INDEX, layout.rx_entries()),
-        (TXPDO_INDEX, layout.tx_entries()),
-    ] {
-        write(sd, who, pdo, 0, 0u8).await?;
-        for (i, e) in entries.iter().enumerate() {
-            write(sd, who, pdo, i as u8 + 1, e.mapping_value()).await?;
         }
-        write(sd, who, pdo, 0, entries.len() as u8).await?;
+        if now_ns() >= until {
+            return false;
+        }
+        Until(now_ns() + 10_000_000).await;
     }
-    write(sd, who, RXPDO_ASSIGN, 1, RXPDO_INDEX).await?;
-    write(sd, who, RXPDO_ASSIGN, 0, 1u8).await?;
-    write(sd, who, TXPDO_ASSIGN, 1, TXPDO_INDEX).await?;
-    write(sd, who, TXPDO_ASSIGN, 0, 1u8).await
-}
-
-/// 0x6060 = 8 (cyclic synchronous position), checked in 0x6061.
-async fn set_csp<S>(sd: &SubDeviceRef<'_, S>, who: &Sd<'_>) -> Result<(), StartupError>
-where
-    S: Deref<Target = SubDevice>,
-{
-    write(sd, who, 0x6060, 0, MODE_CSP as u8).await?;
-    let shown = sd.sdo_read::<u8>(0x6061, 0).await.map_err(|e| {
-        who.err(format!(
-            "reading 0x6061 modes of operation display failed: {e}"
-        ))
-    })?;
-    if shown as i8 != MODE_CSP {
-        return Err(who.err(format!(
-            "0x6061 shows mode {} after 0x6060 = 8 (cyclic synchronous position)",
-            shown as i8
-        )));
-    }
-    Ok(())
 }
 
 /// DC SYNC0 where the drive and `dc` allow it (0x1C32:01 = 2), free run
-/// otherwise (0); 0x1C32:02 = the cycle. Returns whether it runs on DC.
+/// otherwise (0); 0x1C32:02 = the cycle. Returns whether it runs on DC and
+/// the line for the log.
 async fn synchronisation<S>(
     sd: &SubDeviceRef<'_, S>,
     who: &Sd<'_>,
     cfg: &EthercatBus,
-    warnings: &mut Vec<String>,
-) -> Result<bool, StartupError>
+) -> Result<(bool, String), StartupError>
 where
     S: Deref<Target = SubDevice>,
 {
@@ -250,6 +217,12 @@ where
             true
         }
     };
+    let cycle_us = cfg.cycle().as_micros();
+    let mut line = if dc {
+        format!("sync: DC SYNC0, cycle {cycle_us} µs (0x1C32:01 = 2), shift half a cycle")
+    } else {
+        format!("sync: free run, cycle {cycle_us} µs (0x1C32:01 = 0)")
+    };
     if supported.is_some() {
         let mode: u16 = if dc { 2 } else { 0 };
         write(sd, who, 0x1C32, 1, mode).await?;
@@ -257,8 +230,10 @@ where
         let _ = sd.sdo_write(0x1C33, 1, mode).await;
         let ns = u32::try_from(cfg.cycle().as_nanos()).unwrap_or(u32::MAX);
         if sd.sdo_write(0x1C32, 2, ns).await.is_err() {
-            warnings.push(who.warning("0x1C32:02 cycle time not writable"));
+            line.push_str("; 0x1C32:02 cycle time not writable");
         }
+    } else {
+        line.push_str("; no 0x1C32 sync manager parameters");
     }
-    Ok(dc)
+    Ok((dc, line))
 }

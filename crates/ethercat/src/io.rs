@@ -153,3 +153,20 @@ impl<'sto> BusIo<'sto> {
         }
     }
 }
+
+/// A future that is ready at `CLOCK_MONOTONIC` `until_ns`: a wait inside
+/// the bus thread's futures (the executor polls them every idle period,
+/// see [`BusIo::run`]).
+pub(crate) struct Until(pub u64);
+
+impl Future for Until {
+    type Output = ();
+
+    fn poll(self: Pin<&mut Self>, _: &mut Context<'_>) -> Poll<()> {
+        if now_ns() >= self.0 {
+            Poll::Ready(())
+        } else {
+            Poll::Pending
+        }
+    }
+}

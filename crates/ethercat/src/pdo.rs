@@ -1,87 +1,24 @@
-//! The process data layout: which CiA 402 objects travel in the RxPDO
-//! (0x1600, master → drive) and the TxPDO (0x1A00, drive → master), their
-//! mapping values for the CoE mapping objects, and packing / unpacking of one
-//! drive's slice of the process image (little endian, in mapping order).
+//! The process data layout of one drive as it is in force: the entries of
+//! the assigned RxPDOs (master → drive) and TxPDOs (drive → master) in
+//! order, each at its bit offset, and the packing / unpacking of the
+//! drive's slice of the process image (little endian).
 //!
-//! The layout is fixed by the master and written to the drive over CoE at
-//! PRE-OP (see [`crate::startup`]); ethercrab reads it back to size the
-//! sync managers and FMMUs, so the bytes here and ethercrab's view agree by
-//! construction.
+//! The layout is whatever start-up settled on ([`crate::mapping`]): the
+//! backend's own mapping written to a writable PDO, a predefined one
+//! assigned, or a fixed one as the drive has it. Entries the backend does
+//! not know (a fixed mapping's 0x60FF target velocity, padding) are carried
+//! as zeros on the way out and skipped on the way in; objects the layout
+//! lacks read as absent ([`Present`]), never as zero values that look real.
+//! ethercrab reads the mapping back to size the sync managers and FMMUs, so
+//! the bytes here and ethercrab's view agree by construction (checked at
+//! start-up).
 
-/// One object in a PDO mapping (CiA 301: index, sub-index, bit length).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PdoEntry {
-    pub index: u16,
-    pub sub: u8,
-    pub bits: u8,
-    /// Name for messages ("touch probe function").
-    pub name: &'static str,
-}
+use crate::objects::*;
 
-impl PdoEntry {
-    /// The 32-bit value written to a mapping object's sub-index:
-    /// index << 16 | sub-index << 8 | bit length.
-    pub const fn mapping_value(&self) -> u32 {
-        ((self.index as u32) << 16) | ((self.sub as u32) << 8) | self.bits as u32
-    }
-
-    /// Inverse of [`mapping_value`](Self::mapping_value) (name unknown).
-    pub const fn from_mapping_value(v: u32) -> PdoEntry {
-        PdoEntry {
-            index: (v >> 16) as u16,
-            sub: (v >> 8) as u8,
-            bits: v as u8,
-            name: "",
-        }
-    }
-
-    pub const fn bytes(&self) -> usize {
-        self.bits as usize / 8
-    }
-}
-
-const fn entry(index: u16, bits: u8, name: &'static str) -> PdoEntry {
-    PdoEntry {
-        index,
-        sub: 0,
-        bits,
-        name,
-    }
-}
-
-pub const CONTROLWORD: PdoEntry = entry(0x6040, 16, "controlword");
-pub const STATUSWORD: PdoEntry = entry(0x6041, 16, "statusword");
-pub const MODES_OF_OPERATION: PdoEntry = entry(0x6060, 8, "modes of operation");
-pub const MODES_OF_OPERATION_DISPLAY: PdoEntry = entry(0x6061, 8, "modes of operation display");
-pub const TARGET_POSITION: PdoEntry = entry(0x607A, 32, "target position");
-pub const POSITION_ACTUAL: PdoEntry = entry(0x6064, 32, "position actual value");
-pub const VELOCITY_ACTUAL: PdoEntry = entry(0x606C, 32, "velocity actual value");
-pub const TORQUE_ACTUAL: PdoEntry = entry(0x6077, 16, "torque actual value");
-pub const DIGITAL_INPUTS: PdoEntry = entry(0x60FD, 32, "digital inputs");
-pub const ERROR_CODE: PdoEntry = entry(0x603F, 16, "error code");
-pub const TOUCH_PROBE_FUNCTION: PdoEntry = entry(0x60B8, 16, "touch probe function");
-pub const TOUCH_PROBE_STATUS: PdoEntry = entry(0x60B9, 16, "touch probe status");
-pub const TOUCH_PROBE_1_POSITIVE: PdoEntry = entry(0x60BA, 32, "touch probe 1 positive edge");
-pub const TOUCH_PROBE_1_NEGATIVE: PdoEntry = entry(0x60BB, 32, "touch probe 1 negative edge");
-pub const TOUCH_PROBE_2_POSITIVE: PdoEntry = entry(0x60BC, 32, "touch probe 2 positive edge");
-pub const TOUCH_PROBE_2_NEGATIVE: PdoEntry = entry(0x60BD, 32, "touch probe 2 negative edge");
-pub const POSITIVE_TORQUE_LIMIT: PdoEntry = entry(0x60E0, 16, "positive torque limit value");
-pub const NEGATIVE_TORQUE_LIMIT: PdoEntry = entry(0x60E1, 16, "negative torque limit value");
-pub const MAX_TORQUE: PdoEntry = entry(0x6072, 16, "max torque");
-/// Not mapped: written over SDO when the commanded position error
-/// tolerance changes (optional object).
-pub const FOLLOWING_ERROR_WINDOW: PdoEntry = entry(0x6065, 32, "following error window");
-
-/// RxPDO mapping object used.
-pub const RXPDO_INDEX: u16 = 0x1600;
-/// TxPDO mapping object used.
-pub const TXPDO_INDEX: u16 = 0x1A00;
-/// SM2 (outputs) PDO assignment.
-pub const RXPDO_ASSIGN: u16 = 0x1C12;
-/// SM3 (inputs) PDO assignment.
-pub const TXPDO_ASSIGN: u16 = 0x1C13;
-/// Cyclic synchronous position mode (0x6060).
-pub const MODE_CSP: i8 = 8;
+/// Most entries per direction.
+pub const MAX_ENTRIES: usize = 32;
+/// Most PDOs assigned per direction.
+pub const MAX_PDOS: usize = 4;
 
 /// Which objects carry the torque limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,17 +29,39 @@ pub enum TorqueLimits {
     MaxTorque,
 }
 
-const MAX_ENTRIES: usize = 12;
+/// One entry of the layout at its bit offset in its direction's image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Mapped {
+    pub entry: PdoEntry,
+    pub bit: u16,
+}
+
+/// What the drive's inputs carry (a fixed mapping may lack any of it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Present {
+    pub velocity: bool,
+    pub torque: bool,
+    pub digital_inputs: bool,
+    pub touch_probes: bool,
+    pub error_code: bool,
+    pub mode_display: bool,
+    /// The outputs carry 0x6060.
+    pub mode: bool,
+    /// The outputs carry a torque limit (per direction or 0x6072).
+    pub torque_limit: Option<TorqueLimits>,
+}
 
 /// The layout of one drive's process data.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PdoLayout {
-    rx: [PdoEntry; MAX_ENTRIES],
-    rx_len: usize,
-    tx: [PdoEntry; MAX_ENTRIES],
-    tx_len: usize,
-    pub torque: TorqueLimits,
-    pub mode_in_pdo: bool,
+    rx: heapless::Vec<Mapped, MAX_ENTRIES>,
+    tx: heapless::Vec<Mapped, MAX_ENTRIES>,
+    rx_bits: u32,
+    tx_bits: u32,
+    /// The assigned PDO objects (0x1C12 / 0x1C13), in order.
+    pub rx_pdos: heapless::Vec<u16, MAX_PDOS>,
+    pub tx_pdos: heapless::Vec<u16, MAX_PDOS>,
+    pub present: Present,
 }
 
 /// What the master writes each cycle (RxPDO values).
@@ -118,7 +77,8 @@ pub struct DriveOutputs {
     pub mode: i8,
 }
 
-/// What the drive reports each cycle (TxPDO values).
+/// What the drive reports each cycle (TxPDO values; what the layout lacks
+/// is 0, see [`PdoLayout::present`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct DriveInputs {
     pub statusword: u16,
@@ -134,32 +94,78 @@ pub struct DriveInputs {
     pub probe2_positive: i32,
     pub probe2_negative: i32,
     pub error_code: u16,
+    pub mode_display: i8,
 }
 
+/// Why a list of entries is not a layout.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TooMany;
+
 impl PdoLayout {
-    /// The layout this backend uses.
-    pub fn new(torque: TorqueLimits, mode_in_pdo: bool) -> PdoLayout {
-        let mut rx = [CONTROLWORD; MAX_ENTRIES];
-        let mut n = 0;
-        let mut push = |e: PdoEntry| {
-            rx[n] = e;
-            n += 1;
+    /// The layout of `rx` then `tx` entries in that order (the entries of
+    /// the assigned PDOs, `rx_pdos` / `tx_pdos`, concatenated).
+    pub fn from_entries(
+        rx: &[PdoEntry],
+        tx: &[PdoEntry],
+        rx_pdos: &[u16],
+        tx_pdos: &[u16],
+    ) -> Result<PdoLayout, TooMany> {
+        let place =
+            |list: &[PdoEntry]| -> Result<(heapless::Vec<Mapped, MAX_ENTRIES>, u32), TooMany> {
+                let mut out = heapless::Vec::new();
+                let mut bit = 0u32;
+                for e in list {
+                    out.push(Mapped {
+                        entry: *e,
+                        bit: u16::try_from(bit).map_err(|_| TooMany)?,
+                    })
+                    .map_err(|_| TooMany)?;
+                    bit += u32::from(e.bits);
+                }
+                Ok((out, bit))
+            };
+        let (rx, rx_bits) = place(rx)?;
+        let (tx, tx_bits) = place(tx)?;
+        let mut l = PdoLayout {
+            rx,
+            tx,
+            rx_bits,
+            tx_bits,
+            rx_pdos: heapless::Vec::from_slice(rx_pdos).map_err(|_| TooMany)?,
+            tx_pdos: heapless::Vec::from_slice(tx_pdos).map_err(|_| TooMany)?,
+            present: Present::default(),
         };
-        push(CONTROLWORD);
-        push(TARGET_POSITION);
-        push(TOUCH_PROBE_FUNCTION);
+        let has_tx = |i: u16| l.has_tx(i);
+        let has_rx = |i: u16| l.has_rx(i);
+        l.present = Present {
+            velocity: has_tx(0x606C),
+            torque: has_tx(0x6077),
+            digital_inputs: has_tx(0x60FD),
+            touch_probes: has_rx(0x60B8) && has_tx(0x60B9),
+            error_code: has_tx(0x603F),
+            mode_display: has_tx(0x6061),
+            mode: has_rx(0x6060),
+            torque_limit: if has_rx(0x60E0) && has_rx(0x60E1) {
+                Some(TorqueLimits::PerDirection)
+            } else if has_rx(0x6072) {
+                Some(TorqueLimits::MaxTorque)
+            } else {
+                None
+            },
+        };
+        Ok(l)
+    }
+
+    /// The layout the backend writes when a drive lets it (and the one the
+    /// unit tests use): every object it uses, the torque limits as given,
+    /// 0x6060 / 0x6061 with `mode`.
+    pub fn standard(torque: TorqueLimits, mode: bool) -> PdoLayout {
+        let mut rx = vec![CONTROLWORD, TARGET_POSITION, TOUCH_PROBE_FUNCTION];
         match torque {
-            TorqueLimits::PerDirection => {
-                push(POSITIVE_TORQUE_LIMIT);
-                push(NEGATIVE_TORQUE_LIMIT);
-            }
-            TorqueLimits::MaxTorque => push(MAX_TORQUE),
+            TorqueLimits::PerDirection => rx.extend([POSITIVE_TORQUE_LIMIT, NEGATIVE_TORQUE_LIMIT]),
+            TorqueLimits::MaxTorque => rx.push(MAX_TORQUE),
         }
-        if mode_in_pdo {
-            push(MODES_OF_OPERATION);
-        }
-        let rx_len = n;
-        let tx_list = [
+        let mut tx = vec![
             STATUSWORD,
             POSITION_ACTUAL,
             VELOCITY_ACTUAL,
@@ -172,56 +178,48 @@ impl PdoLayout {
             TOUCH_PROBE_2_NEGATIVE,
             ERROR_CODE,
         ];
-        let mut tx = [CONTROLWORD; MAX_ENTRIES];
-        tx[..tx_list.len()].copy_from_slice(&tx_list);
-        PdoLayout {
-            rx,
-            rx_len,
-            tx,
-            tx_len: tx_list.len(),
-            torque,
-            mode_in_pdo,
+        if mode {
+            rx.push(MODES_OF_OPERATION);
+            tx.push(MODES_OF_OPERATION_DISPLAY);
         }
+        PdoLayout::from_entries(&rx, &tx, &[RXPDO_INDEX], &[TXPDO_INDEX])
+            .expect("the standard layout fits")
     }
 
-    /// RxPDO entries (0x1600), in order.
-    pub fn rx_entries(&self) -> &[PdoEntry] {
-        &self.rx[..self.rx_len]
+    /// RxPDO entries, in order, with their bit offsets.
+    pub fn rx(&self) -> &[Mapped] {
+        &self.rx
     }
 
-    /// TxPDO entries (0x1A00), in order.
-    pub fn tx_entries(&self) -> &[PdoEntry] {
-        &self.tx[..self.tx_len]
+    /// TxPDO entries, in order, with their bit offsets.
+    pub fn tx(&self) -> &[Mapped] {
+        &self.tx
+    }
+
+    pub fn has_rx(&self, index: u16) -> bool {
+        self.rx.iter().any(|m| m.entry.index == index)
+    }
+
+    pub fn has_tx(&self, index: u16) -> bool {
+        self.tx.iter().any(|m| m.entry.index == index)
     }
 
     /// Output (RxPDO) bytes.
     pub fn rx_bytes(&self) -> usize {
-        self.rx_entries().iter().map(PdoEntry::bytes).sum()
+        self.rx_bits.div_ceil(8) as usize
     }
 
     /// Input (TxPDO) bytes.
     pub fn tx_bytes(&self) -> usize {
-        self.tx_entries().iter().map(PdoEntry::bytes).sum()
+        self.tx_bits.div_ceil(8) as usize
     }
 
-    /// Every object the drive must have: the mapped ones and the mode
-    /// objects, for the start-up check (in the order they are checked).
-    pub fn required_objects(&self) -> impl Iterator<Item = PdoEntry> + '_ {
-        let mode = (!self.mode_in_pdo).then_some(MODES_OF_OPERATION);
-        self.rx_entries()
-            .iter()
-            .chain(self.tx_entries())
-            .copied()
-            .chain(mode)
-            .chain([MODES_OF_OPERATION_DISPLAY])
-    }
-
-    /// Packs `out` into `buf` (the drive's output slice). A short buffer
-    /// leaves the rest unwritten: never panics.
+    /// Packs `out` into `buf` (the drive's output slice); entries the
+    /// backend does not drive are 0. A short buffer leaves the rest
+    /// unwritten: never panics.
     pub fn pack_outputs(&self, out: &DriveOutputs, buf: &mut [u8]) {
-        let mut at = 0;
-        for e in self.rx_entries() {
-            let v: u32 = match e.index {
+        for m in self.rx.iter() {
+            let v: u32 = match m.entry.index {
                 0x6040 => u32::from(out.controlword),
                 0x607A => out.target_position as u32,
                 0x60B8 => u32::from(out.touch_probe_function),
@@ -231,19 +229,16 @@ impl PdoLayout {
                 0x6060 => out.mode as u8 as u32,
                 _ => 0,
             };
-            put(buf, at, e.bytes(), v);
-            at += e.bytes();
+            put_bits(buf, usize::from(m.bit), m.entry.bits, v);
         }
     }
 
     /// Unpacks the drive's input slice. Missing bytes read as 0.
     pub fn unpack_inputs(&self, buf: &[u8]) -> DriveInputs {
         let mut d = DriveInputs::default();
-        let mut at = 0;
-        for e in self.tx_entries() {
-            let v = get(buf, at, e.bytes());
-            at += e.bytes();
-            match e.index {
+        for m in self.tx.iter() {
+            let v = get_bits(buf, usize::from(m.bit), m.entry.bits);
+            match m.entry.index {
                 0x6041 => d.statusword = v as u16,
                 0x6064 => d.position = v as i32,
                 0x606C => d.velocity = v as i32,
@@ -255,71 +250,84 @@ impl PdoLayout {
                 0x60BC => d.probe2_positive = v as i32,
                 0x60BD => d.probe2_negative = v as i32,
                 0x603F => d.error_code = v as u16,
+                0x6061 => d.mode_display = v as u8 as i8,
                 _ => {}
             }
         }
         d
     }
-}
 
-fn put(buf: &mut [u8], at: usize, len: usize, v: u32) {
-    let bytes = v.to_le_bytes();
-    if let Some(dst) = buf.get_mut(at..at + len) {
-        dst.copy_from_slice(&bytes[..len]);
+    /// The layout in words for the start-up log: `RxPDO 0x1600 (12 B):
+    /// 0x6040 controlword @0.0/16, …`.
+    pub fn describe(&self) -> Vec<String> {
+        let side = |name: &str, pdos: &[u16], list: &[Mapped], bytes: usize| {
+            let pdos: Vec<String> = pdos.iter().map(|p| format!("{p:#06X}")).collect();
+            let entries: Vec<String> = list
+                .iter()
+                .map(|m| {
+                    format!(
+                        "{} @{}.{}/{}",
+                        m.entry.label(),
+                        m.bit / 8,
+                        m.bit % 8,
+                        m.entry.bits
+                    )
+                })
+                .collect();
+            format!(
+                "{name} {} ({bytes} B): {}",
+                pdos.join("+"),
+                entries.join(", ")
+            )
+        };
+        vec![
+            side("RxPDO", &self.rx_pdos, &self.rx, self.rx_bytes()),
+            side("TxPDO", &self.tx_pdos, &self.tx, self.tx_bytes()),
+        ]
     }
 }
 
-fn get(buf: &[u8], at: usize, len: usize) -> u32 {
-    let mut b = [0u8; 4];
-    if let Some(src) = buf.get(at..at + len) {
-        b[..len].copy_from_slice(src);
+/// Writes the low `bits` bits of `v` at bit offset `at` (little endian).
+fn put_bits(buf: &mut [u8], at: usize, bits: u8, v: u32) {
+    let bits = usize::from(bits).min(32);
+    if at % 8 == 0 && bits % 8 == 0 {
+        let n = bits / 8;
+        if let Some(dst) = buf.get_mut(at / 8..at / 8 + n) {
+            dst.copy_from_slice(&v.to_le_bytes()[..n]);
+        }
+        return;
     }
-    u32::from_le_bytes(b)
-}
-
-/// Name of a CiA 402 / 301 object this backend uses, for messages.
-pub fn object_name(index: u16) -> &'static str {
-    let all = [
-        CONTROLWORD,
-        STATUSWORD,
-        MODES_OF_OPERATION,
-        MODES_OF_OPERATION_DISPLAY,
-        TARGET_POSITION,
-        POSITION_ACTUAL,
-        VELOCITY_ACTUAL,
-        TORQUE_ACTUAL,
-        DIGITAL_INPUTS,
-        ERROR_CODE,
-        TOUCH_PROBE_FUNCTION,
-        TOUCH_PROBE_STATUS,
-        TOUCH_PROBE_1_POSITIVE,
-        TOUCH_PROBE_1_NEGATIVE,
-        TOUCH_PROBE_2_POSITIVE,
-        TOUCH_PROBE_2_NEGATIVE,
-        POSITIVE_TORQUE_LIMIT,
-        NEGATIVE_TORQUE_LIMIT,
-        MAX_TORQUE,
-        FOLLOWING_ERROR_WINDOW,
-    ];
-    match index {
-        0x1600 => "RxPDO mapping",
-        0x1A00 => "TxPDO mapping",
-        0x1C12 => "RxPDO assignment",
-        0x1C13 => "TxPDO assignment",
-        0x1C32 => "output sync manager parameters",
-        0x1C33 => "input sync manager parameters",
-        _ => all
-            .iter()
-            .find(|e| e.index == index)
-            .map_or("object", |e| e.name),
+    for k in 0..bits {
+        let (byte, bit) = ((at + k) / 8, (at + k) % 8);
+        if let Some(b) = buf.get_mut(byte) {
+            if v & (1 << k) != 0 {
+                *b |= 1 << bit;
+            } else {
+                *b &= !(1 << bit);
+            }
+        }
     }
 }
 
-/// Digital inputs 0x60FD bits (CiA 402).
-pub mod di {
-    pub const NEGATIVE_LIMIT_SWITCH: u32 = 1 << 0;
-    pub const POSITIVE_LIMIT_SWITCH: u32 = 1 << 1;
-    pub const HOME_SWITCH: u32 = 1 << 2;
+/// Reads `bits` bits at bit offset `at` (little endian; missing bits 0).
+fn get_bits(buf: &[u8], at: usize, bits: u8) -> u32 {
+    let bits = usize::from(bits).min(32);
+    if at % 8 == 0 && bits % 8 == 0 {
+        let mut b = [0u8; 4];
+        let n = bits / 8;
+        if let Some(src) = buf.get(at / 8..at / 8 + n) {
+            b[..n].copy_from_slice(src);
+        }
+        return u32::from_le_bytes(b);
+    }
+    let mut v = 0u32;
+    for k in 0..bits {
+        let (byte, bit) = ((at + k) / 8, (at + k) % 8);
+        if buf.get(byte).is_some_and(|b| b & (1 << bit) != 0) {
+            v |= 1 << k;
+        }
+    }
+    v
 }
 
 #[cfg(test)]
@@ -327,21 +335,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn mapping_values() {
-        assert_eq!(CONTROLWORD.mapping_value(), 0x6040_0010);
-        assert_eq!(TARGET_POSITION.mapping_value(), 0x607A_0020);
-        assert_eq!(MODES_OF_OPERATION.mapping_value(), 0x6060_0008);
-        let e = PdoEntry::from_mapping_value(0x60B9_0010);
-        assert_eq!((e.index, e.sub, e.bits), (0x60B9, 0, 16));
-    }
-
-    #[test]
     fn sizes_and_order() {
-        let l = PdoLayout::new(TorqueLimits::PerDirection, false);
-        let rx: Vec<u16> = l.rx_entries().iter().map(|e| e.index).collect();
+        let l = PdoLayout::standard(TorqueLimits::PerDirection, false);
+        let rx: Vec<u16> = l.rx().iter().map(|m| m.entry.index).collect();
         assert_eq!(rx, [0x6040, 0x607A, 0x60B8, 0x60E0, 0x60E1]);
         assert_eq!(l.rx_bytes(), 12);
-        let tx: Vec<u16> = l.tx_entries().iter().map(|e| e.index).collect();
+        let tx: Vec<u16> = l.tx().iter().map(|m| m.entry.index).collect();
         assert_eq!(
             tx,
             [
@@ -350,22 +349,25 @@ mod tests {
             ]
         );
         assert_eq!(l.tx_bytes(), 2 + 4 + 4 + 2 + 4 + 2 + 16 + 2);
+        assert_eq!(l.present.torque_limit, Some(TorqueLimits::PerDirection));
+        assert!(l.present.velocity && l.present.touch_probes && !l.present.mode);
 
-        let m = PdoLayout::new(TorqueLimits::MaxTorque, true);
-        let rx: Vec<u16> = m.rx_entries().iter().map(|e| e.index).collect();
+        let m = PdoLayout::standard(TorqueLimits::MaxTorque, true);
+        let rx: Vec<u16> = m.rx().iter().map(|m| m.entry.index).collect();
         assert_eq!(rx, [0x6040, 0x607A, 0x60B8, 0x6072, 0x6060]);
         assert_eq!(m.rx_bytes(), 11);
-
-        let req: Vec<u16> = l.required_objects().map(|e| e.index).collect();
-        assert_eq!(req.iter().filter(|&&i| i == 0x6060).count(), 1);
-        assert!(req.contains(&0x6061) && req.contains(&0x60B8));
-        let req: Vec<u16> = m.required_objects().map(|e| e.index).collect();
-        assert_eq!(req.iter().filter(|&&i| i == 0x6060).count(), 1);
+        assert!(m.present.mode && m.present.mode_display);
+        assert_eq!(
+            m.describe()[0],
+            "RxPDO 0x1600 (11 B): 0x6040 controlword @0.0/16, 0x607A target position @2.0/32, \
+             0x60B8 touch probe function @6.0/16, 0x6072 max torque @8.0/16, 0x6060 modes of \
+             operation @10.0/8"
+        );
     }
 
     #[test]
     fn pack_unpack() {
-        let l = PdoLayout::new(TorqueLimits::PerDirection, false);
+        let l = PdoLayout::standard(TorqueLimits::PerDirection, false);
         let out = DriveOutputs {
             controlword: 0x000F,
             target_position: -2,
@@ -383,7 +385,7 @@ mod tests {
         // short buffers never panic
         l.pack_outputs(&out, &mut buf[..3]);
 
-        let m = PdoLayout::new(TorqueLimits::MaxTorque, true);
+        let m = PdoLayout::standard(TorqueLimits::MaxTorque, true);
         let mut b2 = [0u8; 11];
         m.pack_outputs(&out, &mut b2);
         assert_eq!(&b2[8..], &[0xE8, 0x03, 8]);
@@ -407,9 +409,56 @@ mod tests {
     }
 
     #[test]
-    fn names() {
-        assert_eq!(object_name(0x60B8), "touch probe function");
-        assert_eq!(object_name(0x1C12), "RxPDO assignment");
-        assert_eq!(object_name(0x1234), "object");
+    fn fixed_mappings_with_foreign_entries_and_bit_padding() {
+        // a drive's fixed mapping: statusword, 4 bits padding, 4 bits of a
+        // vendor object, position, following error actual
+        let pad = PdoEntry::from_mapping_value(0x0000_0004);
+        let vendor = PdoEntry::from_mapping_value(0x2010_0104);
+        let tx = [
+            STATUSWORD,
+            pad,
+            vendor,
+            POSITION_ACTUAL,
+            PdoEntry::from_mapping_value(0x60F4_0020),
+        ];
+        let rx = [
+            CONTROLWORD,
+            TARGET_POSITION,
+            PdoEntry::from_mapping_value(0x60FF_0020),
+        ];
+        let l = PdoLayout::from_entries(&rx, &tx, &[0x1701], &[0x1B01]).unwrap();
+        assert_eq!((l.rx_bytes(), l.tx_bytes()), (10, 11));
+        assert_eq!(
+            l.present,
+            Present::default(),
+            "no velocity, torque, inputs, probes, error code"
+        );
+        let mut ibuf = [0u8; 11];
+        ibuf[0] = 0x37;
+        ibuf[1] = 0x02;
+        ibuf[2] = 0xA5; // padding low nibble, vendor high nibble
+        ibuf[3..7].copy_from_slice(&77i32.to_le_bytes());
+        let d = l.unpack_inputs(&ibuf);
+        assert_eq!((d.statusword, d.position), (0x0237, 77));
+        let mut obuf = [0xFFu8; 10];
+        l.pack_outputs(
+            &DriveOutputs {
+                controlword: 0x000F,
+                target_position: 5,
+                ..DriveOutputs::default()
+            },
+            &mut obuf,
+        );
+        assert_eq!(
+            obuf,
+            [0x0F, 0, 5, 0, 0, 0, 0, 0, 0, 0],
+            "unknown entries are 0"
+        );
+        // bit-level round trip
+        let mut b = [0u8; 3];
+        put_bits(&mut b, 3, 12, 0xABC);
+        assert_eq!(get_bits(&b, 3, 12), 0xABC);
+        assert_eq!(get_bits(&b, 0, 3), 0);
+        assert!(PdoLayout::from_entries(&[CONTROLWORD; 33], &[], &[], &[]).is_err());
     }
 }

@@ -17,6 +17,21 @@ impl fmt::Display for StartupError {
 
 impl std::error::Error for StartupError {}
 
+/// A SubDevice as messages name it.
+pub(crate) struct Sd<'a> {
+    pub position: usize,
+    pub name: &'a str,
+}
+
+impl Sd<'_> {
+    pub fn err(&self, what: String) -> StartupError {
+        StartupError(format!(
+            "SubDevice {} ({}): {what}",
+            self.position, self.name
+        ))
+    }
+}
+
 /// How a SubDevice is synchronised.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SyncMode {
@@ -58,6 +73,10 @@ pub struct SubDeviceReport {
     /// Output / input bytes of its process data.
     pub output_bytes: usize,
     pub input_bytes: usize,
+    /// Its set-up for the log: the mapping in force (objects, offsets,
+    /// bits), sync mode and cycle, SM watchdog, stop, brake, homing, and
+    /// what is unavailable.
+    pub lines: Vec<String>,
 }
 
 impl fmt::Display for SubDeviceReport {

@@ -1,24 +1,19 @@
 //! Bus start-up, INIT → OP: ethercrab discovers the SubDevices and brings
 //! them to PRE-OP; then, per mapped SubDevice, over CoE
-//! ([`crate::drive_setup`]):
+//! ([`crate::drive_setup`]): its dictionary checked against what its axis
+//! needs, the PDO mapping settled (written, predefined or fixed), 0x6060 =
+//! 8 (CSP) with 0x6061 awaited, the drive's own homing parameters, DC SYNC0
+//! or free run. **Every drive is checked before any is refused**: the
+//! start-up error lists, per drive, every missing or unsupported object.
 //!
-//! 1. every object the layout needs is read once — an SDO abort is a
-//!    start-up error naming the SubDevice and the object ("SubDevice 1
-//!    (name): object 0x60B8 touch probe function not supported (SDO abort
-//!    0x06020000)"); the torque limits fall back from 0x60E0/0x60E1 to
-//!    0x6072;
-//! 2. PDO assignment 0x1C12/0x1C13 cleared, mappings 0x1600/0x1A00 written
-//!    (sub-index 0 = 0, entries, count), assignment written;
-//! 3. 0x6060 = 8 (CSP), checked in 0x6061;
-//! 4. synchronisation: DC SYNC0 where the drive and `dc` allow it (0x1C32:01
-//!    = 2, SYNC0 = the bus cycle), free run otherwise (0x1C32:01 = 0);
-//!    0x1C32:02 = the cycle;
-//! 5. the SM watchdog (0x0400 divider = 100 µs, 0x0420 = `sm_watchdog_ms`),
-//!    and the SM2 watchdog enable bit checked.
-//!
-//! ethercrab then reads the mapping back to size SM2/SM3 and the FMMUs
-//! (PRE-OP with PDI), DC SYNC0 is configured, SAFE-OP, and OP is requested;
-//! the bus thread cycles process data until every SubDevice reports OP.
+//! Then the SM watchdog (0x0400 divider = 100 µs, 0x0420 = `sm_watchdog_ms`,
+//! the SM2 watchdog enable bit checked); ethercrab reads the mapping back to
+//! size SM2/SM3 and the FMMUs (PRE-OP with PDI), DC SYNC0 is configured,
+//! SAFE-OP — where a drive that did not show its mode at PRE-OP gets
+//! another bound to show it — and OP is requested; the bus thread cycles
+//! process data until every SubDevice reports OP. Each drive's report
+//! carries the lines of its set-up for the log (mapping in force, sync
+//! mode and cycle, SM watchdog, stop, brake, homing, unavailable objects).
 
 use std::time::Duration;
 
@@ -28,18 +23,23 @@ use ethercrab::{DcSync, MainDevice};
 use motion_config::{EthercatBus, EthercatDrive};
 
 use crate::capacity::{MAX_PDI, MAX_SUBDEVICES};
-use crate::drive_setup::{configure_drive, Sd};
+use crate::drive_setup::{await_mode, configure_drive, MODE_SAFEOP_WAIT};
 use crate::group::{Group, OpGroup};
+use crate::objects::MODE_CSP;
 use crate::pdo::PdoLayout;
-use crate::report::{StartupError, SubDeviceReport, SyncMode};
+use crate::report::{Sd, StartupError, SubDeviceReport, SyncMode};
 
 /// Per axis, what the bus thread needs.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) struct AxisPlan {
     /// Index in the group (= bus position).
     pub sd: usize,
     pub layout: PdoLayout,
     pub has_window: bool,
+    /// The drive's own homing, if its axis's drive homes.
+    pub homing: Option<motion_config::ethercat::DriveHomingPlan>,
+    /// 0x6061 has not yet shown mode 8 (awaited in SAFE-OP).
+    pub mode_pending: bool,
 }
 
 /// What start-up hands the bus thread: the group with OP requested, the
@@ -122,7 +122,7 @@ pub(crate) async fn startup(
     let mut reports = discovered(&group, md);
     let names: Vec<String> = reports.iter().map(|r| r.name.clone()).collect();
     let map = map_axes(cfg, &names)?;
-    let (plans, syncs) = configure_axes(&group, md, cfg, &map, &mut reports, warnings).await?;
+    let (plans, syncs) = configure_axes(&group, md, cfg, &map, &mut reports).await?;
     let any_dc = syncs.contains(&SyncMode::Dc);
     if any_dc {
         for (i, mut sd) in group.iter_mut(md).enumerate() {
@@ -136,7 +136,7 @@ pub(crate) async fn startup(
         .await
         .map_err(|e| StartupError(format!("process data configuration failed: {e}")))?;
     check_process_data(&group, md, cfg, &plans, &mut reports, warnings).await?;
-    let group = into_op(group, md, cfg, any_dc, &reports).await?;
+    let group = into_op(group, md, cfg, any_dc, &plans, &reports).await?;
     Ok(Started {
         group,
         plans,
@@ -166,23 +166,26 @@ fn discovered(group: &Group<PreOp, NoDc>, md: &MainDevice<'_>) -> Vec<SubDeviceR
                 device_name: None,
                 output_bytes: 0,
                 input_bytes: 0,
+                lines: Vec::new(),
             }
         })
         .collect()
 }
 
 /// Sets up the drive of every axis (`map`: its SubDevice) over CoE and
-/// notes in its report which axis it drives and how it is synchronised.
+/// notes in its report which axis it drives, how it is synchronised and
+/// the lines of its set-up. Every drive is set up (or found wanting)
+/// before an error is returned: the error lists every drive's problems.
 async fn configure_axes(
     group: &Group<PreOp, NoDc>,
     md: &MainDevice<'_>,
     cfg: &EthercatBus,
     map: &[usize],
     reports: &mut [SubDeviceReport],
-    warnings: &mut Vec<String>,
 ) -> Result<(Vec<AxisPlan>, Vec<SyncMode>), StartupError> {
     let mut plans = Vec::new();
     let mut syncs = Vec::new();
+    let mut errors = Vec::new();
     for (axis, &sdi) in cfg.axes.iter().zip(map) {
         let sd = group
             .subdevice(md, sdi)
@@ -192,7 +195,13 @@ async fn configure_axes(
             position: sdi,
             name: &name,
         };
-        let setup = configure_drive(&sd, &who, cfg, warnings).await?;
+        let setup = match configure_drive(&sd, &who, axis, cfg).await {
+            Ok(s) => s,
+            Err(e) => {
+                errors.push(e.0);
+                continue;
+            }
+        };
         // 0x1008 through a normal (or segmented) upload, for the report
         reports[sdi].device_name = sd
             .sdo_read::<heapless::String<96>>(0x1008, 0)
@@ -206,12 +215,23 @@ async fn configure_axes(
             SyncMode::FreeRun
         };
         reports[sdi].sync = Some(sync);
+        reports[sdi].lines = setup.lines;
         syncs.push(sync);
         plans.push(AxisPlan {
             sd: sdi,
             layout: setup.layout,
             has_window: setup.has_window,
+            homing: setup.homing,
+            mode_pending: !setup.mode_shown,
         });
+    }
+    if !errors.is_empty() {
+        return Err(StartupError(format!(
+            "{} of {} drive(s) cannot run their axes; nothing was started:\n  {}",
+            errors.len(),
+            map.len(),
+            errors.join("\n  ")
+        )));
     }
     Ok((plans, syncs))
 }
@@ -227,6 +247,7 @@ async fn check_process_data(
     reports: &mut [SubDeviceReport],
     warnings: &mut Vec<String>,
 ) -> Result<(), StartupError> {
+    let wd_ms = cfg.sm_watchdog().as_millis();
     let wd_units = u16::try_from((cfg.sm_watchdog().as_micros() / 100).max(1)).unwrap_or(u16::MAX);
     for (i, sd) in group.iter(md).enumerate() {
         let (inp, out) = {
@@ -254,7 +275,12 @@ async fn check_process_data(
         sd.register_write(0x0400u16, 2498u16).await.map_err(reg)?;
         sd.register_write(0x0420u16, wd_units).await.map_err(reg)?;
         let control: u8 = sd.register_read(0x0814u16).await.map_err(reg)?;
+        let mut line = format!(
+            "SM watchdog: {wd_ms} ms (0x0400 = 2498: 100 µs units, 0x0420 = {wd_units}), SM2 \
+             watchdog on: the drive stops this long after the last process data"
+        );
         if control & 0x40 == 0 {
+            line.push_str(" (switched on: its EEPROM had it off)");
             // the EEPROM left the SM2 watchdog off: switch it on (SM off,
             // control, SM on)
             let enable: u8 = sd.register_read(0x0816u16).await.map_err(reg)?;
@@ -270,6 +296,7 @@ async fn check_process_data(
                 reports[i].name
             ));
         }
+        reports[i].lines.push(line);
     }
     Ok(())
 }
@@ -280,10 +307,13 @@ async fn into_op(
     md: &MainDevice<'_>,
     cfg: &EthercatBus,
     any_dc: bool,
+    plans: &[AxisPlan],
     reports: &[SubDeviceReport],
 ) -> Result<OpGroup, StartupError> {
     if !any_dc {
-        return Ok(OpGroup::FreeRun(request_op(group, md, reports).await?));
+        return Ok(OpGroup::FreeRun(
+            request_op(group, md, plans, reports).await?,
+        ));
     }
     let g = group
         .configure_dc_sync(
@@ -296,14 +326,16 @@ async fn into_op(
         )
         .await
         .map_err(|e| StartupError(format!("DC SYNC0 configuration failed: {e}")))?;
-    Ok(OpGroup::Dc(request_op(g, md, reports).await?))
+    Ok(OpGroup::Dc(request_op(g, md, plans, reports).await?))
 }
 
-/// SAFE-OP, then OP requested (the bus thread cycles process data until
-/// every SubDevice has reached it).
+/// SAFE-OP — where the mode display of a drive that did not show it at
+/// PRE-OP is awaited again, with a bound — then OP requested (the bus
+/// thread cycles process data until every SubDevice has reached it).
 async fn request_op<DC>(
     group: Group<PreOpPdi, DC>,
     md: &MainDevice<'_>,
+    plans: &[AxisPlan],
     reports: &[SubDeviceReport],
 ) -> Result<Group<Op, DC>, StartupError> {
     let transition = |e: Error, to: &str| {
@@ -320,6 +352,24 @@ async fn request_op<DC>(
         .into_safe_op(md)
         .await
         .map_err(|e| transition(e, "SAFE-OP"))?;
+    for p in plans.iter().filter(|p| p.mode_pending) {
+        let sd = g
+            .subdevice(md, p.sd)
+            .map_err(|e| StartupError(format!("SubDevice {}: {e}", p.sd)))?;
+        if !await_mode(&sd, MODE_CSP, MODE_SAFEOP_WAIT).await {
+            let shown = sd.sdo_read::<u8>(0x6061, 0).await.map(|m| m as i8);
+            return Err(Sd {
+                position: p.sd,
+                name: &reports[p.sd].name,
+            }
+            .err(format!(
+                "0x6061 modes of operation display shows {} after 0x6060 = 8 (cyclic \
+                 synchronous position), still {} ms into SAFE-OP",
+                shown.map_or("nothing readable".into(), |m| m.to_string()),
+                MODE_SAFEOP_WAIT.as_millis()
+            )));
+        }
+    }
     g.request_into_op(md).await.map_err(|e| transition(e, "OP"))
 }
 
@@ -327,7 +377,6 @@ async fn request_op<DC>(
 mod tests {
     use super::*;
     use motion_config::ethercat::BusAxis;
-    use motion_config::AxisEthercat;
 
     fn cfg(sel: &[EthercatDrive]) -> EthercatBus {
         EthercatBus::new(
@@ -335,12 +384,10 @@ mod tests {
             1000,
             sel.iter()
                 .enumerate()
-                .map(|(i, s)| BusAxis {
-                    name: format!("A{i}"),
-                    ethercat: AxisEthercat {
-                        drive: s.clone(),
-                        index_pulse_bit: None,
-                    },
+                .map(|(i, s)| {
+                    let mut a = BusAxis::at(&format!("A{i}"), 0);
+                    a.ethercat.drive = s.clone();
+                    a
                 })
                 .collect(),
         )

@@ -3,10 +3,72 @@
 //! thread, read by anyone), plus their public snapshots.
 
 use std::fmt;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicU8, Ordering};
 
+use crate::capacity::MAX_SUBDEVICES;
 use crate::shared::SeqBuffer;
 use crate::words;
+
+/// How a SubDevice that drives an axis is doing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Health {
+    /// In OP, answering.
+    #[default]
+    Ok,
+    /// It does not answer (cable, power, the SubDevice before it).
+    NotAnswering,
+    /// It answers but is out of OP (SM watchdog, AL error, a state change
+    /// of its own); being brought back.
+    NotOp,
+    /// It was power-cycled (station address lost): being re-configured.
+    PowerCycled,
+    /// Re-configuring it failed: only a restart of motion-io brings it back.
+    Failed,
+}
+
+impl Health {
+    fn from_u8(v: u8) -> Health {
+        match v {
+            1 => Health::NotAnswering,
+            2 => Health::NotOp,
+            3 => Health::PowerCycled,
+            4 => Health::Failed,
+            _ => Health::Ok,
+        }
+    }
+
+    fn to_u8(self) -> u8 {
+        match self {
+            Health::Ok => 0,
+            Health::NotAnswering => 1,
+            Health::NotOp => 2,
+            Health::PowerCycled => 3,
+            Health::Failed => 4,
+        }
+    }
+}
+
+/// One SubDevice's health, written by the bus thread.
+pub(crate) struct SdAtomics {
+    health: AtomicU8,
+    /// AL status (low byte) as last seen; AL status code (0x0134).
+    pub al_status: AtomicU8,
+    pub al_code: AtomicU16,
+    /// Times it was lost, came back to OP, was re-configured.
+    pub losses: AtomicU64,
+    pub returns: AtomicU64,
+    pub reconfigured: AtomicU64,
+}
+
+impl SdAtomics {
+    pub fn health(&self) -> Health {
+        Health::from_u8(self.health.load(Ordering::Acquire))
+    }
+
+    pub fn set_health(&self, h: Health) {
+        self.health.store(h.to_u8(), Ordering::Release);
+    }
+}
 
 /// Round-trip histogram: 1 µs buckets up to this.
 const HIST_US: usize = 10_000;
@@ -38,6 +100,14 @@ pub(crate) struct Shared {
     pub frames_received: AtomicU64,
     pub window_write_failures: AtomicU64,
     pub needs_restart: AtomicU64,
+    /// Per bus position: the health of the SubDevices that drive axes.
+    pub sd: Vec<SdAtomics>,
+    /// Bumped on every change of a SubDevice's health (the log's cue).
+    pub health_events: AtomicU64,
+    /// Why re-configuring a SubDevice failed (per bus position), written
+    /// by the bus thread before it sets `Health::Failed` (off the cycle:
+    /// from the background job, which may allocate).
+    pub failures: std::sync::Mutex<Vec<(usize, String)>>,
     /// System-allocator calls of the bus thread in the cycle loop after
     /// warm-up (only counted when motion_rt::RtAllocator is the global
     /// allocator).
@@ -78,6 +148,18 @@ impl Shared {
             frames_received: AtomicU64::new(0),
             window_write_failures: AtomicU64::new(0),
             needs_restart: AtomicU64::new(0),
+            sd: (0..MAX_SUBDEVICES)
+                .map(|_| SdAtomics {
+                    health: AtomicU8::new(0),
+                    al_status: AtomicU8::new(0),
+                    al_code: AtomicU16::new(0),
+                    losses: AtomicU64::new(0),
+                    returns: AtomicU64::new(0),
+                    reconfigured: AtomicU64::new(0),
+                })
+                .collect(),
+            health_events: AtomicU64::new(0),
+            failures: std::sync::Mutex::new(Vec::new()),
             bus_allocations: AtomicU64::new(0),
             hist: (0..HIST_US).map(|_| AtomicU64::new(0)).collect(),
             hist_over: AtomicU64::new(0),
@@ -134,6 +216,9 @@ impl Shared {
             recoveries: l(&self.recoveries),
             recovery_failures: l(&self.recovery_failures),
             needs_restart: l(&self.needs_restart),
+            losses: self.sd.iter().map(|s| l(&s.losses)).sum(),
+            returns: self.sd.iter().map(|s| l(&s.returns)).sum(),
+            reconfigured: self.sd.iter().map(|s| l(&s.reconfigured)).sum(),
             bus_thread_allocations: l(&self.bus_allocations),
             command_read_failures: l(&self.command_read_failures),
             feedback_read_failures: self.feedback.read_failures(),
@@ -154,6 +239,54 @@ impl Shared {
                 })
                 .collect(),
         }
+    }
+}
+
+/// One SubDevice that drives an axis, as its health stands (for the log).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SubDeviceHealth {
+    pub position: usize,
+    pub name: String,
+    /// The axes it drives.
+    pub axes: Vec<String>,
+    pub health: Health,
+    /// AL status (state nibble, 0 = did not answer) last seen, and the AL
+    /// status code of its last acknowledged error.
+    pub al_status: u8,
+    pub al_code: u16,
+    pub losses: u64,
+    pub returns: u64,
+    pub reconfigured: u64,
+    /// Why re-configuring it failed.
+    pub failure: Option<String>,
+}
+
+impl Shared {
+    /// The health of the SubDevices at `positions` (named `names`, driving
+    /// `axes`). Off the bus thread (allocates; reads the failure list with
+    /// a lock the bus thread only ever tries).
+    pub(crate) fn health(&self, who: &[(usize, String, Vec<String>)]) -> Vec<SubDeviceHealth> {
+        let failures = self.failures.lock().map(|f| f.clone()).unwrap_or_default();
+        who.iter()
+            .map(|(p, name, axes)| {
+                let sd = &self.sd[*p];
+                SubDeviceHealth {
+                    position: *p,
+                    name: name.clone(),
+                    axes: axes.clone(),
+                    health: sd.health(),
+                    al_status: sd.al_status.load(Ordering::Relaxed),
+                    al_code: sd.al_code.load(Ordering::Relaxed),
+                    losses: sd.losses.load(Ordering::Relaxed),
+                    returns: sd.returns.load(Ordering::Relaxed),
+                    reconfigured: sd.reconfigured.load(Ordering::Relaxed),
+                    failure: failures
+                        .iter()
+                        .find(|(k, _)| k == p)
+                        .map(|(_, w)| w.clone()),
+                }
+            })
+            .collect()
     }
 }
 
@@ -212,9 +345,14 @@ pub struct BusStatus {
     /// SubDevices brought back to OP.
     pub recoveries: u64,
     pub recovery_failures: u64,
-    /// SubDevices found in INIT / PRE-OP (lost their configuration, e.g.
-    /// power-cycled): only a restart of the backend brings them back.
+    /// SubDevices given up on (re-configuring them failed): only a restart
+    /// of the backend brings them back.
     pub needs_restart: u64,
+    /// Losses of SubDevices that drive axes (not answering, out of OP),
+    /// returns to OP, and re-configurations after a power cycle.
+    pub losses: u64,
+    pub returns: u64,
+    pub reconfigured: u64,
     /// System-allocator calls the bus thread made while cycling, after
     /// [`crate::bus::WARM_UP_CYCLES`] (counted only in a binary whose global
     /// allocator is `motion_rt::RtAllocator`; 0 otherwise).

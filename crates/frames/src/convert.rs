@@ -28,12 +28,12 @@
 //! * `switch_arm_edge`: 0 = rising, any other value = falling.
 //! * Latched flags: 0 = false, any other value = true.
 
-use motion_homing::{Command, DriveState, Edge, Feedback, LatchArm, LatchFeedback};
+use motion_homing::{Command, DriveHoming, DriveState, Edge, Feedback, LatchArm, LatchFeedback};
 
 use crate::frame::{
-    AxisCommand, AxisFeedback, CW_ENABLE, CW_FAULT_RESET, DI_HOME_SWITCH, DI_MARKER_PULSE,
-    DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING, SW_ENABLED,
-    SW_FAULT,
+    AxisCommand, AxisFeedback, CW_DRIVE_HOME, CW_ENABLE, CW_FAULT_RESET, DI_HOME_SWITCH,
+    DI_MARKER_PULSE, DI_OVERTRAVEL_NEGATIVE, DI_OVERTRAVEL_POSITIVE, EDGE_FALLING, EDGE_RISING,
+    SW_DRIVE_HOMED, SW_DRIVE_HOMING, SW_DRIVE_HOMING_ERROR, SW_ENABLED, SW_FAULT,
 };
 
 /// Wire value of a position that was not a number (see the module docs).
@@ -112,6 +112,9 @@ fn control_word(cmd: &Command) -> u16 {
     if cmd.fault_reset {
         cw |= CW_FAULT_RESET;
     }
+    if cmd.drive_home {
+        cw |= CW_DRIVE_HOME;
+    }
     cw
 }
 
@@ -151,6 +154,7 @@ pub fn axis_to_command(ac: &AxisCommand, counts_per_unit: f64) -> Command {
             edge: edge_from_wire(ac.switch_arm_edge),
         },
         fault_reset: ac.control_word & CW_FAULT_RESET != 0,
+        drive_home: ac.control_word & CW_DRIVE_HOME != 0,
     }
 }
 
@@ -175,6 +179,15 @@ pub fn feedback_to_axis(fb: &Feedback, counts_per_unit: f64) -> AxisFeedback {
     }
     if fb.drive.fault {
         sw |= SW_FAULT;
+    }
+    for (on, bit) in [
+        (fb.drive_homing.active, SW_DRIVE_HOMING),
+        (fb.drive_homing.attained, SW_DRIVE_HOMED),
+        (fb.drive_homing.error, SW_DRIVE_HOMING_ERROR),
+    ] {
+        if on {
+            sw |= bit;
+        }
     }
     AxisFeedback {
         position: units_to_counts(fb.position, counts_per_unit),
@@ -216,6 +229,11 @@ pub fn axis_to_feedback(af: &AxisFeedback, counts_per_unit: f64) -> Feedback {
             enabled: af.status_word & SW_ENABLED != 0,
             fault: af.status_word & SW_FAULT != 0,
         },
+        drive_homing: DriveHoming {
+            active: af.status_word & SW_DRIVE_HOMING != 0,
+            attained: af.status_word & SW_DRIVE_HOMED != 0,
+            error: af.status_word & SW_DRIVE_HOMING_ERROR != 0,
+        },
     }
 }
 
@@ -243,6 +261,7 @@ mod tests {
                 edge: Edge::Falling,
             },
             fault_reset: true,
+            drive_home: true,
         }
     }
 
@@ -268,6 +287,11 @@ mod tests {
             drive: DriveState {
                 enabled: true,
                 fault: true,
+            },
+            drive_homing: DriveHoming {
+                active: true,
+                attained: true,
+                error: false,
             },
         }
     }
@@ -343,7 +367,7 @@ mod tests {
         assert_eq!(w.torque_limit_negative, 80.25);
         assert_eq!(w.position_error_tolerance, 500.0);
         assert_eq!(w.velocity_error_tolerance, 3000.0);
-        assert_eq!(w.control_word, CW_ENABLE | CW_FAULT_RESET);
+        assert_eq!(w.control_word, CW_ENABLE | CW_FAULT_RESET | CW_DRIVE_HOME);
         assert_eq!(w.marker_arm_id, 7);
         assert_eq!(w.switch_arm_id, 200);
         assert_eq!(w.switch_arm_edge, EDGE_FALLING);
@@ -394,7 +418,10 @@ mod tests {
             w.digital_inputs,
             DI_HOME_SWITCH | DI_OVERTRAVEL_NEGATIVE | DI_MARKER_PULSE
         );
-        assert_eq!(w.status_word, SW_ENABLED | SW_FAULT);
+        assert_eq!(
+            w.status_word,
+            SW_ENABLED | SW_FAULT | SW_DRIVE_HOMING | SW_DRIVE_HOMED
+        );
         assert_eq!((w.marker_latch_id, w.marker_latched), (3, 1));
         assert_eq!((w.switch_latch_id, w.switch_latched), (9, 0));
         assert_eq!(w.marker_latch_position, 2500);

@@ -69,8 +69,15 @@ pub const CW_ENABLE: u16 = 1 << 0;
 /// [`AxisCommand::control_word`] bit 1: fault reset (MAFR). Its rising edge
 /// asks the drive to clear a fault: CiA 402 control word bit 7 on EtherCAT,
 /// the plant's fault in the `sim`. It never enables anything by itself.
-/// Bits 2..=15 are reserved: sent as 0, ignored by the receiver.
 pub const CW_FAULT_RESET: u16 = 1 << 1;
+/// [`AxisCommand::control_word`] bit 2: the drive homes the axis itself
+/// (CiA 402 homing mode on EtherCAT; a `drive_homing` axis's drive-homing
+/// leg). Set for the whole request; its fall ends it (the drive halts if it
+/// has not attained home, and hands back to cyclic position mode with its
+/// set-point taken from its actual position first). A backend that cannot
+/// home by the drive answers [`SW_DRIVE_HOMING_ERROR`].
+/// Bits 3..=15 are reserved: sent as 0, ignored by the receiver.
+pub const CW_DRIVE_HOME: u16 = 1 << 2;
 
 /// [`AxisFeedback::status_word`] bit 0: power stage on and following the command.
 pub const SW_ENABLED: u16 = 1 << 0;
@@ -82,8 +89,27 @@ pub const SW_FAULT: u16 = 1 << 1;
 /// SubDevice out of OP). The rest of the entry is the last known state and
 /// must not be used as feedback: the supervisor counts the axis as missing
 /// feedback, and its loss rule decides.
-/// Bits 3..=15 are reserved: sent as 0, ignored by the receiver.
 pub const SW_NO_DATA: u16 = 1 << 2;
+/// [`AxisFeedback::status_word`] bit 3: the axis's drive is lost while the
+/// I/O process is alive (EtherCAT: its SubDevice does not answer, is out of
+/// OP, or was power-cycled), always together with [`SW_NO_DATA`]. The
+/// supervisor names the loss after the drive (ERR 12 / EXERR 45), not after
+/// the I/O process; the I/O process's log says which device and what to do.
+pub const SW_DRIVE_LOST: u16 = 1 << 3;
+/// [`AxisFeedback::status_word`] bit 4: the drive's own homing is in force
+/// for the [`CW_DRIVE_HOME`] request (homing mode confirmed by the drive),
+/// or the drive is still handing back after it: the drive, not the command,
+/// moves the axis.
+pub const SW_DRIVE_HOMING: u16 = 1 << 4;
+/// [`AxisFeedback::status_word`] bit 5: with [`SW_DRIVE_HOMING`], the drive
+/// attained home (CiA 402 statusword bits 12 and 10) and redefined its
+/// position: its position 0 is the home point.
+pub const SW_DRIVE_HOMED: u16 = 1 << 5;
+/// [`AxisFeedback::status_word`] bit 6: the drive reports a homing error
+/// (CiA 402 statusword bit 13), did not take homing mode within its bound,
+/// or cannot home by itself.
+/// Bits 7..=15 are reserved: sent as 0, ignored by the receiver.
+pub const SW_DRIVE_HOMING_ERROR: u16 = 1 << 6;
 
 /// [`AxisFeedback::digital_inputs`] bit 0: home switch contact closed (electrical level).
 pub const DI_HOME_SWITCH: u32 = 1 << 0;
@@ -213,8 +239,8 @@ pub struct AxisCommand {
     pub position_error_tolerance: f64,
     /// Velocity error tolerance, counts/s (0 = check off).
     pub velocity_error_tolerance: f64,
-    /// Control bits: bit 0 [`CW_ENABLE`] (request power stage on); bits 1..=15
-    /// reserved (0).
+    /// Control bits: bit 0 [`CW_ENABLE`] (request power stage on), bit 1
+    /// [`CW_FAULT_RESET`], bit 2 [`CW_DRIVE_HOME`]; bits 3..=15 reserved (0).
     pub control_word: u16,
     /// Marker latch arm request id (0 = disarmed; a new non-zero value re-arms).
     pub marker_arm_id: u8,
@@ -243,7 +269,9 @@ pub struct AxisFeedback {
     /// bits 3..=31 reserved (0).
     pub digital_inputs: u32,
     /// Status bits: [`SW_ENABLED`] (bit 0), [`SW_FAULT`] (bit 1),
-    /// [`SW_NO_DATA`] (bit 2); bits 3..=15 reserved (0).
+    /// [`SW_NO_DATA`] (bit 2), [`SW_DRIVE_LOST`] (bit 3), [`SW_DRIVE_HOMING`]
+    /// (bit 4), [`SW_DRIVE_HOMED`] (bit 5), [`SW_DRIVE_HOMING_ERROR`] (bit 6);
+    /// bits 7..=15 reserved (0).
     pub status_word: u16,
     /// Id of the marker arm request this latch state belongs to (0 = disarmed).
     pub marker_latch_id: u8,

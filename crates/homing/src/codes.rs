@@ -15,6 +15,8 @@
 //! | 12   | 42    | *ours* drive did not report enabled within `enable_timeout` |
 //! | 12   | 43    | *ours* hardware overtravel input tripped during homing |
 //! | 12   | 44    | *ours* feedback implausible: a position further than `max_speed` allows from where the axis was last seen or has been commanded since (a forged or corrupt frame; never an event) |
+//! | 12   | 45    | *ours* drive lost: the I/O process is alive but reports the axis's drive gone (EtherCAT: its SubDevice stopped answering, left OP or was power-cycled); the feedback-loss rule tripped on it. motion-io's log names the SubDevice and says what to do |
+//! | 12   | 46    | *ours* drive homing error: a `drive_homing` axis's drive reported a homing error (CiA 402 statusword bit 13), refused homing mode, or left it before attaining home |
 //! | 41   | 4     | home sequence incompatible with home mode / axis (passive torque, virtual axis moving sequence, absolute mode with a sequence other than immediate) |
 //! | 41   | 6     | home speed zero |
 //! | 41   | 7     | home return speed zero |
@@ -122,6 +124,8 @@ pub const EX_FEEDBACK_INVALID: u16 = 41;
 pub const EX_ENABLE_TIMEOUT: u16 = 42;
 pub const EX_OVERTRAVEL: u16 = 43;
 pub const EX_FEEDBACK_IMPLAUSIBLE: u16 = 44;
+pub const EX_DRIVE_LOST: u16 = 45;
+pub const EX_DRIVE_HOMING_ERROR: u16 = 46;
 
 // EXERR under ERR 41.
 pub const EX_SEQUENCE_INCOMPATIBLE: u16 = 4;

@@ -291,6 +291,12 @@ pub struct AxisConfig {
     /// edge approached the same way as from the near side. Validation
     /// refuses it for every other sequence and direction (ERR 41 / EXERR 37).
     pub home_reverse_at_limit: bool,
+    /// The drive homes the axis itself (EtherCAT: CiA 402 homing mode 6,
+    /// the `[[axis]]` key `drive_homing`): an active sequence's plan is then
+    /// one leg "the drive homes" and the move to Home Position (see
+    /// `axis::drive_homing`). The drive's homing method and speeds are the
+    /// I/O process's to set; the engine only asks and watches.
+    pub drive_homing: bool,
 }
 
 impl Default for AxisConfig {
@@ -342,6 +348,7 @@ impl Default for AxisConfig {
             stream_timeout_ns: 0,
             stream_unhomed: false,
             home_reverse_at_limit: false,
+            drive_homing: false,
         }
     }
 }

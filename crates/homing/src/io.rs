@@ -51,6 +51,23 @@ pub struct Feedback {
     /// config); the engine then knows the marker to one cycle of travel.
     pub marker_pulse: bool,
     pub drive: DriveState,
+    /// The drive's own homing (`drive_homing` axes), as it reports it.
+    pub drive_homing: DriveHoming,
+}
+
+/// The drive's own homing (CiA 402 homing mode), as the drive reports it
+/// while the engine asks for it (`Command::drive_home`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DriveHoming {
+    /// The drive runs its homing for this request (or has just finished it,
+    /// or is still leaving homing mode): the drive, not the command, moves
+    /// the axis, and the command follows the actual position.
+    pub active: bool,
+    /// Homing attained: the drive found its home and redefined its
+    /// position (the home point is its position 0), and is at rest.
+    pub attained: bool,
+    /// The drive reports a homing error (or did not take homing mode).
+    pub error: bool,
 }
 
 /// Which electrical edge of the home switch input a registration latch takes.
@@ -97,6 +114,9 @@ pub struct Command {
     /// drive reports no fault (at most `enable_timeout`), so the drive sees
     /// a rising edge however the frames are timed.
     pub fault_reset: bool,
+    /// Ask the drive to home the axis itself (a `drive_homing` axis in its
+    /// drive-homing leg): set for the whole leg, cleared to end it.
+    pub drive_home: bool,
 }
 
 /// Control inputs for one cycle, as a PLC program would drive the MAH rung.
@@ -141,4 +161,9 @@ pub struct Request {
     /// The jog's client renewed its lease this cycle: it runs until
     /// `now + lease_ns` at least.
     pub jog_renew: bool,
+    /// The I/O process reports the axis's drive lost (its fieldbus device
+    /// stopped answering or left operation) while motion-io itself is
+    /// alive: the loss of feedback that follows names the drive (ERR 12 /
+    /// EXERR 45) instead of the I/O process, and the status shows it.
+    pub drive_lost: bool,
 }

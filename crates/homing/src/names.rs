@@ -134,7 +134,8 @@ mod tests {
         );
         assert_eq!(Phase::from_number(10), Some(Phase::Creep));
         assert_eq!(Phase::from_number(11), Some(Phase::Reverse));
-        assert_eq!(Phase::from_number(12), None);
+        assert_eq!(Phase::from_number(12), Some(Phase::DriveHoming));
+        assert_eq!(Phase::from_number(13), None);
         assert_eq!(
             HomeSequence::from_number(7),
             Some(HomeSequence::LimitSwitchThenMarker)

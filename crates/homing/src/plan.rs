@@ -107,6 +107,10 @@ pub enum Leg {
     Continue,
     /// Passive: wait for the goal while something else moves the axis.
     Watch(Goal),
+    /// The drive homes the axis itself (`drive_homing`): asked for, then
+    /// watched until the drive reports home attained (or an error); the
+    /// command follows the drive (see `axis::drive_homing`).
+    DriveHomes,
 }
 
 impl Leg {
@@ -130,6 +134,9 @@ impl Leg {
 
 use Goal::*;
 use Leg::*;
+
+/// A sequence the drive homes by itself (`drive_homing`).
+pub const DRIVE_HOMES: &[Leg] = &[DriveHomes, MoveHome];
 
 const PASSIVE_SWITCH: &[Leg] = &[Watch(SwitchDetect)];
 const PASSIVE_MARKER: &[Leg] = &[Watch(Marker)];
@@ -277,6 +284,13 @@ pub fn creeps(cfg: &AxisConfig) -> bool {
 
 /// The plan of `cfg`'s sequence.
 pub fn plan_for(cfg: &AxisConfig) -> &'static [Leg] {
+    if cfg.drive_homing
+        && cfg.home_mode == HomeMode::Active
+        && cfg.home_sequence != HomeSequence::Immediate
+    {
+        // the drive homes (see `axis::drive_homing`), then the move home
+        return DRIVE_HOMES;
+    }
     plan(
         cfg.home_sequence,
         cfg.home_direction,
@@ -345,6 +359,7 @@ pub fn phase_of(plan: &[Leg], i: usize, to_home: bool) -> Phase {
         Some(Continue) if to_home => Phase::MoveHome,
         Some(Continue) => Phase::SeekStop,
         Some(Watch(_)) => Phase::Passive,
+        Some(DriveHomes) => Phase::DriveHoming,
     }
 }
 

@@ -38,6 +38,8 @@ pub enum Phase {
     /// switch; running back at Home Speed past the home switch, to search
     /// again from its near side.
     Reverse = 11,
+    /// The drive runs its own homing (`drive_homing`, CiA 402 mode 6).
+    DriveHoming = 12,
 }
 
 crate::spellings!(Phase {
@@ -53,6 +55,7 @@ crate::spellings!(Phase {
     Stopping => "stopping",
     Creep => "creep",
     Reverse => "reverse",
+    DriveHoming => "drive_homing",
 });
 
 /// Feedback refused as implausible, by kind, counted over the axis's life.
@@ -176,4 +179,7 @@ pub struct Status {
     /// `home_reverse_at_limit`: this homing met the limit switch in Home
     /// Direction before the home switch and reversed its search.
     pub reversed_at_limit: bool,
+    /// The I/O process reports the axis's drive lost (`Request::drive_lost`):
+    /// not a reading, not enabled, whatever the last feedback said.
+    pub drive_lost: bool,
 }

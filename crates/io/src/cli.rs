@@ -1,7 +1,7 @@
 //! Command line, parsed with clap: every value checked by the same rules as
 //! the config file; a mistake is answered with the usage and exit code 2.
 
-use clap::{Parser, ValueEnum};
+use clap::{Parser, Subcommand, ValueEnum};
 use motion_config::args::{cpu, interface, io, runtime_dir, service_prefix};
 use std::path::PathBuf;
 
@@ -82,6 +82,28 @@ pub struct Options {
     /// Print only errors and watchdog messages.
     #[arg(long)]
     pub quiet: bool,
+    #[command(subcommand)]
+    pub command: Option<Sub>,
+}
+
+/// What `motion-io` does besides serving the supervisor.
+#[derive(Clone, Debug, Subcommand)]
+pub enum Sub {
+    /// List every SubDevice on an EtherCAT bus — position, name, identity,
+    /// DC, the CiA 402 objects it has, touch probe, homing methods (0x60E3),
+    /// the PDO mapping in force — and which homing sequences each can serve
+    /// (controller-side and drive-side), then a config skeleton of the bus.
+    /// It only reads (PRE-OP, then INIT) and needs CAP_NET_RAW; no
+    /// supervisor and no config are involved.
+    Scan {
+        /// The network interface of the bus.
+        #[arg(long, value_name = "IF", value_parser = interface)]
+        interface: String,
+        /// One JSON object on stdout (`{"interface", "subdevices": [...],
+        /// "config"}`; on failure `{"errors": [...]}`).
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[cfg(test)]
@@ -109,6 +131,12 @@ mod tests {
         assert!(p("--service-prefix a/b").is_err());
         assert!(p("--config").is_err());
         assert!(p("--io").is_err());
+        let o = p("scan --interface eth1 --json").unwrap();
+        assert!(
+            matches!(o.command, Some(Sub::Scan { ref interface, json: true }) if interface == "eth1")
+        );
+        assert!(p("scan").is_err(), "the interface is required");
+        assert!(p("scan --interface a/b").is_err());
     }
 
     /// Issue 8, fuzzed: any argument vector is parsed or refused, never a

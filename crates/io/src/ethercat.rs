@@ -12,11 +12,14 @@
 
 use std::cell::RefCell;
 
-use motion_ethercat::{EthercatBackend, EthercatBus, StartupReport};
+use motion_ethercat::{EthercatBackend, EthercatBus};
 use motion_frames::backend::{Backend, ExchangeError};
 use motion_frames::{
     AxisCommand, AxisFeedback, CommandFrame, FeedbackFrame, CW_ENABLE, SW_ENABLED,
 };
+
+use crate::ethercat_log::{self, HealthLog};
+use crate::say::Say;
 
 /// Why the backend could not start, and the exit code it calls for.
 #[derive(Debug)]
@@ -24,42 +27,6 @@ pub struct StartError {
     /// 2: a configuration / command-line mistake; 1: the bus refused.
     pub code: i32,
     pub message: String,
-}
-
-/// The start-up report in lines for the log: one summary, one line per
-/// SubDevice (name, position, the axis it drives, DC or free run), warnings.
-pub fn report_lines(interface: &str, r: &StartupReport) -> Vec<String> {
-    let dc = r
-        .axes
-        .iter()
-        .filter(|(_, s)| *s == motion_ethercat::SyncMode::Dc)
-        .count();
-    let mut out = vec![format!(
-        "EtherCAT on {interface}: {} SubDevice(s) in OP after {} ms; {} of {} axes on \
-         distributed clocks (SYNC0), {} free run; bus thread: {}",
-        r.subdevices.len(),
-        r.duration.as_millis(),
-        dc,
-        r.axes.len(),
-        r.axes.len() - dc,
-        r.rt.lines().next().unwrap_or_default()
-    )];
-    for s in &r.subdevices {
-        let sync = match (&s.axis, s.sync) {
-            (Some(axis), Some(sync)) => format!("axis {axis}, {sync}"),
-            _ => "no axis".to_string(),
-        };
-        out.push(format!(
-            "  SubDevice {} {:?}: {sync} (DC {}capable)",
-            s.position,
-            s.name,
-            if s.dc_capable { "" } else { "not " }
-        ));
-    }
-    for w in &r.warnings {
-        out.push(format!("  warning: {w}"));
-    }
-    out
 }
 
 /// Copies the bus feedback `bus` into `fb` in frame order (`map`: frame →
@@ -104,6 +71,8 @@ pub struct EthercatIo {
     /// Last command of each frame axis (the virtual ones are echoed).
     last: Vec<AxisCommand>,
     interface: String,
+    /// Logs every change of a drive's health.
+    _health: HealthLog,
 }
 
 impl EthercatIo {
@@ -113,6 +82,8 @@ impl EthercatIo {
         cfg: EthercatBus,
         map: Vec<Option<usize>>,
         names: Vec<String>,
+        say: Say,
+        io: &str,
     ) -> Result<EthercatIo, StartError> {
         let interface = cfg.keys.interface.clone();
         let inner = EthercatBackend::new(cfg).map_err(|e| StartError {
@@ -120,7 +91,9 @@ impl EthercatIo {
             message: format!("EtherCAT start-up on {interface} failed: {e}"),
         })?;
         let direct = map.iter().enumerate().all(|(i, m)| *m == Some(i));
+        let health = HealthLog::start(inner.health_watch(), say, io.to_string());
         Ok(EthercatIo {
+            _health: health,
             inner,
             last: vec![AxisCommand::ZERO; names.len()],
             names,
@@ -133,7 +106,7 @@ impl EthercatIo {
     }
 
     pub fn report_lines(&self) -> Vec<String> {
-        report_lines(&self.interface, self.inner.report())
+        ethercat_log::report_lines(&self.interface, self.inner.report())
     }
 
     /// Runs `f` on the bus feedback, then fills `fb` from it.
@@ -153,21 +126,7 @@ impl EthercatIo {
 
     /// A summary of the bus counters and its round trip, for the log at exit.
     pub fn summary(&self) -> String {
-        let st = self.inner.bus_status();
-        format!(
-            "EtherCAT on {}: {} bus cycles, {} lost frame(s), {} late, {} working-counter \
-             error(s), {} overrun(s), {} recovery(ies), {} SubDevice(s) needing a restart; \
-             bus round trip (frame out → inputs back): {}",
-            self.interface,
-            st.cycles,
-            st.lost_frames,
-            st.late_frames,
-            st.wkc_errors,
-            st.overruns,
-            st.recoveries,
-            st.needs_restart,
-            st.roundtrip
-        )
+        ethercat_log::summary(&self.interface, &self.inner.bus_status())
     }
 }
 
@@ -224,7 +183,8 @@ impl Backend for EthercatIo {
     }
 
     fn shutdown(&mut self, dt_s: f64, fb: &mut FeedbackFrame) -> bool {
-        // paced by the bus cycle, bounded (motion_ethercat::backend::MAX_SHUTDOWN)
+        // paced by the bus cycle, bounded by the stop's own bound
+        // (EthercatBackend::stop_bound)
         self.via_bus(fb, |b, f| b.shutdown(dt_s, f))
     }
 

@@ -16,8 +16,10 @@
 
 use motion_io::cli;
 mod ethercat;
+mod ethercat_log;
 mod run;
 mod say;
+mod scan;
 mod sim;
 
 use std::path::Path;
@@ -56,6 +58,9 @@ fn real_main() -> i32 {
     let say = Say { quiet: opts.quiet };
     if opts.quiet {
         log::set_max_level(log::LevelFilter::Warn);
+    }
+    if let Some(cli::Sub::Scan { interface, json }) = &opts.command {
+        return scan::run(interface, *json);
     }
 
     let (cfg, label) = match motion_config::load(opts.config.as_deref()) {
@@ -132,7 +137,12 @@ fn real_main() -> i32 {
     loop {
         let domain = match wait_for_supervisor(&settings, &runtime_dir) {
             Ok(d) => d,
-            Err(code) => return code,
+            Err(code) => {
+                if let Some(s) = backend.summary() {
+                    say.notice(format_args!("{s}"));
+                }
+                return code;
+            }
         };
         let outcome = serve(&domain, &io_name, backend.as_mut(), &settings, &label);
         // node and ports are gone: tidy the domain (dead peers), and the
@@ -184,7 +194,7 @@ fn start_ethercat(
             bus.keys.dc,
             bus.sm_watchdog().as_millis()
         ));
-        ethercat::EthercatIo::start(bus, map, names)
+        ethercat::EthercatIo::start(bus, map, names, say, &cfg.ios[io].name)
     });
     match started {
         Ok(b) => {

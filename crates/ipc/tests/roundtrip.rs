@@ -118,6 +118,7 @@ fn engine_command(i: u64) -> Command {
             edge: Edge::Falling,
         },
         fault_reset: false,
+        drive_home: false,
     }
 }
 

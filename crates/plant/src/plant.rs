@@ -188,6 +188,7 @@ impl Plant {
             switch_latch: self.switch_latch.feedback(),
             marker_pulse: self.marker_pulse,
             drive: self.drive.state(),
+            drive_homing: Default::default(),
         }
     }
 

@@ -163,6 +163,7 @@ fn wild_command() -> impl Strategy<Value = (Command, f64)> {
                             edge: edge(se),
                         },
                         fault_reset,
+                        drive_home: false,
                     },
                     dt,
                 )

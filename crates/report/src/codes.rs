@@ -13,6 +13,14 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         (ERR_SERVO_MESSAGE, EX_FEEDBACK_INVALID) => "invalid feedback (non-finite or absurd)",
         (ERR_SERVO_MESSAGE, EX_ENABLE_TIMEOUT) => "drive did not enable in time",
         (ERR_SERVO_MESSAGE, EX_OVERTRAVEL) => "hardware overtravel: a limit switch was hit",
+        (ERR_SERVO_MESSAGE, EX_DRIVE_LOST) => {
+            "drive lost: it stopped answering on its bus, left operation or was power-cycled \
+             (its I/O process is alive; its log names the drive and what to do)"
+        }
+        (ERR_SERVO_MESSAGE, EX_DRIVE_HOMING_ERROR) => {
+            "the drive's own homing failed: it reported a homing error or did not take homing \
+             mode"
+        }
         (ERR_SERVO_MESSAGE, EX_FEEDBACK_IMPLAUSIBLE) => {
             "implausible feedback: a position the axis cannot have reached (never a home event)"
         }

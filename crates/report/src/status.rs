@@ -49,6 +49,10 @@ pub struct AxisStatus {
     /// applied at start-up without motion.
     #[serde(default)]
     pub restored: bool,
+    /// The axis's drive is lost (its I/O process is alive and says so:
+    /// the drive stopped answering, left operation or was power-cycled).
+    #[serde(default)]
+    pub drive_lost: bool,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
     /// Warnings of the last homing (ambiguous marker, drift, invalidated
@@ -104,6 +108,16 @@ pub struct IoStatus {
     pub gaps: GapCounts,
     /// Current gap (cycles without a fresh answer).
     pub gap_cycles: u64,
+    /// A spawned I/O process: times the supervisor started it again.
+    #[serde(default)]
+    pub restarts: u32,
+    /// A spawned I/O process waiting to be started again: in this many
+    /// seconds (1 s doubling to 30 s while it keeps failing at start-up).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub retry_in_s: Option<f64>,
+    /// A spawned I/O process: the error of its last failed start.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_error: Option<String>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -42,6 +42,9 @@ pub struct Hub {
     pub requests_refused: u64,
     /// The control thread could not serve (its services failed).
     pub control_error: Option<String>,
+    /// The spawned I/O processes' restarts and start-up errors, by I/O
+    /// process index (the session writes them; empty: none spawned).
+    pub spawns: Vec<crate::io_child::SpawnNote>,
 }
 
 impl Hub {
@@ -59,6 +62,7 @@ impl Hub {
             trace: TraceBuf::default(),
             requests_refused: 0,
             control_error: None,
+            spawns: Vec::new(),
         }
     }
 

@@ -10,7 +10,7 @@
 
 use crate::control_thread::{self, ControlSettings, Ready};
 use crate::hub::SharedHub;
-use crate::io_child::IoChild;
+use crate::io_child::{Backoff, IoChild, Seen, SpawnNote};
 use crate::rt_thread::{self, RtOutcome, RtSettings};
 use crate::shared::{Control, Phase, Shared, Snapshot};
 use motion_config::{IoMode, MachineConfig};
@@ -43,6 +43,12 @@ struct Spawned {
     child: Option<IoChild>,
     restart_at: Option<Instant>,
     restarts: u32,
+    /// The delay before the next start (1 s doubling to 30 s).
+    backoff: Backoff,
+    /// Its lines shown already.
+    seen: Seen,
+    /// The error its last failed start ended with.
+    last_error: Option<String>,
 }
 
 pub struct Session {
@@ -210,6 +216,9 @@ impl Session {
                     child: None,
                     restart_at: None,
                     restarts: 0,
+                    backoff: Backoff::default(),
+                    seen: Seen::default(),
+                    last_error: None,
                 });
             }
         }
@@ -231,10 +240,26 @@ impl Session {
             &self.domain.prefix,
             &self.domain.runtime_dir,
             &args,
+            self.spawned[i].seen.clone(),
         )?;
         self.spawned[i].child = Some(child);
         self.spawned[i].restart_at = None;
+        self.note_spawns();
         Ok(())
+    }
+
+    /// The spawned I/O processes' restarts and start-up errors, for the
+    /// status (`io_child::note_spawns`).
+    fn note_spawns(&self) {
+        let mut notes = vec![SpawnNote::default(); self.machine.ios.len()];
+        for sp in &self.spawned {
+            notes[sp.io] = SpawnNote {
+                restarts: sp.restarts,
+                retry_at: sp.restart_at,
+                start_error: sp.last_error.clone(),
+            };
+        }
+        self.hub.lock().spawns = notes;
     }
 
     /// Collects what the control thread gathered: the newest snapshot.
@@ -299,23 +324,57 @@ impl Session {
     }
 
     /// Spawned I/O processes that ended since the last call, in words; with
-    /// `respawn`, each is started again a second later (the daemon keeps its
-    /// simulators; the axes of a restarted one are unhomed, as on real buses).
+    /// `respawn`, each is started again after its back-off (1 s, doubling to
+    /// 30 s while it keeps failing at start-up: see `io_child`; the daemon
+    /// keeps its simulators; the axes of a restarted one are unhomed, as on
+    /// real buses). A failure like the one before is said in a line of its
+    /// own, not repeated in full.
     pub fn poll_children(&mut self, respawn: bool) -> Vec<String> {
         let mut events = Vec::new();
+        let mut changed = false;
         for i in 0..self.spawned.len() {
             let sp = &mut self.spawned[i];
             if let Some(c) = sp.child.as_mut() {
                 if let Some(status) = c.exited() {
-                    events.push(format!(
-                        "I/O process {} (motion-io pid {}) ended: {status}",
-                        c.name,
-                        c.pid()
-                    ));
-                    sp.child = None;
-                    if respawn {
-                        sp.restart_at = Some(Instant::now() + Duration::from_secs(1));
+                    let error = c.start_error();
+                    let again = error.is_some() && error == sp.last_error;
+                    let delay = sp.backoff.ended(c.ran());
+                    if c.ran() >= Backoff::STABLE {
+                        // it did run: its lines are news again
+                        if let Ok(mut s) = sp.seen.lock() {
+                            s.clear();
+                        }
                     }
+                    let mut e = if again {
+                        format!(
+                            "I/O process {} (motion-io pid {}) failed at start-up again, as \
+                             before ({status})",
+                            c.name,
+                            c.pid()
+                        )
+                    } else {
+                        format!(
+                            "I/O process {} (motion-io pid {}) ended: {status}{}",
+                            c.name,
+                            c.pid(),
+                            error
+                                .as_deref()
+                                .and_then(|e| e.lines().next())
+                                .map_or(String::new(), |e| format!(" ({e})"))
+                        )
+                    };
+                    if respawn {
+                        e.push_str(&format!(
+                            "; starting it again in {} s (restart {})",
+                            delay.as_secs(),
+                            sp.restarts + 1
+                        ));
+                        sp.restart_at = Some(Instant::now() + delay);
+                    }
+                    events.push(e);
+                    sp.last_error = error;
+                    sp.child = None;
+                    changed = true;
                 }
             } else if sp.restart_at.is_some_and(|t| Instant::now() >= t) {
                 sp.restarts += 1;
@@ -323,11 +382,18 @@ impl Session {
                 match self.spawn_io(i) {
                     Ok(()) => log::info!("I/O process {name} restarted"),
                     Err(e) => {
-                        log::error!("{e}");
-                        self.spawned[i].restart_at = Some(Instant::now() + Duration::from_secs(5));
+                        let sp = &mut self.spawned[i];
+                        let delay = sp.backoff.ended(Duration::ZERO);
+                        log::error!("{e}; trying again in {} s", delay.as_secs());
+                        sp.last_error = Some(e);
+                        sp.restart_at = Some(Instant::now() + delay);
                     }
                 }
+                changed = true;
             }
+        }
+        if changed {
+            self.note_spawns();
         }
         events
     }

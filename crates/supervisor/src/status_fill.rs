@@ -36,7 +36,8 @@ pub fn fill(
             (s.pc, ST_PC),
             (s.homing, ST_HOMING),
             (s.homed, ST_HOMED),
-            (a.enabled, ST_ENABLED),
+            // a lost drive is not "enabled", whatever it last said
+            (a.enabled && !s.drive_lost, ST_ENABLED),
             (a.fault, ST_FAULT),
             (a.switch, ST_SWITCH),
             (a.marker, ST_MARKER),
@@ -65,6 +66,7 @@ pub fn fill(
             })
             | (if a.in_sequence { SX_IN_SEQUENCE } else { 0 })
             | (if a.restored { SX_RESTORED } else { 0 })
+            | (if s.drive_lost { SX_DRIVE_LOST } else { 0 })
             | lost_cause_bits(a.lost_cause);
         let note = notes.get(i).copied().unwrap_or_default();
         e.warnings = note.warnings

@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use motion_homing::AxisConfiguration;
 
-use super::{AxisEthercat, EthercatIo};
+use super::{AxisEthercat, AxisNeeds, EthercatIo};
 use crate::{IoBackend, MachineConfig};
 
 /// SCHED_FIFO priority of the bus thread without `motion-io --priority`.
@@ -19,6 +19,26 @@ pub struct BusAxis {
     /// The axis name (messages).
     pub name: String,
     pub ethercat: AxisEthercat,
+    /// What its configuration needs of the drive (checked at start-up).
+    pub needs: AxisNeeds,
+}
+
+impl BusAxis {
+    /// Axis `name` on the drive at bus position `position`, needing nothing
+    /// but the cyclic position objects (tests, tools).
+    pub fn at(name: &str, position: u16) -> BusAxis {
+        BusAxis {
+            name: name.to_string(),
+            ethercat: AxisEthercat {
+                drive: super::EthercatDrive::Position(position),
+                index_pulse_bit: None,
+                home_switch_bit: None,
+                brake_delay_ms: 0,
+                drive_homing_method: None,
+            },
+            needs: AxisNeeds::default(),
+        }
+    }
 }
 
 /// Everything the EtherCAT backend needs. Built from a parsed (so checked)
@@ -95,6 +115,7 @@ impl EthercatBus {
                     axes.push(BusAxis {
                         name: a.name.clone(),
                         ethercat: e.clone(),
+                        needs: AxisNeeds::of(&a.engine, e),
                     });
                 }
                 None if a.engine.configuration == AxisConfiguration::Virtual => map.push(None),

@@ -13,12 +13,18 @@
 //!
 //! * `parse` — reading and checking the keys;
 //! * `bus` — [`EthercatBus`] for one I/O process (`motion-io --backend
-//!   ethercat`), with `--interface` and the bus thread's CPU and priority.
+//!   ethercat`), with `--interface` and the bus thread's CPU and priority;
+//! * `needs` — what each axis's configuration needs of its drive
+//!   ([`AxisNeeds`]), which the backend checks at start-up;
+//! * `homing` — the CiA 402 homing method of a sequence the drive homes.
 
 mod bus;
+pub mod homing;
+mod needs;
 pub(crate) mod parse;
 
 pub use bus::{BusAxis, EthercatBus, DEFAULT_BUS_PRIORITY};
+pub use needs::{AxisNeeds, DriveHomingPlan};
 
 /// Distributed clocks of an EtherCAT I/O process (`[[io]] dc`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -62,6 +68,10 @@ pub struct EthercatIo {
     pub mode_in_pdo: bool,
     /// Rounds of the distributed clocks' static drift compensation.
     pub dc_static_sync_iterations: u32,
+    /// The watchdog's and the shutdown's stop: a drive gets quick stop for
+    /// at most this long (less once it is at rest, none if it ignores quick
+    /// stop), then disable voltage (Switch on disabled, power stage off).
+    pub quick_stop_timeout_ms: u32,
 }
 
 impl Default for EthercatIo {
@@ -74,6 +84,7 @@ impl Default for EthercatIo {
             startup_timeout_s: 30,
             mode_in_pdo: false,
             dc_static_sync_iterations: 1000,
+            quick_stop_timeout_ms: 500,
         }
     }
 }
@@ -94,4 +105,19 @@ pub struct AxisEthercat {
     /// `ethercat_index_pulse_bit`: manufacturer bit (16..=31) of 0x60FD
     /// that reports an index pulse per cycle (`marker_latch = false` axes).
     pub index_pulse_bit: Option<u8>,
+    /// `ethercat_home_switch_bit`: manufacturer bit (16..=31) of 0x60FD
+    /// wired to the home switch, instead of bit 2.
+    pub home_switch_bit: Option<u8>,
+    /// `ethercat_brake_delay_ms`: the axis has a holding brake the drive
+    /// controls (a vertical axis); every stop ends with disable operation,
+    /// this long with the power stage on while the brake closes, then
+    /// disable voltage. 0: no brake.
+    pub brake_delay_ms: u32,
+    /// `drive_homing` / `drive_homing_method`: the drive homes the axis
+    /// itself (CiA 402 mode 6) with this method — the given one, else the
+    /// standard method of the sequence ([`homing::standard_method`]).
+    pub drive_homing_method: Option<i8>,
 }
+
+#[cfg(test)]
+mod tests;

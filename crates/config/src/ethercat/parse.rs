@@ -19,13 +19,18 @@ const IO_KEYS: &[&str] = &[
     "startup_timeout_s",
     "mode_in_pdo",
     "dc_static_sync_iterations",
+    "quick_stop_timeout_ms",
 ];
 
 /// The `[[axis]]` keys that only an axis of an EtherCAT I/O process has.
-const AXIS_KEYS: [&str; 3] = [
+const AXIS_KEYS: [&str; 7] = [
     "ethercat_position",
     "ethercat_name",
     "ethercat_index_pulse_bit",
+    "ethercat_home_switch_bit",
+    "ethercat_brake_delay_ms",
+    "drive_homing",
+    "drive_homing_method",
 ];
 
 const DC_MODES: &[(&str, EthercatDc)] = &[
@@ -128,6 +133,12 @@ fn ethercat_io(r: &mut Reader<'_>, label: &str, sup: &SupervisorConfig) -> Ether
         DC_STATIC_SYNC_ITERATIONS.0,
         DC_STATIC_SYNC_ITERATIONS.1,
     );
+    let quick_stop_timeout_ms = r.u32_in(
+        "quick_stop_timeout_ms",
+        d.quick_stop_timeout_ms,
+        QUICK_STOP_TIMEOUT_MS.0,
+        QUICK_STOP_TIMEOUT_MS.1,
+    );
     if sup.cycle_us < ETHERCAT_MIN_CYCLE_US {
         r.problem(
             "backend",
@@ -146,14 +157,17 @@ fn ethercat_io(r: &mut Reader<'_>, label: &str, sup: &SupervisorConfig) -> Ether
         startup_timeout_s,
         mode_in_pdo,
         dc_static_sync_iterations,
+        quick_stop_timeout_ms,
     }
 }
 
 /// The axis' EtherCAT keys: allowed on (and, but for a virtual axis,
-/// required by) an axis of an EtherCAT I/O process only.
+/// required by) an axis of an EtherCAT I/O process only. `drive_homing`
+/// marks the engine's configuration (`engine.drive_homing`): its plan is
+/// then the drive's homing.
 pub(crate) fn axis_keys(
     r: &mut Reader<'_>,
-    engine: &AxisConfig,
+    engine: &mut AxisConfig,
     io: Option<&IoConfig>,
 ) -> Option<AxisEthercat> {
     let given: Vec<&str> = AXIS_KEYS.iter().copied().filter(|k| r.has(k)).collect();
@@ -180,6 +194,45 @@ pub(crate) fn axis_keys(
         }
         return None;
     }
+    let drive = drive_key(r, io_name);
+    let bit = |r: &mut Reader<'_>, key: &str| {
+        r.has(key)
+            .then(|| r.u32_in(key, INDEX_PULSE_BIT.0, INDEX_PULSE_BIT.0, INDEX_PULSE_BIT.1) as u8)
+    };
+    let index_pulse_bit = bit(r, "ethercat_index_pulse_bit");
+    let home_switch_bit = bit(r, "ethercat_home_switch_bit");
+    let brake_delay_ms = r.u32_in(
+        "ethercat_brake_delay_ms",
+        0,
+        BRAKE_DELAY_MS.0,
+        BRAKE_DELAY_MS.1,
+    );
+    let drive_homing_method = drive_homing(r, engine);
+    engine.drive_homing = drive_homing_method.is_some();
+    if engine.home_sequence.uses_marker()
+        && !engine.marker_latch
+        && !engine.drive_homing
+        && index_pulse_bit.is_none()
+    {
+        r.problem(
+            "ethercat_index_pulse_bit",
+            "missing: a marker sequence with marker_latch = false sees the index pulse in a \
+             manufacturer bit of 0x60FD: name it (16..=31), or latch the marker \
+             (marker_latch = true, touch probe 0x60B8)"
+                .into(),
+        );
+    }
+    Some(AxisEthercat {
+        drive,
+        index_pulse_bit,
+        home_switch_bit,
+        brake_delay_ms,
+        drive_homing_method,
+    })
+}
+
+/// `ethercat_position` or `ethercat_name`: exactly one of them.
+fn drive_key(r: &mut Reader<'_>, io_name: &str) -> EthercatDrive {
     let position = r.has("ethercat_position").then(|| {
         r.u32_in(
             "ethercat_position",
@@ -195,15 +248,7 @@ pub(crate) fn axis_keys(
         }
         n
     });
-    let index_pulse_bit = r.has("ethercat_index_pulse_bit").then(|| {
-        r.u32_in(
-            "ethercat_index_pulse_bit",
-            INDEX_PULSE_BIT.0,
-            INDEX_PULSE_BIT.0,
-            INDEX_PULSE_BIT.1,
-        ) as u8
-    });
-    let drive = match (position, name) {
+    match (position, name) {
         (Some(p), None) => EthercatDrive::Position(p),
         (None, Some(n)) => EthercatDrive::Name(n),
         (Some(p), Some(_)) => {
@@ -223,11 +268,68 @@ pub(crate) fn axis_keys(
             );
             EthercatDrive::Position(0)
         }
-    };
-    Some(AxisEthercat {
-        drive,
-        index_pulse_bit,
-    })
+    }
+}
+
+/// `drive_homing` / `drive_homing_method`: the method the drive homes the
+/// axis with, if it does (a method given means `drive_homing = true`).
+fn drive_homing(r: &mut Reader<'_>, engine: &AxisConfig) -> Option<i8> {
+    let method = r.has("drive_homing_method").then(|| {
+        let m = r.i32("drive_homing_method", 0);
+        if m == 0 || !(DRIVE_HOMING_METHOD.0..=DRIVE_HOMING_METHOD.1).contains(&m) {
+            r.problem(
+                "drive_homing_method",
+                format!("{m}: a CiA 402 homing method is -128..=127 and not 0"),
+            );
+        }
+        m.clamp(-128, 127) as i8
+    });
+    let on = r.bool("drive_homing", method.is_some());
+    if !on {
+        if method.is_some() {
+            r.problem(
+                "drive_homing_method",
+                "drive_homing = false: the drive does not home this axis, its method is unused"
+                    .into(),
+            );
+        }
+        return None;
+    }
+    let seq = engine.home_sequence;
+    if engine.home_mode != motion_homing::HomeMode::Active
+        || seq == motion_homing::HomeSequence::Immediate
+    {
+        r.problem(
+            "drive_homing",
+            format!(
+                "the drive homes actively; home_mode = {:?} with home_sequence = {:?} leaves it \
+                 nothing to do",
+                engine.home_mode.name(),
+                seq.name()
+            ),
+        );
+        return None;
+    }
+    match method.or_else(|| super::homing::standard_method(seq, engine.home_direction)) {
+        Some(m) => Some(m),
+        None => {
+            r.problem(
+                "drive_homing_method",
+                format!(
+                    "missing: no standard CiA 402 homing method does home_sequence = {:?} \
+                     {:?}{}: set the drive's method (see its 0x60E3 or motion-io scan)",
+                    seq.name(),
+                    engine.home_direction.name(),
+                    if seq.uses_torque() {
+                        " (hard-stop methods are the manufacturer's, negative on most drives)"
+                    } else {
+                        ""
+                    }
+                ),
+            );
+            None
+        }
+    }
 }
 
 /// Across the axes of each EtherCAT I/O process: one drive per axis, and

@@ -91,6 +91,9 @@ impl Drive {
                     self.state = ReadyToSwitchOn;
                 } else if disable_voltage {
                     self.state = SwitchOnDisabled;
+                } else if quick_stop && self.cfg.ignores_quick_stop {
+                    // this drive does not implement quick stop: it goes on
+                    // holding its set-point
                 } else if quick_stop {
                     let fb = self.plant.feedback();
                     self.ramp = Some(Ramp {

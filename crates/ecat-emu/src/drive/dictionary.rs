@@ -4,7 +4,7 @@
 //! backend needs (the touch-probe and per-direction torque-limit objects
 //! only where the [`DriveConfig`] says the drive has them).
 
-use super::config::{DriveConfig, TorqueObjects};
+use super::config::{DriveConfig, PdoProfile, TorqueObjects};
 use crate::od::{Access, Mappable, Od};
 
 /// PDO mapping objects' capacity (sub-indices).
@@ -37,17 +37,7 @@ pub(super) fn build(cfg: &DriveConfig) -> Od {
             (32, Ro, No, u64::from(cfg.serial)),
         ],
     );
-    // default mapping: controlword + target / statusword + position
-    let mut rx = vec![(32, Rw, No, 0u64); MAP_SUBS];
-    rx[0].3 = 0x6040_0010;
-    rx[1].3 = 0x607A_0020;
-    od.record(0x1600, "RxPDO mapping", Rw, &rx);
-    od.put(0x1600, 0, 2);
-    let mut tx = vec![(32, Rw, No, 0u64); MAP_SUBS];
-    tx[0].3 = 0x6041_0010;
-    tx[1].3 = 0x6064_0020;
-    od.record(0x1A00, "TxPDO mapping", Rw, &tx);
-    od.put(0x1A00, 0, 2);
+    pdo_objects(&mut od, &cfg.pdo);
     od.record(
         0x1C00,
         "sync manager communication type",
@@ -59,8 +49,6 @@ pub(super) fn build(cfg: &DriveConfig) -> Od {
             (8, Ro, No, 4),
         ],
     );
-    od.record(0x1C12, "RxPDO assign", Rw, &[(16, Rw, No, 0x1600)]);
-    od.record(0x1C13, "TxPDO assign", Rw, &[(16, Rw, No, 0x1A00)]);
     let modes = if cfg.dc { 0x0007 } else { 0x0003 };
     for index in [0x1C32, 0x1C33] {
         od.record(
@@ -110,7 +98,96 @@ pub(super) fn build(cfg: &DriveConfig) -> Od {
         od.var(0x60E0, "positive torque limit value", 16, Rw, Rx, 3000);
         od.var(0x60E1, "negative torque limit value", 16, Rw, Rx, 3000);
     }
-    od.var(0x60FD, "digital inputs", 32, Ro, Tx, 0);
-    od.var(0x6502, "supported drive modes", 32, Ro, No, 0x80);
+    if cfg.digital_inputs {
+        od.var(0x60FD, "digital inputs", 32, Ro, Tx, 0);
+    }
+    homing_objects(&mut od, &cfg.homing_methods);
+    for &index in &cfg.without {
+        od.remove(index);
+    }
     od
+}
+
+/// The mapping and assignment objects of the drive's PDO profile.
+fn pdo_objects(od: &mut Od, profile: &PdoProfile) {
+    use Access::*;
+    use Mappable::*;
+    let fixed = |od: &mut Od, index: u16, name: &'static str, entries: &[u32]| {
+        let subs: Vec<(u16, Access, Mappable, u64)> = entries
+            .iter()
+            .map(|&m| (32, Ro, No, u64::from(m)))
+            .collect();
+        od.record(index, name, Ro, &subs);
+    };
+    match profile {
+        PdoProfile::Writable => {
+            // default mapping: controlword + target / statusword + position
+            let mut rx = vec![(32, Rw, No, 0u64); MAP_SUBS];
+            rx[0].3 = 0x6040_0010;
+            rx[1].3 = 0x607A_0020;
+            od.record(0x1600, "RxPDO mapping", Rw, &rx);
+            od.put(0x1600, 0, 2);
+            let mut tx = vec![(32, Rw, No, 0u64); MAP_SUBS];
+            tx[0].3 = 0x6041_0010;
+            tx[1].3 = 0x6064_0020;
+            od.record(0x1A00, "TxPDO mapping", Rw, &tx);
+            od.put(0x1A00, 0, 2);
+            od.record(0x1C12, "RxPDO assign", Rw, &[(16, Rw, No, 0x1600)]);
+            od.record(0x1C13, "TxPDO assign", Rw, &[(16, Rw, No, 0x1A00)]);
+        }
+        PdoProfile::Fixed { rx, tx } => {
+            fixed(od, 0x1600, "RxPDO mapping", rx);
+            fixed(od, 0x1A00, "TxPDO mapping", tx);
+            od.record(0x1C12, "RxPDO assign", Ro, &[(16, Ro, No, 0x1600)]);
+            od.record(0x1C13, "TxPDO assign", Ro, &[(16, Ro, No, 0x1A00)]);
+        }
+        PdoProfile::Predefined(list) => {
+            for (index, entries) in list {
+                let name = if *index < 0x1A00 {
+                    "RxPDO mapping"
+                } else {
+                    "TxPDO mapping"
+                };
+                fixed(od, *index, name, entries);
+            }
+            let first = |rx: bool| {
+                list.iter()
+                    .map(|(i, _)| *i)
+                    .find(|i| (*i < 0x1A00) == rx)
+                    .unwrap_or(0)
+            };
+            // room for two assigned PDOs
+            let assign = |i: u16| [(16, Rw, No, u64::from(i)), (16, Rw, No, 0)];
+            od.record(0x1C12, "RxPDO assign", Rw, &assign(first(true)));
+            od.put(0x1C12, 0, 1);
+            od.record(0x1C13, "TxPDO assign", Rw, &assign(first(false)));
+            od.put(0x1C13, 0, 1);
+        }
+    }
+}
+
+/// Homing mode's objects where the drive has homing methods; 0x6502 says
+/// which modes it supports (bit 7 CSP, bit 5 homing).
+fn homing_objects(od: &mut Od, methods: &[i8]) {
+    use Access::*;
+    use Mappable::*;
+    if methods.is_empty() {
+        od.var(0x6502, "supported drive modes", 32, Ro, No, 0x80);
+        return;
+    }
+    od.var(0x6502, "supported drive modes", 32, Ro, No, 0xA0);
+    od.var(0x6098, "homing method", 8, Rw, No, 0);
+    od.record(
+        0x6099,
+        "homing speeds",
+        Ro,
+        &[(32, Rw, No, 1000), (32, Rw, No, 100)],
+    );
+    od.var(0x609A, "homing acceleration", 32, Rw, No, 100_000);
+    od.var(0x607C, "home offset", 32, Rw, No, 0);
+    let list: Vec<(u16, Access, Mappable, u64)> = methods
+        .iter()
+        .map(|&m| (8, Ro, No, u64::from(m as u8)))
+        .collect();
+    od.record(0x60E3, "supported homing methods", Ro, &list);
 }

@@ -13,14 +13,18 @@ impl Drive {
         let fb = self.plant.feedback();
         let cpu = self.cfg.counts_per_unit;
         let mut sw = self.state.bits() | 0x0200;
-        if self.state == State::OperationEnabled {
+        if self.mode() == 6 {
+            sw |= self.homing_statusword();
+        } else if self.state == State::OperationEnabled {
+            // CSP: following the target
             sw |= 0x1000;
         }
         if self.od.get(0x603F, 0) as u16 == ERR_FOLLOWING && self.state == State::Fault {
             sw |= 0x2000;
         }
         self.od.put(0x6041, 0, u64::from(sw));
-        self.od.put(0x6064, 0, self.counts(fb.position));
+        self.od
+            .put(0x6064, 0, self.counts(fb.position + self.offset));
         let v = (fb.velocity * cpu)
             .round()
             .clamp(i32::MIN as f64, i32::MAX as f64) as i32;
@@ -28,10 +32,10 @@ impl Drive {
         let t = (fb.torque * 10.0).round().clamp(-32768.0, 32767.0) as i16;
         self.od.put(0x6077, 0, t as u16 as u64);
         let mut di = 0u32;
-        if fb.overtravel_negative {
+        if fb.overtravel_negative && self.cfg.limit_switches {
             di |= 1 << 0;
         }
-        if fb.overtravel_positive {
+        if fb.overtravel_positive && self.cfg.limit_switches {
             di |= 1 << 1;
         }
         if fb.home_switch {

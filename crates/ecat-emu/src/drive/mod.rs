@@ -35,6 +35,7 @@
 pub mod cia402;
 pub mod config;
 pub mod dictionary;
+pub mod homing;
 pub mod inputs;
 pub mod motion;
 pub mod pdo;
@@ -46,7 +47,7 @@ use motion_plant::Plant;
 use crate::od::Od;
 
 pub use cia402::State;
-pub use config::{DriveConfig, TorqueObjects};
+pub use config::{DriveConfig, ModeDisplay, PdoProfile, TorqueObjects, SUPPORTED_METHODS};
 use motion::Ramp;
 use probes::ProbeUnit;
 
@@ -98,6 +99,13 @@ pub struct Drive {
     next_probe_id: u8,
     cycles: u64,
     ticks: u64,
+    /// Homing mode's run, if one was started.
+    homing: Option<homing::HomingRun>,
+    /// Added to the plant's position to make the drive's (units): homing
+    /// redefines it; a power cycle restarts the encoder at its start value.
+    offset: f64,
+    /// The ESC is in SAFE-OP or OP (a late mode display shows only then).
+    operational: bool,
 }
 
 impl Drive {
@@ -117,6 +125,9 @@ impl Drive {
             next_probe_id: 0,
             cycles: 0,
             ticks: 0,
+            homing: None,
+            offset: 0.0,
+            operational: false,
         };
         d.update_inputs();
         d
@@ -158,6 +169,8 @@ impl Drive {
             self.od.put(0x603F, 0, u64::from(code));
         } else if outputs_valid {
             self.transitions(cw);
+            self.show_mode();
+            self.homing_bits(cw);
         }
         self.last_cw = cw;
         self.step_plant(dt, outputs_valid);
@@ -211,7 +224,98 @@ impl Drive {
     pub fn plant(&self) -> &Plant {
         &self.plant
     }
+
+    /// The drive's position (what 0x6064 reports), units: the plant's plus
+    /// the offset homing or a power cycle made.
+    pub fn drive_position(&self) -> f64 {
+        self.plant.feedback().position + self.offset
+    }
+
+    /// The ESC's AL state is (not) SAFE-OP or OP.
+    pub fn set_operational(&mut self, operational: bool) {
+        self.operational = operational;
+        self.show_mode();
+    }
+
+    /// 0x6061 shows 0x6060 if the drive supports that mode (8; 6 with
+    /// homing methods; 0), at once or, with `late_mode_display`, only in
+    /// SAFE-OP / OP.
+    fn show_mode(&mut self) {
+        match self.cfg.mode_display {
+            ModeDisplay::Never => return,
+            ModeDisplay::Late if !self.operational => return,
+            _ => {}
+        }
+        let want = self.od.get(0x6060, 0) as u8 as i8;
+        let ok = match want {
+            0 | 8 => true,
+            6 => !self.cfg.homing_methods.is_empty(),
+            _ => false,
+        };
+        if ok && self.od.get(0x6061, 0) as u8 as i8 != want {
+            if want != 6 {
+                self.homing = None;
+            }
+            self.od.put(0x6061, 0, u64::from(want as u8));
+        }
+    }
+
+    /// The mode in force (0x6061).
+    pub fn mode(&self) -> i8 {
+        self.od.get(0x6061, 0) as u8 as i8
+    }
+
+    /// Homing mode: controlword bit 4's rising edge starts a run (in
+    /// Operation enabled).
+    fn homing_bits(&mut self, cw: u16) {
+        if self.mode() == 6 && self.state == State::OperationEnabled {
+            if cw & 0x0010 != 0 && self.last_cw & 0x0010 == 0 {
+                self.start_homing();
+            }
+        } else {
+            self.homing = None;
+        }
+    }
+
+    /// Homing mode's statusword bits: 12 attained, 10 target reached (at
+    /// rest after a run), 13 error.
+    fn homing_statusword(&self) -> u16 {
+        let Some(r) = &self.homing else { return 0 };
+        let mut sw = 0;
+        if r.attained {
+            sw |= 0x1000;
+        }
+        if r.done {
+            sw |= 0x0400;
+        }
+        if r.error {
+            sw |= 0x2000;
+        }
+        sw
+    }
 }
 
 #[cfg(test)]
 mod tests;
+
+impl Drive {
+    /// This drive after a power cycle: a fresh dictionary and state machine
+    /// over the same plant (at rest where it is, power stage off); the
+    /// encoder reads its start value again.
+    pub fn power_cycled(&self) -> Drive {
+        let mut d = Drive::new(self.cfg.clone());
+        d.plant = self.plant.clone();
+        let here = d.plant.feedback().position;
+        // power stage off: a zero-length step without enable
+        d.plant.step(
+            &motion_homing::Command {
+                position: here,
+                ..motion_homing::Command::default()
+            },
+            0.0,
+        );
+        d.offset = self.cfg.plant.start - here;
+        d.update_inputs();
+        d
+    }
+}

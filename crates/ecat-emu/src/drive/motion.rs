@@ -105,7 +105,7 @@ impl Drive {
             velocity_error_tolerance: 0.0,
             marker_arm,
             switch_arm,
-            fault_reset: false,
+            ..Command::default()
         };
         if let Some(mut r) = self.ramp {
             let dec = (self.od.get(0x6085, 0) as f64 / cpu).max(1e-9);
@@ -135,18 +135,26 @@ impl Drive {
             } else {
                 self.ramp = Some(r);
             }
-        } else if self.state == State::OperationEnabled && outputs_valid {
+        } else if self.state == State::OperationEnabled && outputs_valid && self.mode() == 6 {
+            // homing mode: the run's own profile (holding where it stands
+            // before one starts); halt (bit 8) or bit 4 low bring it to rest
+            let cw = self.od.get(0x6040, 0) as u16;
+            let halt = cw & 0x0100 != 0 || cw & 0x0010 == 0;
+            cmd.enable = true;
+            self.homing_command(dt, halt, &mut cmd);
+        } else if self.state == State::OperationEnabled && outputs_valid && self.mode() == 8 {
             let target = self.od.get_signed(0x607A, 0) as i32;
-            // 32-bit target: extended around the current position
-            let here = (fb.position * cpu).round();
+            // 32-bit target (the drive's counts): extended around the
+            // current position
+            let here = ((fb.position + self.offset) * cpu).round();
             let here32 = here as i64 as i32;
             let counts = here + f64::from(target.wrapping_sub(here32));
             cmd.enable = true;
-            cmd.position = counts / cpu;
+            cmd.position = counts / cpu - self.offset;
             cmd.position_error_tolerance = tolerance;
         } else if self.state == State::OperationEnabled {
             // SAFE-OP with the drive enabled cannot happen (outputs_lost);
-            // hold the position
+            // no mode in force: hold the position
             cmd.enable = true;
         } else if self.enabling {
             cmd.enable = true;

@@ -61,10 +61,12 @@ impl Drive {
             if l.id != 0 && l.id == self.probes[0].id && l.latched {
                 if f & 0x0010 != 0 {
                     st |= 0x0002;
-                    self.od.put(0x60BA, 0, self.counts(l.position));
+                    self.od
+                        .put(0x60BA, 0, self.counts(l.position + self.offset));
                 } else {
                     st |= 0x0004;
-                    self.od.put(0x60BB, 0, self.counts(l.position));
+                    self.od
+                        .put(0x60BB, 0, self.counts(l.position + self.offset));
                 }
             }
         }
@@ -74,10 +76,12 @@ impl Drive {
             if l.id != 0 && l.id == self.probes[1].id && l.latched {
                 if f & 0x1000 != 0 {
                     st |= 0x0200;
-                    self.od.put(0x60BC, 0, self.counts(l.position));
+                    self.od
+                        .put(0x60BC, 0, self.counts(l.position + self.offset));
                 } else {
                     st |= 0x0400;
-                    self.od.put(0x60BD, 0, self.counts(l.position));
+                    self.od
+                        .put(0x60BD, 0, self.counts(l.position + self.offset));
                 }
             }
         }

@@ -27,8 +27,18 @@ impl Drive {
             0x1C12 | 0x1C13 if !preop => return Err(abort::STATE),
             0x1600..=0x17FF | 0x1A00..=0x1BFF => self.check_mapping_write(index, sub, value)?,
             0x1C12 | 0x1C13 => self.check_assign_write(index, sub, value)?,
-            // cyclic synchronous position only (0 = no mode)
-            0x6060 if value as u8 as i8 != 8 && value != 0 => return Err(abort::VALUE_RANGE),
+            // cyclic synchronous position, homing where it has methods
+            // (0 = no mode)
+            0x6060 => {
+                let m = value as u8 as i8;
+                let homing = m == 6 && !self.cfg.homing_methods.is_empty();
+                if m != 8 && m != 0 && !homing {
+                    return Err(abort::VALUE_RANGE);
+                }
+            }
+            0x6098 if !self.cfg.homing_methods.contains(&(value as u8 as i8)) => {
+                return Err(abort::VALUE_RANGE)
+            }
             0x1C32 | 0x1C33 if sub == 1 => {
                 let ok = match value {
                     0 | 1 => true,
@@ -43,7 +53,7 @@ impl Drive {
         }
         self.od.set_bytes(index, sub, data);
         if index == 0x6060 {
-            self.od.put(0x6061, 0, value);
+            self.show_mode();
         }
         Ok(())
     }

@@ -134,7 +134,13 @@ impl Axis {
             // Edges across a gap of unknown length mean nothing.
             self.prev = None;
             self.last = None;
-            self.feedback_trouble(now, EX_FEEDBACK_LOST);
+            // a lost drive is named as such, not as its I/O process
+            let exerr = if self.status.drive_lost {
+                EX_DRIVE_LOST
+            } else {
+                EX_FEEDBACK_LOST
+            };
+            self.feedback_trouble(now, exerr);
         }
     }
 

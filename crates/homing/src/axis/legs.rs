@@ -28,7 +28,9 @@ impl Axis {
             if self.cfg.home_sequence.uses_torque() {
                 self.overrides = true;
             }
-            if self.cfg.home_sequence.uses_switch() && s.switch_active {
+            // (the drive's own homing starts with its leg, whatever the switch)
+            let by_us = !self.cfg.drive_homing;
+            if by_us && self.cfg.home_sequence.uses_switch() && s.switch_active {
                 if self.cfg.home_direction.is_unidirectional() {
                     // Establish the event where we stand, then go on if the
                     // unidirectional constraint allows.
@@ -122,6 +124,7 @@ impl Axis {
                 Run::Search(search)
             }
             Leg::Watch(goal) => Run::Search(self.begin_search(goal, s.fb.position)),
+            Leg::DriveHomes => self.start_drive_homing(now, s),
             Leg::Stop | Leg::StopAtLimit => {
                 self.profile
                     .set(Profile::stop(now, p, v, self.cfg.home_deceleration));

@@ -39,6 +39,7 @@
 
 mod at_limit;
 mod detect;
+pub mod drive_homing;
 mod followed;
 mod intake;
 mod latches;
@@ -255,6 +256,7 @@ impl Axis {
     }
 
     pub fn step(&mut self, now_ns: u64, feedback: Option<&Feedback>, request: &Request) -> Command {
+        self.drive_presence(request.drive_lost);
         let fresh = self.intake(now_ns, feedback, request.stalled);
         self.requests(now_ns, request);
         // A fresh sample is the newest one (requests never drop it).
@@ -292,7 +294,7 @@ impl Axis {
             (Run::Search(search), _) => {
                 self.status.search_travel = (self.profile.at(now).0 - search.start).abs();
             }
-            (Run::Profile { .. }, _) => {}
+            (Run::Profile { .. } | Run::Drive(_), _) => {}
         }
     }
 
@@ -410,6 +412,7 @@ impl Axis {
         self.watch_drive(now, s);
         let moving = self.state.commands_motion();
         let stopping = matches!(self.state, State::Stopping { .. } | State::Motion(_));
+        self.follow_the_drive(now, s);
         if !moving && !stopping && !s.fb.drive.enabled {
             // Nobody holds the axis: follow it, so enabling never jumps.
             self.profile.set(Profile::hold(now, s.fb.position));
@@ -475,6 +478,7 @@ impl Axis {
                 Run::Profile { .. } => {}
                 Run::Waiting { .. } if !self.request.hold => self.start_leg(now, s),
                 Run::Waiting { .. } => {}
+                Run::Drive(d) => self.drive_homing_step(now, s, d),
             },
             &State::Stopping { released } if done => {
                 if self.overrides && !released {
@@ -633,6 +637,7 @@ impl Axis {
                 edge: self.latches.switch_edge,
             },
             fault_reset: self.fault_reset_out(),
+            drive_home: self.drive_home_requested(),
         };
         self.last_command = cmd;
         self.plausible.commanded(cmd.position);

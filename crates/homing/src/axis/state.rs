@@ -53,6 +53,8 @@ pub(super) enum Run {
     /// Following the leg's profile to its end. `to_home`: the profile ends at
     /// Home Position (a continue leg that only stops does not).
     Profile { to_home: bool },
+    /// The drive homes the axis itself (`Leg::DriveHomes`).
+    Drive(super::drive_homing::DriveRun),
 }
 
 impl Homing {

@@ -45,7 +45,7 @@ pub fn run(a: &RunArgs) -> i32 {
             break;
         }
         for e in session.poll_children(true) {
-            log::warn!("{e}; starting it again in 1 s");
+            log::warn!("{e}");
         }
         if let Some(e) = session.check_alive() {
             log::error!("{e}");

@@ -194,6 +194,7 @@ impl ControlThread {
         if let Err(e) = server.publish_status(|f| {
             status_fill::fill(&self.s.machine, snap, notes, uptime, f);
             status_fill::owners(snap, |t| owners.name_of(t), f);
+            crate::io_child::note_spawns(&hub.spawns, f);
         }) {
             log::warn!("status service: {e}");
         }

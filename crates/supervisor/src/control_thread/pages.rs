@@ -30,6 +30,7 @@ impl ControlThread {
                 let notes = self.keeper.notes();
                 status_fill::fill(&self.s.machine, s, notes, uptime, &mut frame);
                 status_fill::owners(s, |t| self.owners.name_of(t), &mut frame);
+                crate::io_child::note_spawns(&hub.spawns, &mut frame);
             }
         }
         let json = serde_json::to_vec(&frame.to_report()).unwrap_or_default();

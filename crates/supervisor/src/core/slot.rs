@@ -9,7 +9,7 @@
 //! per axis — the jog's token, the operation id before a request — is
 //! here too, and their rules are in `ops.rs`.
 
-use motion_frames::{axis_to_feedback, AxisFeedback, SW_NO_DATA};
+use motion_frames::{axis_to_feedback, AxisFeedback, SW_DRIVE_LOST, SW_NO_DATA};
 use motion_homing::{Axis, Command, Feedback, Phase, Request, Status};
 
 use super::link::LinkCycle;
@@ -216,6 +216,11 @@ impl AxisSlot {
         };
         if c.reconnected {
             self.engine.reconnected(now_ns);
+        }
+        // the I/O process says the axis's drive is gone (it is alive)
+        if c.fresh {
+            self.rung.request.drive_lost =
+                entry.is_some_and(|a| a.status_word & SW_DRIVE_LOST != 0);
         }
         self.feedback = match entry {
             Some(a) if c.fresh && a.status_word & SW_NO_DATA == 0 => {
