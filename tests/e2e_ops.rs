@@ -447,6 +447,15 @@ fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
             })
             .unwrap();
         }
+        // released only once the cycle has judged the three frames: a
+        // release that reaches the cycle first would leave them unowned
+        let refused = |a: &motion_report::StreamIntake| {
+            a.refused_key + a.refused_sequence + a.refused_axis + a.refused_token
+        };
+        let judged = wait_for(Duration::from_secs(5), || {
+            refused(&d.status().stream) >= refused(&before) + 3
+        });
+        assert!(judged, "{:?}", d.status().stream);
         s.release().expect("released");
     }
     let after = d.status().stream;

@@ -35,7 +35,8 @@ fn long_jog(speed: f64) -> Operation {
 
 #[test]
 fn a_jog_into_a_limit_switch_stops_at_max_deceleration_as_a_fault() {
-    // Unhomed (no soft limits), jog +20. The first command beyond 12 is
+    // Unhomed (no soft limits), jog +20. The first command at or beyond 12
+    // (a limit switch is actuated at its end, `[axis.sim] limit_switches`) is
     // applied by the plant; the next frame shows the switch; in that step
     // the stop begins from the command state there (20 u/s) at
     // max_deceleration 2000: 20² / (2·2000) = 0.1 further, not the jog's
@@ -51,7 +52,7 @@ fn a_jog_into_a_limit_switch_stops_at_max_deceleration_as_a_fault() {
     assert_eq!(s.last_stop, StopCause::LimitSwitch);
     assert_eq!((s.op.id, s.op.ip, s.op.pc), (id, false, false));
     let n = r.cmds.len();
-    let first_beyond = r.cmds.iter().position(|c| c.position > 12.0).unwrap();
+    let first_beyond = r.cmds.iter().position(|c| c.position >= 12.0).unwrap();
     assert_eq!(first_beyond, n - 2, "seen one frame later");
     let at = r.cmds[n - 1].position;
     assert!(r.run_until(100, |s| !s.stopping));

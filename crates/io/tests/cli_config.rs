@@ -78,7 +78,7 @@ fn command_line_mistakes_exit_2_with_usage() {
         (&["--cpu"][..], "a value is required for '--cpu <N>'"),
         (&["--priority", "0"][..], "1..=99"),
         (&["--frobnicate"][..], "unexpected argument '--frobnicate'"),
-        (&["stray"][..], "unexpected argument 'stray'"),
+        (&["stray"][..], "unrecognized subcommand 'stray'"),
         (&["--service-prefix", "../../tmp/x"][..], "service prefix"),
     ] {
         let mut io = spawn_io(args);

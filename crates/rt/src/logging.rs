@@ -6,8 +6,68 @@
 //! with its syslog priority (`<3>` error, `<4>` warning, `<6>` info, `<7>`
 //! debug, see sd-daemon(3)) and carries no time stamp — the journal adds
 //! both. On a terminal a line reads `motion-supervisor: warning: …`.
+//!
+//! A `motion-io` the supervisor spawns writes its stderr into a pipe the
+//! supervisor reads (each line shown once). When the supervisor dies that
+//! pipe has no reader, and the lines that matter most — the watchdog
+//! stopping every axis — would be lost: the supervisor hands the child its
+//! own stderr as a second descriptor ([`FALLBACK_FD_ENV`]), and the logger
+//! writes there once the pipe is broken.
 
-use std::io::Write;
+use std::fs::File;
+use std::io::{self, Write};
+use std::os::fd::FromRawFd;
+
+/// Environment variable naming an inherited descriptor the logger writes to
+/// once stderr is a broken pipe (set by the supervisor for its children).
+pub const FALLBACK_FD_ENV: &str = "MOTION_STDERR_FALLBACK_FD";
+
+/// stderr, then the fallback descriptor once stderr's reader is gone.
+struct Stderr {
+    fallback: Option<File>,
+    broken: bool,
+}
+
+impl Stderr {
+    fn from_env() -> Self {
+        let fd = std::env::var(FALLBACK_FD_ENV)
+            .ok()
+            .and_then(|v| v.parse::<i32>().ok())
+            .filter(|&fd| fd > 2);
+        // SAFETY: F_GETFD only asks whether the descriptor is open; the
+        // descriptor was inherited for this purpose alone and is owned by
+        // the `File` from here on.
+        let fallback = fd
+            .filter(|&fd| unsafe { libc::fcntl(fd, libc::F_GETFD) } >= 0)
+            .map(|fd| unsafe { File::from_raw_fd(fd) });
+        Stderr {
+            fallback,
+            broken: false,
+        }
+    }
+}
+
+impl Write for Stderr {
+    fn write(&mut self, b: &[u8]) -> io::Result<usize> {
+        if !self.broken {
+            match io::stderr().write(b) {
+                Err(e) if e.kind() == io::ErrorKind::BrokenPipe => self.broken = true,
+                other => return other,
+            }
+        }
+        match &mut self.fallback {
+            Some(f) => f.write(b),
+            None => Ok(b.len()),
+        }
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        match (&mut self.fallback, self.broken) {
+            (Some(f), true) => f.flush(),
+            _ => io::stderr().flush(),
+        }
+    }
+}
 
 /// Installs the logger for `program` (idempotent: a second call is ignored).
 pub fn init(program: &'static str) {
@@ -21,7 +81,7 @@ pub fn init(program: &'static str) {
     if let Ok(spec) = std::env::var("RUST_LOG") {
         b.parse_filters(&spec);
     }
-    b.target(env_logger::Target::Stderr);
+    b.target(env_logger::Target::Pipe(Box::new(Stderr::from_env())));
     b.format(move |buf, r| {
         let (prio, word) = match r.level() {
             log::Level::Error => (3, "error: "),

@@ -9,13 +9,17 @@
 //!   per child): every line is shown once — a process that fails the same
 //!   way again does not print the same lines again (the set is forgotten
 //!   after a run that lasted) — and the error it ended with (`error: …` and
-//!   what follows) is kept for the status ([`IoChild::start_error`]).
+//!   what follows) is kept for the status ([`IoChild::start_error`]). It
+//!   also inherits a copy of our stderr (`motion_rt::logging::FALLBACK_FD_ENV`)
+//!   that its logger writes to once the pipe has no reader: when we are
+//!   killed, its watchdog's "stopping every axis" still reaches the journal.
 //! * **The status.** Per I/O process, the restarts, the time to the next
 //!   start and the last start-up error ([`SpawnNote`]) go into the I/O rows
 //!   of the status frame ([`note_spawns`]).
 
 use std::collections::HashSet;
 use std::io::{BufRead, BufReader};
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::{Arc, Mutex};
@@ -171,8 +175,29 @@ impl IoChild {
         if let Some(c) = config {
             cmd.arg("--config").arg(c);
         }
-        let mut child = cmd
-            .spawn()
+        // Our stderr, for its logger once the pipe has no reader (we died):
+        // a copy above the standard descriptors, inherited by this child only.
+        // SAFETY: F_DUPFD_CLOEXEC duplicates a descriptor we own.
+        let keep = unsafe { libc::fcntl(2, libc::F_DUPFD_CLOEXEC, 10) };
+        if keep >= 0 {
+            cmd.env(motion_rt::logging::FALLBACK_FD_ENV, keep.to_string());
+            // SAFETY: between fork and exec, only fcntl (async-signal-safe):
+            // the copy loses close-on-exec in the child alone.
+            unsafe {
+                cmd.pre_exec(move || {
+                    if libc::fcntl(keep, libc::F_SETFD, 0) < 0 {
+                        return Err(std::io::Error::last_os_error());
+                    }
+                    Ok(())
+                });
+            }
+        }
+        let spawned = cmd.spawn();
+        if keep >= 0 {
+            // SAFETY: our copy, no longer needed once the child has its own.
+            unsafe { libc::close(keep) };
+        }
+        let mut child = spawned
             .map_err(|e| format!("cannot start I/O process {name} ({}): {e}", bin.display()))?;
         let error = Arc::new(Mutex::new(None));
         let reader = child.stderr.take().and_then(|out| {
