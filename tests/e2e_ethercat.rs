@@ -535,11 +535,21 @@ fn sigterm_ends_motion_io_within_the_bound_with_drives_lost() {
     let alive = |pid: i32| nix::sys::signal::kill(nix::unistd::Pid::from_raw(pid), None).is_ok();
     assert!(wait_for(Duration::from_secs(10), || !alive(io)));
     let took = t0.elapsed();
+    // its bus summary counts the losses: S and T at least (more when a
+    // loaded machine made a drive miss frames and come back meanwhile)
     assert!(
-        d.wait_line("2 drive loss(es)", Duration::from_secs(5)),
+        d.wait_line(" drive loss(es)", Duration::from_secs(5)),
         "{}",
         d.stderr()
     );
+    let losses: Option<u32> = d.stderr().lines().find_map(|l| {
+        let before = l
+            .split(" drive loss(es)")
+            .next()
+            .filter(|b| b.len() < l.len())?;
+        before.rsplit(' ').next()?.parse().ok()
+    });
+    assert!(losses.is_some_and(|n| n >= 2), "{losses:?}\n{}", d.stderr());
     eprintln!(
         "SIGTERM with two of three drives lost: motion-io (pid {io}) gone after {:.0} ms",
         took.as_secs_f64() * 1e3
@@ -667,11 +677,12 @@ fn a_drive_lacking_objects_is_refused_with_every_one_named_and_restarted_with_ba
         assert!(out.stderr.contains(want), "no {want:?} in\n{}", out.stderr);
     }
     // the daemon starts it again and again, 1 s, 2 s, 4 s …, saying so
-    // once; its status shows the restarts and the error
+    // once; its status shows the restarts and the error (read while it
+    // waits for the next start: while one runs there is no retry time)
     let mut d = Daemon::spawn(&b.cfg);
     let ok = wait_for(Duration::from_secs(20), || {
         motion_harness::daemon::status(&motion_harness::bins::test_bin("motionctl"), &b.cfg.prefix)
-            .is_some_and(|s| s.io[0].restarts >= 2)
+            .is_some_and(|s| s.io[0].restarts >= 2 && s.io[0].retry_in_s.is_some())
     });
     let st = d.status();
     assert!(ok, "{:#?}\n{}", st.io, d.stderr());

@@ -524,7 +524,12 @@ fn c_domain(prefix: &str) -> motion_ipc::Domain {
 #[test]
 fn a_gantry_jogs_moves_and_streams_as_one_axis_never_a_side_alone() {
     let _serial = serial();
-    let cfg = ops("ops_gantry");
+    // stream_timeout_ms 300 (not 50): motionctl descheduled on a loaded
+    // machine must not read as a silent program (not the subject here)
+    let cfg = Machine::fixture("ops")
+        .set("axis.G1.stream_timeout_ms", 300)
+        .set("axis.G2.stream_timeout_ms", 300)
+        .write("ops_gantry");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "G"]).expect_code(0);
     d.ctl(&["enable", "G"]).expect_code(0);

@@ -301,6 +301,10 @@ fn serve(
             "event wake-up"
         },
     ));
+    // joined: what it says from now on goes to the supervisor's stderr
+    // directly, not through the pipe a spawning supervisor reads (lost if
+    // the supervisor is killed)
+    motion_rt::logging::direct_stderr();
     let outcome = run::run(&mut ports, backend, s, &domain.id);
     drop(ports);
     drop(node);

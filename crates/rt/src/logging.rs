@@ -11,8 +11,10 @@
 //! supervisor reads (each line shown once). When the supervisor dies that
 //! pipe has no reader, and the lines that matter most — the watchdog
 //! stopping every axis — would be lost: the supervisor hands the child its
-//! own stderr as a second descriptor ([`FALLBACK_FD_ENV`]), and the logger
-//! writes there once the pipe is broken.
+//! own stderr as a second descriptor ([`FALLBACK_FD_ENV`]). Once its
+//! start-up is over the child writes there directly ([`direct_stderr`]:
+//! nothing of a running child waits in a pipe buffer its reader may never
+//! empty), and before that the logger writes there once the pipe is broken.
 
 use std::fs::File;
 use std::io::{self, Write};
@@ -21,6 +23,22 @@ use std::os::fd::FromRawFd;
 /// Environment variable naming an inherited descriptor the logger writes to
 /// once stderr is a broken pipe (set by the supervisor for its children).
 pub const FALLBACK_FD_ENV: &str = "MOTION_STDERR_FALLBACK_FD";
+
+/// The inherited descriptor of [`FALLBACK_FD_ENV`] (-1: none).
+static FALLBACK_FD: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(-1);
+
+/// Start-up is over: stderr becomes the parent's own stderr (the copy of
+/// [`FALLBACK_FD_ENV`]), so what the process says from now on — above all
+/// how it stopped its axes when the parent died — reaches the terminal or
+/// the journal without passing through the parent. Without such a copy
+/// nothing changes.
+pub fn direct_stderr() {
+    let fd = FALLBACK_FD.load(std::sync::atomic::Ordering::Relaxed);
+    if fd > 2 {
+        // SAFETY: dup2 of a descriptor we own onto our stderr.
+        unsafe { libc::dup2(fd, 2) };
+    }
+}
 
 /// stderr, then the fallback descriptor once stderr's reader is gone.
 struct Stderr {
@@ -39,7 +57,10 @@ impl Stderr {
         // the `File` from here on.
         let fallback = fd
             .filter(|&fd| unsafe { libc::fcntl(fd, libc::F_GETFD) } >= 0)
-            .map(|fd| unsafe { File::from_raw_fd(fd) });
+            .map(|fd| {
+                FALLBACK_FD.store(fd, std::sync::atomic::Ordering::Relaxed);
+                unsafe { File::from_raw_fd(fd) }
+            });
         Stderr {
             fallback,
             broken: false,

@@ -11,8 +11,9 @@
 //!   after a run that lasted) — and the error it ended with (`error: …` and
 //!   what follows) is kept for the status ([`IoChild::start_error`]). It
 //!   also inherits a copy of our stderr (`motion_rt::logging::FALLBACK_FD_ENV`)
-//!   that its logger writes to once the pipe has no reader: when we are
-//!   killed, its watchdog's "stopping every axis" still reaches the journal.
+//!   and writes there directly once it has joined us
+//!   (`motion_rt::logging::direct_stderr`): when we are killed, its
+//!   watchdog's "stopping every axis" still reaches the journal.
 //! * **The status.** Per I/O process, the restarts, the time to the next
 //!   start and the last start-up error ([`SpawnNote`]) go into the I/O rows
 //!   of the status frame ([`note_spawns`]).
