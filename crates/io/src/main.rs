@@ -72,25 +72,10 @@ fn real_main() -> i32 {
             return 2;
         }
     };
-    let io = match (&opts.io, cfg.ios.len()) {
-        (Some(name), _) => match cfg.io_index(name) {
-            Some(k) => k,
-            None => {
-                let known: Vec<&str> = cfg.ios.iter().map(|i| i.name.as_str()).collect();
-                log::error!(
-                    "--io {name}: the config has no such I/O process (configured: {})",
-                    known.join(", ")
-                );
-                return 2;
-            }
-        },
-        (None, 1) => 0,
-        (None, _) => {
-            let known: Vec<&str> = cfg.ios.iter().map(|i| i.name.as_str()).collect();
-            log::error!(
-                "the config has several I/O processes ({}): say which one with --io NAME",
-                known.join(", ")
-            );
+    let io = match which_io(&cfg, opts.io.as_deref()) {
+        Ok(k) => k,
+        Err(e) => {
+            log::error!("{e}");
             return 2;
         }
     };
@@ -161,6 +146,28 @@ fn real_main() -> i32 {
             say.notice(format_args!("{s}"));
         }
         return code;
+    }
+}
+
+/// The index of the I/O process this process serves: the one `--io`
+/// names, or the config's only one.
+fn which_io(cfg: &motion_config::MachineConfig, name: Option<&str>) -> Result<usize, String> {
+    let known = || {
+        let names: Vec<&str> = cfg.ios.iter().map(|i| i.name.as_str()).collect();
+        names.join(", ")
+    };
+    match (name, cfg.ios.len()) {
+        (Some(name), _) => cfg.io_index(name).ok_or_else(|| {
+            format!(
+                "--io {name}: the config has no such I/O process (configured: {})",
+                known()
+            )
+        }),
+        (None, 1) => Ok(0),
+        (None, _) => Err(format!(
+            "the config has several I/O processes ({}): say which one with --io NAME",
+            known()
+        )),
     }
 }
 

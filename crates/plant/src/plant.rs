@@ -112,7 +112,8 @@ impl Plant {
             self.trip();
         }
 
-        if following {
+        // (a wire-break fault of this step leaves no torque either)
+        if following && self.drive.enabled() {
             let acceleration = if dt > 0.0 {
                 // Second difference as two first differences, each saturated,
                 // so huge commands cannot produce ∞ − ∞.
