@@ -72,16 +72,22 @@ fn a_fixed_mapping_is_used_as_the_drive_has_it() {
     // it moves, and its velocity is derived from the position
     r.enable(0);
     let from = r.fb.axes[0].position;
-    let mut sum = 0.0f64;
+    let mut v = Vec::new();
     for k in 1..=300 {
         r.axis(0).target_position = from + 5 * k;
         r.tick();
         if k > 100 {
-            sum += r.fb.axes[0].velocity;
+            v.push(r.fb.axes[0].velocity);
         }
     }
-    let mean = sum / 200.0;
-    assert!((4500.0..=5500.0).contains(&mean), "5 counts per ms: {mean}");
+    // the median: a cycle the bus thread missed on a loaded host shows a
+    // stale or a doubled step, not the drive's speed
+    v.sort_by(f64::total_cmp);
+    let median = v[v.len() / 2];
+    assert!(
+        (4500.0..=5500.0).contains(&median),
+        "5 counts per ms: {median}"
+    );
     r.settle(0);
 
     // an axis that needs a touch probe is refused, with the mapping named
@@ -327,26 +333,38 @@ fn a_drive_that_ignores_quick_stop_is_switched_off_within_the_bound() {
     assert_ne!(fb.axes[0].status_word & SW_FAULT, 0);
     drop(r);
 
-    // a drive that honours it but would ramp for 4 s: cut at the bound
-    let mut d = drive("EMU-SLOWQS");
-    d.quick_stop_deceleration = 5.0;
-    let Some(r) = start(vec![d], axes_from_toml(&axis("immediate", "")), |c| {
-        c.keys.quick_stop_timeout_ms = 200
-    }) else {
-        return;
-    };
-    let mut r = r.unwrap();
-    r.enable(0);
-    // up to 20 u/s (20 counts per cycle), a count per cycle more each cycle
-    let mut at = r.fb.axes[0].position;
-    for k in 1..=400i64 {
-        at += k.min(20);
-        r.axis(0).target_position = at;
-        r.tick();
+    // a drive that honours it but would ramp for 4 s: cut at the bound. On
+    // a loaded host the bus can lose frames during the ramp and the drive
+    // stop by its own SM watchdog before the stop is measured: such an
+    // attempt measures nothing and is made again (at most three).
+    for attempt in 1..=3 {
+        let mut d = drive("EMU-SLOWQS");
+        d.quick_stop_deceleration = 5.0;
+        let Some(r) = start(vec![d], axes_from_toml(&axis("immediate", "")), |c| {
+            c.keys.quick_stop_timeout_ms = 200
+        }) else {
+            return;
+        };
+        let mut r = r.unwrap();
+        r.enable(0);
+        // up to 20 u/s (20 counts per cycle), a count per cycle more each cycle
+        let mut at = r.fb.axes[0].position;
+        for k in 1..=400i64 {
+            at += k.min(20);
+            r.axis(0).target_position = at;
+            r.tick();
+        }
+        let running = r.drive(0).state == State::OperationEnabled;
+        if !running || r.backend.bus_status().losses > 0 {
+            eprintln!("attempt {attempt}: the drive stopped on its own (lost frames): again");
+            assert!(attempt < 3, "no attempt without lost frames");
+            continue;
+        }
+        let (ms, v) = stop_time(&mut r);
+        eprintln!("a 4 s quick stop ramp: cut after {ms:.1} ms (bound 200 ms), at {v:.2} u/s");
+        assert!((195.0..400.0).contains(&ms), "{ms}");
+        break;
     }
-    let (ms, v) = stop_time(&mut r);
-    eprintln!("a 4 s quick stop ramp: cut after {ms:.1} ms (bound 200 ms), at {v:.2} u/s");
-    assert!((195.0..400.0).contains(&ms), "{ms}");
 }
 
 #[test]
@@ -390,9 +408,10 @@ fn a_drive_power_cycled_while_it_moves_is_reported_lost_and_reconfigured() {
         t0.elapsed()
     );
     let st = r.backend.bus_status();
-    assert_eq!(
-        (st.losses, st.reconfigured, st.returns),
-        (1, 1, 1),
+    // once lost and re-configured; a loaded host may add a loss and return
+    // of lost frames, each counted back
+    assert!(
+        st.losses >= 1 && st.reconfigured == 1 && st.returns == st.losses,
         "{st:?}"
     );
     r.until_axis(0, "fresh feedback", |a| a.status_word & SW_NO_DATA == 0);

@@ -156,8 +156,16 @@ pub struct AxisLogic {
     cycle_s: f64,
     /// Counts/s below which an axis counts as at rest (one count per cycle).
     rest_velocity: f64,
+    /// Consecutive cycles below `rest_velocity` so far: at rest only after
+    /// [`REST_CYCLES`] (one sample of a moving drive can read 0 when a
+    /// late master repeated its set-point; disabling voltage on it would
+    /// drop a moving axis).
+    still: u32,
     pub counters: AxisCounters,
 }
+
+/// Cycles an axis must read below one count per cycle to be at rest.
+pub const REST_CYCLES: u32 = 3;
 
 impl AxisLogic {
     pub fn new(setup: AxisSetup) -> AxisLogic {
@@ -194,6 +202,7 @@ impl AxisLogic {
             window: u32::MAX,
             cycle_s,
             rest_velocity: 1.0 / cycle_s,
+            still: 0,
             counters: AxisCounters::default(),
             layout: setup.layout,
         }
@@ -283,7 +292,12 @@ impl AxisLogic {
         }
         let set = self.check_setpoint(cmd, mode, enable, pos64);
         self.window = following_error_window(cmd.position_error_tolerance);
-        let at_rest = velocity.abs() < self.rest_velocity;
+        self.still = if velocity.abs() < self.rest_velocity {
+            self.still.saturating_add(1)
+        } else {
+            0
+        };
+        let at_rest = self.still >= REST_CYCLES;
         let target = self.cia_target(mode, enable, at_rest);
         let home = self.drive_homing(cmd, mode, target, inp, at_rest);
         let mut controlword = self.cia.step(inp.statusword, target);

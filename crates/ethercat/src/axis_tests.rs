@@ -221,6 +221,12 @@ fn watchdog_stop_quick_stops_then_disables_with_a_fault() {
     assert_eq!(fb.status_word & SW_FAULT, 0, "no fault while stopping");
     assert!(!a.at_rest_and_disabled());
     qs.velocity = 0;
+    // at rest only after REST_CYCLES still samples: one may be a repeated
+    // set-point of a moving axis
+    for _ in 1..crate::axis::REST_CYCLES {
+        let (o, _) = a.step(&cmd(true, 0), Mode::WatchdogStop, Some(&qs));
+        assert_eq!(o.controlword, 0x0002, "not yet at rest");
+    }
     let (o, fb) = a.step(&cmd(true, 0), Mode::WatchdogStop, Some(&qs));
     assert_eq!(o.controlword, 0x0000, "quick stop active → disable voltage");
     assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);

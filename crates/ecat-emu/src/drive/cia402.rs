@@ -98,7 +98,7 @@ impl Drive {
                     let fb = self.plant.feedback();
                     self.ramp = Some(Ramp {
                         position: fb.position,
-                        velocity: fb.velocity,
+                        velocity: self.ramp_velocity(),
                         after: After::SwitchOnDisabled,
                     });
                     self.state = QuickStopActive;

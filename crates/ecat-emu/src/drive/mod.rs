@@ -94,6 +94,9 @@ pub struct Drive {
     enabling: bool,
     last_cw: u16,
     ramp: Option<Ramp>,
+    /// The plant's velocity one cycle before the last (see
+    /// [`Drive::ramp_velocity`]).
+    prev_velocity: f64,
     pending_fault: Option<u16>,
     probes: [ProbeUnit; 2],
     next_probe_id: u8,
@@ -120,6 +123,7 @@ impl Drive {
             enabling: false,
             last_cw: 0,
             ramp: None,
+            prev_velocity: 0.0,
             pending_fault: None,
             probes: [ProbeUnit::default(); 2],
             next_probe_id: 0,

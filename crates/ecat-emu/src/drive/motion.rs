@@ -40,7 +40,7 @@ impl Drive {
                 let fb = self.plant.feedback();
                 let (position, velocity) = match self.ramp {
                     Some(r) => (r.position, r.velocity),
-                    None => (fb.position, fb.velocity),
+                    None => (fb.position, self.ramp_velocity()),
                 };
                 self.ramp = Some(Ramp {
                     position,
@@ -80,6 +80,19 @@ impl Drive {
             (max, max)
         };
         (p / 10.0, n / 10.0)
+    }
+
+    /// The velocity a ramp starts from. The plant follows set-points
+    /// ideally, so one set-point the master repeated (a late cycle) reads
+    /// as standing still for a cycle; a real drive's mechanics do not stop
+    /// in a cycle: the mean of the last two cycles' velocities then.
+    pub(super) fn ramp_velocity(&self) -> f64 {
+        let v = self.plant.feedback().velocity;
+        if v.abs() < self.prev_velocity.abs() {
+            (v + self.prev_velocity) / 2.0
+        } else {
+            v
+        }
     }
 
     /// One plant step of `dt` s: along a running ramp, to the CSP target
@@ -160,6 +173,7 @@ impl Drive {
             cmd.enable = true;
         }
         let was_enabled = self.plant.feedback().drive.enabled;
+        self.prev_velocity = self.plant.feedback().velocity;
         let out = self.plant.step(&cmd, dt);
         // The plant faults on a following error, or on a limit-switch wire
         // break (which it keeps while the wire is cut, also while enabling).
