@@ -9,6 +9,7 @@
 
 use crate::auth::Roles;
 use crate::bridge::{BridgeError, Handle};
+use crate::jogs::Watch;
 use crate::methods::{self, CallError, MethodSpec, Scope};
 use crate::space::NAMESPACE_URI;
 use async_trait::async_trait;
@@ -23,6 +24,7 @@ use opcua::server::node_manager::{MethodCall, RequestContext, ServerContext};
 use opcua::sync::RwLock;
 use opcua::types::{Identifier, MessageSecurityMode, NodeId, StatusCode};
 use std::sync::Arc;
+use std::time::Instant;
 
 pub struct MachineManager {
     ns: u16,
@@ -140,7 +142,8 @@ impl MachineManager {
                 return;
             }
         };
-        match self.bridge.run(op).await {
+        let watch = matches!(op, methods::Operation::Jog { .. }).then(|| watch(ctx));
+        match self.bridge.run_watched(op, watch).await {
             Ok(resp) => {
                 let status = methods::status_of(&resp);
                 call.set_outputs(methods::outputs(spec.scope, &resp));
@@ -164,6 +167,21 @@ impl MachineManager {
                 call.set_status(status);
             }
         }
+    }
+}
+
+/// How the bridge tells that the session calling Jog still lives: it is
+/// still in the server's session table (a closed or expired session is
+/// dropped from it) and not past its timeout.
+fn watch(ctx: &RequestContext) -> Watch {
+    let session = Arc::downgrade(&ctx.session);
+    Watch {
+        session: ctx.session_id(),
+        alive: Box::new(move || {
+            session
+                .upgrade()
+                .is_some_and(|s| s.read().deadline() > Instant::now())
+        }),
     }
 }
 

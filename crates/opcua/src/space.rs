@@ -166,7 +166,36 @@ pub const AXIS_LIVE: &[LiveVar] = &[
     live!("HomeMode", enum HOME_MODES, |a, _| Some(Variant::from(a.home_mode))),
     live!("HomeSequence", enum HOME_SEQUENCES, |a, _| Some(Variant::from(a.home_sequence))),
     live!("HomeDirection", enum HOME_DIRECTIONS, |a, _| Some(Variant::from(a.home_direction))),
+    // The operations' status (issue 15): MSO/MAJ/MAM's bits, the limit
+    // switches, the commanded position.
+    live!("ServoActionStatus", Boolean, Plain, |a, _| motion(
+        a,
+        MS_SERVO_ACTION
+    )),
+    live!("JogStatus", Boolean, Plain, |a, _| motion(a, MS_JOGGING)),
+    live!("MoveStatus", Boolean, Plain, |a, _| motion(a, MS_MOVING)),
+    live!("StreamStatus", Boolean, Plain, |a, _| motion(
+        a,
+        MS_STREAMING
+    )),
+    live!("AxisFault", Boolean, Plain, |a, _| motion(a, MS_FAULTED)),
+    live!("NegativeOvertravel", Boolean, Plain, |a, _| motion(
+        a,
+        MS_LIMIT_NEGATIVE
+    )),
+    live!("PositiveOvertravel", Boolean, Plain, |a, _| motion(
+        a,
+        MS_LIMIT_POSITIVE
+    )),
+    live!("CommandPosition", Double, Position, |a, _| {
+        (a.motion & MS_COMMAND != 0 && a.cmd_position.is_finite())
+            .then_some(Variant::from(a.cmd_position))
+    }),
 ];
+
+fn motion(a: &AxisStatusEntry, bit: u16) -> Option<Variant> {
+    Some(Variant::from(a.motion & bit != 0))
+}
 
 /// A configured attribute of an axis (from the machine config, which the
 /// daemon runs with; constant while it runs).

@@ -339,7 +339,9 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         let a = &b["axes"][axis];
         assert_eq!(
             a["_methods"],
-            serde_json::json!(["Home", "Stop", "Unhome"]),
+            serde_json::json!([
+                "Disable", "Enable", "Home", "Jog", "Move", "Reset", "Stop", "Unhome"
+            ]),
             "{a}"
         );
         for v in [
@@ -362,7 +364,10 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
     assert_eq!(b["io"]["io"], true, "{b}");
 
     // Refusals: anonymous and viewer callers, a wrong password.
-    assert_eq!(err_of(&rig.ua("anon-call", &[])), "BadUserAccessDenied");
+    let v = rig.ua("anon-call", &[]);
+    assert_eq!(err_of(&v), "BadUserAccessDenied");
+    assert_eq!(v["jog"], "BadUserAccessDenied", "{v}");
+    assert_eq!(v["enable"], "BadUserAccessDenied", "{v}");
     let v = rig.ua(
         "anon-call",
         &["--login", "view1", "--password", "view-secret"],
@@ -404,6 +409,61 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         e["fields"]["Message"].as_str().unwrap().contains("timeout"),
         "{e}"
     );
+
+    // The operations: Enable then Move, X reaches the target.
+    let m = rig.ua(
+        "enable-move",
+        &["--password", "op-secret", "--target", "10"],
+    );
+    assert_eq!(
+        m["enable"],
+        serde_json::json!([true, "accepted", 0, 0]),
+        "{m}"
+    );
+    assert_eq!(m["servo"], true, "{m}");
+    assert_eq!(
+        m["outputs"],
+        serde_json::json!([true, "accepted", 0, 0]),
+        "{m}"
+    );
+    assert_eq!(m["reached"], true, "{m}");
+    // A Jog with a Duration stops by itself, the session still open ...
+    let j = rig.ua("jog", &["--password", "op-secret", "--duration", "1"]);
+    assert_eq!(
+        j["outputs"],
+        serde_json::json!([true, "accepted", 0, 0]),
+        "{j}"
+    );
+    assert_eq!(
+        (&j["jogging_seen"], &j["stopped"]),
+        (&Value::Bool(true), &Value::Bool(true)),
+        "{j}"
+    );
+    assert!(j["moved"].as_f64().unwrap() > 0.5, "{j}");
+    // ... and one whose session closes stops long before its Duration.
+    let j = rig.ua(
+        "jog",
+        &[
+            "--password",
+            "op-secret",
+            "--speed",
+            "-5",
+            "--duration",
+            "10",
+            "--close",
+            "--timeout",
+            "5",
+        ],
+    );
+    assert_eq!(
+        (&j["jogging_seen"], &j["stopped"]),
+        (&Value::Bool(true), &Value::Bool(true)),
+        "{j}"
+    );
+    rig.wait_log("opcua.err", "the session that started it is gone", 1);
+    assert!(rig
+        .text("opcua.err")
+        .contains("jog on axis X ended: its duration ran out"));
 
     // Hostile arguments: each refused with a Bad status, the server still serves.
     let f = rig.ua("fuzz", &["--password", "op-secret"]);
