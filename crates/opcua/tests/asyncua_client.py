@@ -217,9 +217,12 @@ async def enable_move(a):
         pos, reached = await poll(ax, ns, "ActualPosition",
                                   lambda p: p is not None and abs(p - a.target) < 0.01, a.timeout)
         _, done = await poll(ax, ns, "MoveStatus", lambda m: not m, 5)
+        # What the axis says, should it not have got there (a fault, lost
+        # feedback on a loaded machine): the failure explains itself.
+        why = {k: jsonable(await read(ax, ns, k)) for k in ("ER", "ERR", "EXERR", "Message")}
         return {"enable": [jsonable(x) for x in enable], "servo": servo,
                 "outputs": [jsonable(x) for x in out], "moving_seen": moving or reached,
-                "reached": reached and done, "position": jsonable(pos)}
+                "reached": reached and done, "position": jsonable(pos), "axis": why}
 
 
 async def jog(a):

@@ -327,6 +327,11 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         .output()
         .unwrap();
     assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
+    let said = String::from_utf8_lossy(&t.stdout);
+    assert!(
+        said.contains("subject \"") && said.contains("SHA-1 ") && said.contains("SHA-256 "),
+        "trust names what it trusts: {said}"
+    );
     let v = rig.ua("untrusted", &["--other", "stranger"]);
     assert!(err_of(&v).contains("Untrusted"), "{v}");
     // The refusal is logged with the certificate's name and thumbprint.
@@ -505,6 +510,13 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
     assert_eq!(rig.ua("connected", &["--want", "true"])["connected"], true);
     let b = rig.ua("browse", &[]);
     assert_eq!(b["axes"]["X"]["HomedStatus"]["status"], "Good", "{b}");
+    // Revoking: the trusted certificate deleted, the client is refused
+    // again at once (no restart).
+    for f in std::fs::read_dir(rig.dir.join("state/opcua/trusted")).unwrap() {
+        std::fs::remove_file(f.unwrap().path()).unwrap();
+    }
+    let v = rig.ua("untrusted", &["--other", "client"]);
+    assert!(err_of(&v).contains("Untrusted"), "{v}");
     assert_eq!(
         Rig::stop(&mut rig.opcua),
         Some(0),
