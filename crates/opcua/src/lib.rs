@@ -14,13 +14,15 @@
 //! * [`bridge`] — the thread that talks to the daemon (and follows restarts).
 //! * [`auth`], [`password`], [`pki`] — users and roles, argon2 hashes, the
 //!   certificate, key and trust list.
-//! * [`server`] — endpoints and limits; [`cli`] — the command line.
+//! * [`server`] — endpoints and limits; [`cli`] — the command line;
+//!   [`logging`] — the log, every line escaped.
 
 pub mod auth;
 pub mod bridge;
 pub mod cli;
 pub mod events;
 pub mod jogs;
+pub mod logging;
 pub mod manager;
 pub mod methods;
 pub mod nodes;

@@ -11,7 +11,7 @@ fn main() {
     unsafe {
         libc::umask(0o077);
     }
-    motion_rt::logging::init("motion-opcua");
+    motion_opcua::logging::init();
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
