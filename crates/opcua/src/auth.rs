@@ -32,13 +32,18 @@ const ANONYMOUS_POLICY: &str = "anonymous";
 pub struct Roles {
     users: Vec<User>,
     anonymous: bool,
+    verifying: tokio::sync::Semaphore,
 }
+
+/// Password checks running at once.
+pub const VERIFYING: usize = 2;
 
 impl Roles {
     pub fn new(cfg: &OpcuaConfig) -> Self {
         Self {
             users: cfg.users.clone(),
             anonymous: cfg.anonymous,
+            verifying: tokio::sync::Semaphore::new(VERIFYING),
         }
     }
 
@@ -113,6 +118,10 @@ impl AuthManager for Roles {
         // time taken does not tell which names exist.
         let hash = user.map(|u| u.password_hash.clone());
         let given = password.get().to_string();
+        // At most VERIFYING checks at once (each takes argon2's memory and
+        // tens of ms of CPU): a flood of logins waits here instead of
+        // taking the host's memory and both cores from the daemon's clients.
+        let _turn = self.verifying.acquire().await;
         let ok = tokio::task::spawn_blocking(move || password::verify(hash.as_deref(), &given))
             .await
             .unwrap_or(false);

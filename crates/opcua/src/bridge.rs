@@ -3,16 +3,20 @@
 //! status services). iceoryx2's ports stay on this thread; the OPC UA side
 //! reaches it through a channel.
 //!
-//! Loop (every 2 ms): run the method calls that arrived, take the newest
-//! status frame, every second the statistics. No frame for a second, or a
+//! Loop (every 2 ms): run the method calls that arrived, renew or end the
+//! hold-to-run jogs ([`crate::jogs`]), take the newest status frame, every
+//! second the statistics. No frame for a second, or a
 //! frame of another session: the daemon is gone or restarted — values go
 //! Bad, and it joins again (every 500 ms) when the daemon is back. Nothing
 //! here can hold the daemon up: the control service answers from its own
 //! thread, off the cycle.
 
-use crate::methods::Operation;
+use crate::jogs::{Jogs, Watch};
+use crate::methods::{Operation, JOG_RENEW_MS};
 use crate::values::Publisher;
-use motion_control::{Client, ClientError, ControlResponse, REQ_STATS, RESULT_ACCEPTED};
+use motion_control::{
+    put_str, Axes, Client, ClientError, ControlResponse, Request, REQ_STATS, RESULT_ACCEPTED,
+};
 use motion_report::StatsReport;
 use opcua::server::node_manager::memory::InMemoryNodeManagerImpl;
 use std::path::PathBuf;
@@ -34,6 +38,8 @@ pub enum BridgeError {
 /// A method call for the daemon.
 pub struct Job {
     pub op: Operation,
+    /// For a Jog: the session that asks (renewals only while it lives).
+    pub watch: Option<Watch>,
     pub reply: oneshot::Sender<Result<Box<ControlResponse>, BridgeError>>,
 }
 
@@ -62,6 +68,7 @@ pub fn run<T: InMemoryNodeManagerImpl>(
     let mut last_frame = Instant::now();
     let mut last_stats = Instant::now() - STATS_EVERY;
     let mut told_missing = false;
+    let mut jogs = Jogs::new(Duration::from_millis(JOG_RENEW_MS));
     while !stop.load(Ordering::Acquire) {
         if client.is_none() && last_try.elapsed() >= RETRY {
             last_try = Instant::now();
@@ -85,15 +92,21 @@ pub fn run<T: InMemoryNodeManagerImpl>(
         }
         while let Ok(job) = jobs.try_recv() {
             let r = match client.as_mut() {
-                Some(c) => call(c, &job.op),
+                Some(c) => run_job(c, &mut jogs, job.op, job.watch),
                 None => Err(BridgeError::NoDaemon(
                     "motion-supervisor is not running (or not joined yet)".into(),
                 )),
             };
             if matches!(r, Err(BridgeError::NoDaemon(_))) && client.is_some() {
+                jogs.forget();
                 drop_client(&mut client, &mut publisher, "it stopped answering");
             }
             let _ = job.reply.send(r);
+        }
+        if let Some(c) = client.as_mut() {
+            renew_jogs(c, &mut jogs);
+        } else {
+            jogs.forget();
         }
         if let Some(c) = client.as_mut() {
             match c.status(Duration::ZERO) {
@@ -118,6 +131,75 @@ pub fn run<T: InMemoryNodeManagerImpl>(
         }
         std::thread::sleep(POLL);
     }
+    if let Some(c) = client.as_mut() {
+        for r in jogs.end_all("motion-opcua is stopping") {
+            log::info!("jog on axis {} ended: {}", r.axis, r.why);
+            let _ = jog_renewal(c, r.token, true);
+        }
+    }
+}
+
+/// A method call: a Jog is started (or extended) and then renewed here.
+fn run_job(
+    c: &mut Client,
+    jogs: &mut Jogs,
+    op: Operation,
+    watch: Option<Watch>,
+) -> Result<Box<ControlResponse>, BridgeError> {
+    let (
+        Operation::Jog {
+            axis,
+            speed,
+            duration_s,
+        },
+        Some(watch),
+    ) = (&op, watch)
+    else {
+        return call(c, &op);
+    };
+    let duration = Duration::from_secs_f64(*duration_s);
+    let now = Instant::now();
+    if let Some(token) = jogs.extend(axis, *speed, duration, watch.session, now) {
+        let mut r = ControlResponse::zeroed();
+        r.result = RESULT_ACCEPTED;
+        r.axis_count = 1;
+        put_str(&mut r.axes[0].name, axis);
+        r.axes[0].accepted = 1;
+        r.token = token;
+        return Ok(r);
+    }
+    let r = call(c, &op)?;
+    if r.result == RESULT_ACCEPTED {
+        jogs.started(axis, *speed, duration, r.token, watch, now);
+    }
+    Ok(r)
+}
+
+/// Renews the jogs that may run on, ends the others.
+fn renew_jogs(c: &mut Client, jogs: &mut Jogs) {
+    if jogs.is_empty() {
+        return;
+    }
+    for r in jogs.due(Instant::now()) {
+        let ok = jog_renewal(c, r.token, r.end);
+        if r.end {
+            log::info!("jog on axis {} ended: {}", r.axis, r.why);
+        } else if !ok {
+            log::info!("jog on axis {} ended by the supervisor", r.axis);
+            jogs.gone(r.token);
+        }
+    }
+}
+
+/// One renewal (or the end) of jog `token`: did the supervisor accept it?
+fn jog_renewal(c: &mut Client, token: u64, end: bool) -> bool {
+    let req = Request::JogRenew {
+        axes: Axes::All,
+        token,
+        end,
+    };
+    c.send(&req, CALL_TIMEOUT)
+        .is_ok_and(|r| r.result == RESULT_ACCEPTED)
 }
 
 fn drop_client<T: InMemoryNodeManagerImpl>(
@@ -156,9 +238,23 @@ pub struct Handle {
 
 impl Handle {
     pub async fn run(&self, op: Operation) -> Result<Box<ControlResponse>, BridgeError> {
+        self.run_watched(op, None).await
+    }
+
+    /// [`Handle::run`] for a Jog, renewed while `watch` says its session
+    /// lives.
+    pub async fn run_watched(
+        &self,
+        op: Operation,
+        watch: Option<Watch>,
+    ) -> Result<Box<ControlResponse>, BridgeError> {
         let (tx, rx) = oneshot::channel();
         self.jobs
-            .send(Job { op, reply: tx })
+            .send(Job {
+                op,
+                watch,
+                reply: tx,
+            })
             .map_err(|_| BridgeError::Failed("the daemon thread has ended".into()))?;
         match tokio::time::timeout(CALL_TIMEOUT + Duration::from_secs(2), rx).await {
             Ok(Ok(r)) => r,

@@ -4,8 +4,8 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
 /// An OPC UA server for a running motion-supervisor: the machine's axes, I/O
-/// processes and latency statistics as an address space, Home/Stop/Unhome as
-/// methods. Secure by default (Sign & Encrypt, trusted client certificates,
+/// processes and latency statistics as an address space, Home/Stop/Unhome and
+/// Enable/Disable/Reset/Jog/Move as methods. Secure by default (Sign & Encrypt, trusted client certificates,
 /// anonymous read-only, operators by password hash).
 #[derive(Parser, Debug)]
 #[command(name = "motion-opcua", version)]

@@ -6,19 +6,23 @@
 //! * [`space`] — what the address space holds (tables), [`nodes`] builds it,
 //!   [`units`] the engineering units, [`values`] fills it from status frames,
 //!   [`events`] the event of an axis going ER.
-//! * [`methods`] — Home/Stop/Unhome per axis, HomeAll/StopAll: arguments in,
-//!   the control service's answer out; the extension point for issue 15's
-//!   operations.
+//! * [`methods`] — Home/Stop/Unhome and the operations Enable, Disable,
+//!   Reset, Jog (hold to run), Move per axis, HomeAll/StopAll: arguments
+//!   in, the control service's answer out; [`jogs`] — the jogs the bridge
+//!   renews while the calling session lives.
 //! * [`manager`] — the node manager: roles checked, calls to the daemon.
 //! * [`bridge`] — the thread that talks to the daemon (and follows restarts).
 //! * [`auth`], [`password`], [`pki`] — users and roles, argon2 hashes, the
 //!   certificate, key and trust list.
-//! * [`server`] — endpoints and limits; [`cli`] — the command line.
+//! * [`server`] — endpoints and limits; [`cli`] — the command line;
+//!   [`logging`] — the log, every line escaped.
 
 pub mod auth;
 pub mod bridge;
 pub mod cli;
 pub mod events;
+pub mod jogs;
+pub mod logging;
 pub mod manager;
 pub mod methods;
 pub mod nodes;

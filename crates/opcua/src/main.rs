@@ -3,7 +3,7 @@
 
 use clap::Parser;
 use motion_opcua::cli::{Cli, Command};
-use std::io::Read;
+use std::io::{BufRead, Read};
 
 fn main() {
     // Nothing we create (key, trust list) is for other users.
@@ -11,7 +11,7 @@ fn main() {
     unsafe {
         libc::umask(0o077);
     }
-    motion_rt::logging::init("motion-opcua");
+    motion_opcua::logging::init();
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -46,12 +46,7 @@ fn main() {
     }
     let r = match cli.command {
         Some(Command::HashPassword) => Ok(()),
-        Some(Command::Trust { cert }) => motion_opcua::pki::trust(&cfg.pki_dir, &cert).map(|to| {
-            println!(
-                "trusted: {} (effective for the next connection)",
-                to.display()
-            );
-        }),
+        Some(Command::Trust { cert }) => trust(&cfg.pki_dir, &cert),
         None => serve(machine, cfg),
     };
     if let Err(e) = r {
@@ -60,12 +55,31 @@ fn main() {
     }
 }
 
+/// `trust`: what is trusted (subject, fingerprints), then where it went.
+fn trust(pki: &std::path::Path, cert: &std::path::Path) -> Result<(), String> {
+    let what = motion_opcua::pki::describe(&motion_opcua::pki::read_cert(cert)?)?;
+    let to = motion_opcua::pki::trust(pki, cert)?;
+    println!("{what}");
+    println!(
+        "trusted: {} (effective for the next connection; delete it to revoke)",
+        to.display()
+    );
+    Ok(())
+}
+
+/// `hash-password`: from a pipe, everything up to EOF; from a terminal,
+/// one line typed with echo off (the password is never shown).
 fn hash_password() -> Result<(), String> {
     let mut text = String::new();
-    std::io::stdin()
-        .take(motion_opcua::password::MAX_PASSWORD as u64 + 2)
-        .read_to_string(&mut text)
-        .map_err(|e| format!("reading the password from stdin: {e}"))?;
+    let limit = motion_opcua::password::MAX_PASSWORD as u64 + 2;
+    let read = match NoEcho::on_tty() {
+        Some(_quiet) => {
+            eprint!("password (not shown): ");
+            std::io::stdin().lock().take(limit).read_line(&mut text)
+        }
+        None => std::io::stdin().take(limit).read_to_string(&mut text),
+    };
+    read.map_err(|e| format!("reading the password from stdin: {e}"))?;
     let pw = text.strip_suffix('\n').unwrap_or(&text);
     let pw = pw.strip_suffix('\r').unwrap_or(pw);
     let h = motion_opcua::password::hash(pw)?;
@@ -93,4 +107,35 @@ fn serve(
         .build()
         .map_err(|e| format!("tokio runtime: {e}"))?;
     rt.block_on(motion_opcua::server::serve(machine, cfg))
+}
+
+/// Terminal echo switched off while it lives (stdin a terminal only).
+struct NoEcho(libc::termios);
+
+impl NoEcho {
+    fn on_tty() -> Option<NoEcho> {
+        // SAFETY: isatty/tcgetattr/tcsetattr on fd 0 with a termios we own.
+        unsafe {
+            if libc::isatty(0) != 1 {
+                return None;
+            }
+            let mut t: libc::termios = std::mem::zeroed();
+            if libc::tcgetattr(0, &mut t) != 0 {
+                return None;
+            }
+            let saved = t;
+            t.c_lflag &= !libc::ECHO;
+            t.c_lflag |= libc::ECHONL;
+            (libc::tcsetattr(0, libc::TCSANOW, &t) == 0).then_some(NoEcho(saved))
+        }
+    }
+}
+
+impl Drop for NoEcho {
+    fn drop(&mut self) {
+        // SAFETY: restores the settings read in `on_tty`.
+        unsafe {
+            libc::tcsetattr(0, libc::TCSANOW, &self.0);
+        }
+    }
 }

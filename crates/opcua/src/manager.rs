@@ -9,9 +9,11 @@
 
 use crate::auth::Roles;
 use crate::bridge::{BridgeError, Handle};
+use crate::jogs::Watch;
 use crate::methods::{self, CallError, MethodSpec, Scope};
 use crate::space::NAMESPACE_URI;
 use async_trait::async_trait;
+use motion_config::names::shown;
 use motion_config::opcua::OpcuaConfig;
 use motion_config::MachineConfig;
 use opcua::server::address_space::AddressSpace;
@@ -23,9 +25,13 @@ use opcua::server::node_manager::{MethodCall, RequestContext, ServerContext};
 use opcua::sync::RwLock;
 use opcua::types::{Identifier, MessageSecurityMode, NodeId, StatusCode};
 use std::sync::Arc;
+use std::time::Instant;
 
 pub struct MachineManager {
     ns: u16,
+    /// The trust list: a session whose client certificate left it calls
+    /// nothing any more.
+    pki: std::path::PathBuf,
     axes: Vec<String>,
     roles: Arc<Roles>,
     bridge: Handle,
@@ -52,6 +58,7 @@ impl InMemoryNodeManagerImplBuilder for Builder {
         crate::nodes::build(space, ns, &self.machine, &self.cfg);
         MachineManager {
             ns,
+            pki: self.cfg.pki_dir.clone(),
             axes: self.machine.axes.iter().map(|a| a.name.clone()).collect(),
             roles: self.roles,
             bridge: self.bridge,
@@ -70,11 +77,12 @@ impl MachineManager {
         };
         let s = s.as_ref();
         if let Some(rest) = s.strip_prefix("Machine.Axes.") {
-            let (axis, m) = rest.rsplit_once('.')?;
-            if !self.axes.iter().any(|a| a == axis) {
-                return None;
-            }
-            return methods::spec(m, Scope::Axis).map(|spec| (spec, Some(axis.to_string())));
+            let (key, m) = rest.rsplit_once('.')?;
+            let axis = self
+                .axes
+                .iter()
+                .find(|a| crate::space::axis_key(a) == key)?;
+            return methods::spec(m, Scope::Axis).map(|spec| (spec, Some(axis.clone())));
         }
         let m = s.strip_prefix("Machine.")?;
         methods::spec(m, Scope::Machine).map(|spec| (spec, None))
@@ -87,16 +95,18 @@ impl MachineManager {
             .client_certificate()
             .map(|c| c.thumbprint().as_hex_string())
             .unwrap_or_else(|| "none".into());
+        // The application URI and session name are the client's text:
+        // shown escaped (no control characters reach the log).
         format!(
-            "user {} [{}], client {:?} session {:?}, {} {:?}, certificate {thumb}",
+            "user {} [{}], client {} session {}, {} {:?}, certificate {thumb}",
             if ctx.user_token().is_anonymous() {
                 "anonymous".to_string()
             } else {
                 ctx.user_token().0.clone()
             },
             self.roles.role_of(ctx.user_token()),
-            s.application_description().application_uri.as_ref(),
-            s.session_name(),
+            shown(s.application_description().application_uri.as_ref()),
+            shown(s.session_name()),
             s.security_policy_uri().rsplit('#').next().unwrap_or(""),
             s.message_security_mode(),
         )
@@ -113,6 +123,16 @@ impl MachineManager {
         };
         let secure =
             ctx.session().read().message_security_mode() == MessageSecurityMode::SignAndEncrypt;
+        let revoked = (ctx.session().read().client_certificate())
+            .is_some_and(|c| !crate::pki::still_trusted(&self.pki, c));
+        if revoked {
+            log::warn!(
+                "OPC UA call {what} refused (BadUserAccessDenied: the client certificate is no longer trusted): {}",
+                self.who(ctx)
+            );
+            call.set_status(StatusCode::BadUserAccessDenied);
+            return;
+        }
         if !secure || !self.roles.may_call(ctx.user_token()) {
             log::warn!(
                 "OPC UA call {what} refused (BadUserAccessDenied: {}): {}",
@@ -140,7 +160,8 @@ impl MachineManager {
                 return;
             }
         };
-        match self.bridge.run(op).await {
+        let watch = matches!(op, methods::Operation::Jog { .. }).then(|| watch(ctx));
+        match self.bridge.run_watched(op, watch).await {
             Ok(resp) => {
                 let status = methods::status_of(&resp);
                 call.set_outputs(methods::outputs(spec.scope, &resp));
@@ -164,6 +185,21 @@ impl MachineManager {
                 call.set_status(status);
             }
         }
+    }
+}
+
+/// How the bridge tells that the session calling Jog still lives: it is
+/// still in the server's session table (a closed or expired session is
+/// dropped from it) and not past its timeout.
+fn watch(ctx: &RequestContext) -> Watch {
+    let session = Arc::downgrade(&ctx.session);
+    Watch {
+        session: ctx.session_id(),
+        alive: Box::new(move || {
+            session
+                .upgrade()
+                .is_some_and(|s| s.read().deadline() > Instant::now())
+        }),
     }
 }
 

@@ -5,14 +5,15 @@
 //! Pure functions (no server, no daemon), so they are fuzzed directly
 //! (`tests` below, proptest).
 //!
-//! **Extension point** (issue 15's operations): a new operation is a row
-//! of [`METHODS`], a variant of [`Operation`] with its control request in
-//! [`Operation::request`], and an arm in [`decode`]. Enable, Disable and
-//! Reset take no input (like Stop); Move takes Target (Double), Relative
-//! (Boolean), Speed/Acceleration/Deceleration (Double, 0: the axis's
-//! defaults); Jog is hold to run: Speed and a Duration the client renews
-//! by calling it again, and a session that closes stops it (a session
-//! close hook in `manager.rs`).
+//! A new operation is a row of [`METHODS`], a variant of [`Operation`]
+//! with its control request in [`Operation::typed`], and an arm in
+//! [`decode`]. Enable, Disable and Reset take no input (like Stop); Move
+//! takes Target (Double), Relative (Boolean) and Speed (Double, 0: the
+//! axis's default); Jog is hold to run: Speed and a Duration (at most
+//! [`MAX_JOG_S`]) that the client extends by calling Jog again with the
+//! same speed (the keep-alive), and the jog stops when the duration runs
+//! out or the calling session is gone (the bridge renews the control
+//! service's lease only while both hold: `bridge.rs`, `jogs.rs`).
 
 use motion_control::*;
 use opcua::types::{DataTypeId, StatusCode, Variant};
@@ -70,6 +71,68 @@ pub const METHODS: &[MethodSpec] = &[
         doc: "clear HomedStatus (and invalidate a stored absolute reference)",
     },
     MethodSpec {
+        name: "Enable",
+        scope: Scope::Axis,
+        inputs: &[],
+        doc: "MSO: enable the drive, holding position",
+    },
+    MethodSpec {
+        name: "Disable",
+        scope: Scope::Axis,
+        inputs: &[],
+        doc: "MSF: disable the drive (a moving axis is stopped first)",
+    },
+    MethodSpec {
+        name: "Reset",
+        scope: Scope::Axis,
+        inputs: &[],
+        doc: "MAFR: clear the axis's error and ask the drive for a fault reset",
+    },
+    MethodSpec {
+        name: "Jog",
+        scope: Scope::Axis,
+        inputs: &[
+            ArgSpec {
+                name: "Speed",
+                data_type: DataTypeId::Double,
+                array: false,
+                doc: "signed speed (units/s): the sign is the direction",
+            },
+            ArgSpec {
+                name: "Duration",
+                data_type: DataTypeId::Double,
+                array: false,
+                doc: "seconds the jog runs (0 < Duration <= 10) unless called again with the same speed, which extends it (hold to run); it stops at once when the session closes",
+            },
+        ],
+        doc: "MAJ, hold to run: jog this axis for Duration seconds, or while called again",
+    },
+    MethodSpec {
+        name: "Move",
+        scope: Scope::Axis,
+        inputs: &[
+            ArgSpec {
+                name: "Target",
+                data_type: DataTypeId::Double,
+                array: false,
+                doc: "the target position (units), or the distance with Relative",
+            },
+            ArgSpec {
+                name: "Relative",
+                data_type: DataTypeId::Boolean,
+                array: false,
+                doc: "Target is a distance from where the axis is",
+            },
+            ArgSpec {
+                name: "Speed",
+                data_type: DataTypeId::Double,
+                array: false,
+                doc: "units/s (> 0), or 0: the axis's home_speed",
+            },
+        ],
+        doc: "MAM: a trapezoidal move to Target (or by it); done when MoveStatus drops",
+    },
+    MethodSpec {
         name: "HomeAll",
         scope: Scope::Machine,
         inputs: &[
@@ -103,6 +166,13 @@ pub fn spec(name: &str, scope: Scope) -> Option<&'static MethodSpec> {
 
 /// Longest Timeout accepted (the range of `home_timeout`).
 pub const MAX_TIMEOUT_S: f64 = 86_400.0;
+/// Longest Duration of one Jog call: an HMI that holds longer calls Jog
+/// again; one that vanished without closing its session stops jogging
+/// within this bound.
+pub const MAX_JOG_S: f64 = 10.0;
+/// Largest |Speed| or |Target| taken (the daemon applies the axis's own
+/// limits; this only keeps absurd numbers off the wire).
+pub const MAX_ABS: f64 = 1e12;
 
 /// What the control service is asked.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,35 +189,84 @@ pub enum Operation {
     Unhome {
         axes: Vec<String>,
     },
+    Enable {
+        axes: Vec<String>,
+    },
+    Disable {
+        axes: Vec<String>,
+    },
+    Reset {
+        axes: Vec<String>,
+    },
+    /// Hold to run on one axis: the bridge starts it and renews it while
+    /// `duration_s` lasts and the session lives.
+    Jog {
+        axis: String,
+        speed: f64,
+        duration_s: f64,
+    },
+    Move {
+        axis: String,
+        position: f64,
+        relative: bool,
+        /// `None`: the axis's default.
+        speed: Option<f64>,
+    },
 }
 
+/// The control service's lease of a jog started here, renewed by the
+/// bridge every [`JOG_RENEW_MS`] while the jog may run.
+pub const JOG_LEASE_MS: u32 = 500;
+pub const JOG_RENEW_MS: u64 = 100;
+
 impl Operation {
-    /// The control request (the client adds layout, key and id).
-    pub fn request(&self) -> Box<ControlRequest> {
-        let mut r = ControlRequest::zeroed();
-        let axes = match self {
+    /// The typed control request.
+    pub fn typed(&self) -> Request {
+        let named = |a: &Vec<String>| Axes::from_names(a);
+        match self {
             Operation::Home {
                 axes,
                 parallel,
                 timeout_s,
-            } => {
-                r.kind = REQ_HOME;
-                r.flags = if *parallel { FLAG_PARALLEL } else { 0 };
-                r.timeout_s = *timeout_s;
-                axes
-            }
-            Operation::Stop { axes } => {
-                r.kind = REQ_STOP;
-                axes
-            }
-            Operation::Unhome { axes } => {
-                r.kind = REQ_UNHOME;
-                axes
-            }
-        };
-        // `decode` bounded the names already.
-        r.set_axes(axes);
-        r
+            } => Request::Home {
+                axes: named(axes),
+                parallel: *parallel,
+                timeout_s: (*timeout_s > 0.0).then_some(*timeout_s),
+            },
+            Operation::Stop { axes } => Request::Stop { axes: named(axes) },
+            Operation::Unhome { axes } => Request::Unhome { axes: named(axes) },
+            Operation::Enable { axes } => Request::Enable { axes: named(axes) },
+            Operation::Disable { axes } => Request::Disable { axes: named(axes) },
+            Operation::Reset { axes } => Request::Reset { axes: named(axes) },
+            Operation::Jog { axis, speed, .. } => Request::Jog {
+                axes: Axes::Named(vec![axis.clone()]),
+                speed: *speed,
+                accel: None,
+                decel: None,
+                lease_ms: JOG_LEASE_MS,
+            },
+            Operation::Move {
+                axis,
+                position,
+                relative,
+                speed,
+            } => Request::Move {
+                axes: Axes::Named(vec![axis.clone()]),
+                position: *position,
+                relative: *relative,
+                speed: *speed,
+                accel: None,
+                decel: None,
+                supersede: false,
+            },
+        }
+    }
+
+    /// The control request (the client adds layout, key and id). `decode`
+    /// bounded the names, so it always encodes; were it not, the request
+    /// is of no kind and the daemon refuses it.
+    pub fn request(&self) -> Box<ControlRequest> {
+        self.typed().encode().unwrap_or_else(ControlRequest::zeroed)
     }
 }
 
@@ -177,17 +296,29 @@ pub fn decode(
     let mut timeout_s = 0.0;
     let mut parallel = false;
     let mut named = Vec::new();
+    let (mut speed, mut duration_s, mut target, mut relative) = (0.0, 0.0, 0.0, false);
     for (i, (a, s)) in args.iter().zip(spec.inputs).enumerate() {
-        let r = match s.name {
-            "Timeout" => timeout(a).map(|t| timeout_s = t),
-            "Parallel" => match a {
+        let r = match (spec.name, s.name) {
+            (_, "Timeout") => timeout(a).map(|t| timeout_s = t),
+            ("Jog", "Speed") => bounded(a, |x| x.abs() <= MAX_ABS).map(|x| speed = x),
+            ("Move", "Speed") => bounded(a, |x| (0.0..=MAX_ABS).contains(&x)).map(|x| speed = x),
+            (_, "Duration") => bounded(a, |x| x > 0.0 && x <= MAX_JOG_S).map(|x| duration_s = x),
+            (_, "Target") => bounded(a, |x| x.abs() <= MAX_ABS).map(|x| target = x),
+            (_, "Relative") => match a {
+                Variant::Boolean(b) => {
+                    relative = *b;
+                    Ok(())
+                }
+                _ => Err(StatusCode::BadTypeMismatch),
+            },
+            (_, "Parallel") => match a {
                 Variant::Boolean(b) => {
                     parallel = *b;
                     Ok(())
                 }
                 _ => Err(StatusCode::BadTypeMismatch),
             },
-            "Axes" => names(a).map(|n| named = n),
+            (_, "Axes") => names(a).map(|n| named = n),
             _ => Err(StatusCode::BadInvalidArgument),
         };
         if let Err(e) = r {
@@ -210,6 +341,20 @@ pub fn decode(
         },
         "Stop" | "StopAll" => Operation::Stop { axes },
         "Unhome" => Operation::Unhome { axes },
+        "Enable" => Operation::Enable { axes },
+        "Disable" => Operation::Disable { axes },
+        "Reset" => Operation::Reset { axes },
+        "Jog" => Operation::Jog {
+            axis: axes.concat(),
+            speed,
+            duration_s,
+        },
+        "Move" => Operation::Move {
+            axis: axes.concat(),
+            position: target,
+            relative,
+            speed: (speed > 0.0).then_some(speed),
+        },
         _ => return Err(CallError::Status(StatusCode::BadMethodInvalid)),
     })
 }
@@ -222,6 +367,20 @@ fn timeout(v: &Variant) -> Result<f64, StatusCode> {
     };
     if t.is_finite() && (0.0..=MAX_TIMEOUT_S).contains(&t) {
         Ok(t)
+    } else {
+        Err(StatusCode::BadOutOfRange)
+    }
+}
+
+/// A finite Double (or Float) that `ok` accepts.
+fn bounded(v: &Variant, ok: impl Fn(f64) -> bool) -> Result<f64, StatusCode> {
+    let x = match v {
+        Variant::Double(x) => *x,
+        Variant::Float(x) => f64::from(*x),
+        _ => return Err(StatusCode::BadTypeMismatch),
+    };
+    if x.is_finite() && ok(x) {
+        Ok(x)
     } else {
         Err(StatusCode::BadOutOfRange)
     }

@@ -88,13 +88,7 @@ pub fn build(space: &mut AddressSpace, ns: u16, m: &MachineConfig, cfg: &OpcuaCo
             );
             units_of(space, ns, &vid, v.kind, unit);
         }
-        methods(
-            space,
-            ns,
-            &obj,
-            &format!("Machine.Axes.{}", a.name),
-            Scope::Axis,
-        );
+        methods(space, ns, &obj, &axis_path(&a.name), Scope::Axis);
     }
 
     let ios = id(ns, "Machine.IO");

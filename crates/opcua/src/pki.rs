@@ -104,6 +104,76 @@ pub fn read_cert(path: &Path) -> Result<X509, String> {
         .map_err(|_| format!("{}: not an X.509 certificate (DER or PEM)", path.display()))
 }
 
+/// What an administrator checks against the client's own display before
+/// trusting a certificate: the subject (escaped: it is the client's
+/// text) and the SHA-1 (what OPC UA calls the thumbprint) and SHA-256
+/// fingerprints of the DER.
+pub fn describe(cert: &X509) -> Result<String, String> {
+    use sha2::{Digest, Sha256};
+    let der = cert
+        .to_der()
+        .map_err(|e| format!("encoding the certificate: {e}"))?;
+    let sha256: String = Sha256::digest(&der)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    Ok(format!(
+        "subject {}\n  SHA-1   {}\n  SHA-256 {sha256}",
+        motion_config::names::shown(&cert.subject_name()),
+        cert.thumbprint().as_hex_string().to_lowercase(),
+    ))
+}
+
+/// Is the client certificate of a session still trusted? (Its file in
+/// `trusted/`: removing it revokes the trust for new connections at once
+/// — the stack checks there — and for method calls of sessions already
+/// open, which `manager.rs` checks here.)
+pub fn still_trusted(pki: &Path, cert: &X509) -> bool {
+    pki.join("trusted")
+        .join(CertificateStore::cert_file_name(cert))
+        .is_file()
+}
+
+/// Most certificates kept in `rejected/`, and the largest: every client
+/// that presents an unknown certificate leaves one there (for an
+/// administrator to trust), so a hostile client could fill the disk.
+pub const MAX_REJECTED: usize = 100;
+pub const MAX_REJECTED_BYTES: u64 = 16 * 1024;
+
+/// Bounds `rejected/`: removes files over [`MAX_REJECTED_BYTES`] and
+/// anything that is not a regular file, then the oldest beyond
+/// [`MAX_REJECTED`]. Returns how many it removed.
+pub fn prune_rejected(pki: &Path) -> usize {
+    let Ok(dir) = fs::read_dir(pki.join("rejected")) else {
+        return 0;
+    };
+    let mut kept = Vec::new();
+    let mut removed = 0;
+    for e in dir.flatten() {
+        let Ok(meta) = e.path().symlink_metadata() else {
+            continue;
+        };
+        if !meta.is_file() || meta.len() > MAX_REJECTED_BYTES {
+            let gone = if meta.is_dir() {
+                fs::remove_dir_all(e.path())
+            } else {
+                fs::remove_file(e.path())
+            };
+            removed += usize::from(gone.is_ok());
+        } else {
+            kept.push((meta.modified().ok(), e.path()));
+        }
+    }
+    if kept.len() > MAX_REJECTED {
+        kept.sort();
+        let extra = kept.len() - MAX_REJECTED;
+        for (_, p) in kept.into_iter().take(extra) {
+            removed += usize::from(fs::remove_file(p).is_ok());
+        }
+    }
+    removed
+}
+
 /// Trusts the certificate at `path`: copies it into `trusted/` under the
 /// stack's name for it and removes it from `rejected/`. Returns where it
 /// went.
@@ -151,6 +221,34 @@ mod tests {
         fs::set_permissions(dir.join(KEY), fs::Permissions::from_mode(0o644)).unwrap();
         assert!(ensure(&dir, "localhost").unwrap_err().contains("chmod 600"));
         assert!(read_cert(&dir.join("trusted")).is_err());
+        assert!(still_trusted(&dir, &cert));
+        let d = describe(&cert).unwrap();
+        assert!(d.contains("SHA-256 ") && d.contains("subject \""), "{d}");
+        fs::remove_file(&to).unwrap();
+        assert!(!still_trusted(&dir, &cert), "removing the file revokes");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn rejected_is_bounded_oldest_first() {
+        let dir = std::env::temp_dir().join(format!("opcua-rej-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(dir.join("rejected/sub")).unwrap();
+        for i in 0..MAX_REJECTED + 5 {
+            fs::write(dir.join(format!("rejected/c{i:03}.der")), [0u8; 10]).unwrap();
+        }
+        fs::write(dir.join("rejected/huge.der"), vec![0u8; 20_000]).unwrap();
+        let removed = prune_rejected(&dir);
+        assert_eq!(
+            removed,
+            5 + 2,
+            "5 beyond the bound, the huge file, the directory"
+        );
+        assert_eq!(
+            fs::read_dir(dir.join("rejected")).unwrap().count(),
+            MAX_REJECTED
+        );
+        assert_eq!(prune_rejected(&dir), 0);
         fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -26,6 +26,22 @@ pub const MIN_INTERVAL_MS: f64 = 10.0;
 /// Values a monitored item may queue (a 10 s publishing interval at 100 Hz).
 pub const MAX_QUEUE: usize = 1000;
 
+/// What one client (or many) may hold of the server, so that a hostile or
+/// broken one cannot exhaust it: sessions in all (an HMI, a PLC, a SCADA
+/// and their engineering tools fit many times over), subscriptions per
+/// session, monitored items per subscription (every variable of 16 axes),
+/// notification messages a subscription keeps for a client that does not
+/// publish (the stack's own 20, stated), and how long an abandoned
+/// session lingers (a session silent for this long is closed; with it a
+/// jog it started, should its Duration still run).
+pub const MAX_SESSIONS: usize = 20;
+pub const MAX_SUBSCRIPTIONS_PER_SESSION: usize = 10;
+pub const MAX_MONITORED_ITEMS_PER_SUB: usize = 1000;
+pub const MAX_QUEUED_NOTIFICATIONS: usize = 20;
+pub const MAX_SESSION_TIMEOUT_MS: u64 = 60_000;
+/// A connection that sends no Hello within this is dropped.
+pub const HELLO_TIMEOUT_S: u32 = 5;
+
 fn stack_policy(p: Policy) -> (SecurityPolicy, MessageSecurityMode) {
     match p {
         Policy::Basic256Sha256 => (
@@ -65,6 +81,9 @@ fn builder(
         .check_cert_time(true)
         .discovery_urls(vec![cfg.endpoint.clone()])
         .subscription_poll_interval_ms(MIN_INTERVAL_MS as u64)
+        .max_sessions(MAX_SESSIONS)
+        .max_session_timeout_ms(MAX_SESSION_TIMEOUT_MS)
+        .hello_timeout(HELLO_TIMEOUT_S)
         .with_authenticator(roles.clone())
         .with_node_manager(InMemoryNodeManagerBuilder::new(Builder {
             machine: machine.clone(),
@@ -87,6 +106,9 @@ fn builder(
     l.subscriptions.min_sampling_interval_ms = MIN_INTERVAL_MS;
     l.subscriptions.min_publishing_interval_ms = MIN_INTERVAL_MS;
     l.subscriptions.max_monitored_item_queue_size = MAX_QUEUE;
+    l.subscriptions.max_subscriptions_per_session = MAX_SUBSCRIPTIONS_PER_SESSION;
+    l.subscriptions.max_monitored_items_per_sub = MAX_MONITORED_ITEMS_PER_SUB;
+    l.subscriptions.max_queued_notifications = MAX_QUEUED_NOTIFICATIONS;
     b
 }
 
@@ -128,6 +150,20 @@ pub async fn serve(machine: MachineConfig, cfg: OpcuaConfig) -> Result<(), Strin
         .name("motion-bridge".into())
         .spawn(move || bridge::run(target, publisher, rx, bridge_stop))
         .map_err(|e| format!("cannot start the bridge thread: {e}"))?;
+    let pki_dir = cfg.pki_dir.clone();
+    tokio::spawn(async move {
+        let mut tick = tokio::time::interval(std::time::Duration::from_secs(1));
+        loop {
+            tick.tick().await;
+            let n = pki::prune_rejected(&pki_dir);
+            if n > 0 {
+                log::warn!(
+                    "removed {n} files from rejected/ (at most {} kept)",
+                    pki::MAX_REJECTED
+                );
+            }
+        }
+    });
     let h = handle.clone();
     tokio::spawn(async move {
         use tokio::signal::unix::{signal, SignalKind};
@@ -158,4 +194,29 @@ pub async fn serve(machine: MachineConfig, cfg: OpcuaConfig) -> Result<(), Strin
     stop.store(true, Ordering::Release);
     let _ = thread.join();
     r.map_err(|e| format!("OPC UA server: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Basic128Rsa15 and Basic256 (SHA-1, deprecated since OPC UA 1.04)
+    /// cannot even be configured: no spelling of `policies` reaches them,
+    /// and the secure ones are always Sign & Encrypt.
+    #[test]
+    fn deprecated_policies_are_never_offered() {
+        for (name, p) in Policy::NAMES {
+            let (policy, mode) = stack_policy(p);
+            assert!(
+                !matches!(
+                    policy,
+                    SecurityPolicy::Basic128Rsa15 | SecurityPolicy::Basic256
+                ),
+                "{name}"
+            );
+            if p != Policy::None {
+                assert_eq!(mode, MessageSecurityMode::SignAndEncrypt, "{name}");
+            }
+        }
+    }
 }

@@ -8,7 +8,7 @@
 //! `Machine`, `Machine.Axes.X`, `Machine.Axes.X.HomedStatus`,
 //! `Machine.Axes.X.Home`, `Machine.IO.bus0.Attached`,
 //! `Machine.Latency.WakeUp.P99` — readable in any client, stable across
-//! restarts.
+//! restarts. A `.` in an axis name stands as `%2E` ([`axis_key`]).
 
 use motion_config::AxisEntry;
 use motion_control::*;
@@ -22,12 +22,26 @@ pub fn id(ns: u16, path: &str) -> NodeId {
     NodeId::new(ns, path.to_string())
 }
 
+/// An axis name as it stands in node ids: `.` (allowed in axis names, and
+/// the separator of node ids) as `%2E` — `%` is not allowed in names, so
+/// axes `X` and `X.Home` can never share the id `Machine.Axes.X.Home` with
+/// a method of `X`. Names without a dot are unchanged.
+pub fn axis_key(axis: &str) -> String {
+    axis.replace('.', "%2E")
+}
+
+/// `Machine.Axes.<axis key>`: the axis object's id, and the prefix of its
+/// variables' and methods'.
+pub fn axis_path(axis: &str) -> String {
+    format!("Machine.Axes.{}", axis_key(axis))
+}
+
 pub fn axis_id(ns: u16, axis: &str) -> NodeId {
-    id(ns, &format!("Machine.Axes.{axis}"))
+    id(ns, &axis_path(axis))
 }
 
 pub fn axis_var_id(ns: u16, axis: &str, var: &str) -> NodeId {
-    id(ns, &format!("Machine.Axes.{axis}.{var}"))
+    id(ns, &format!("{}.{var}", axis_path(axis)))
 }
 
 pub fn io_var_id(ns: u16, io: &str, var: &str) -> NodeId {
@@ -166,7 +180,36 @@ pub const AXIS_LIVE: &[LiveVar] = &[
     live!("HomeMode", enum HOME_MODES, |a, _| Some(Variant::from(a.home_mode))),
     live!("HomeSequence", enum HOME_SEQUENCES, |a, _| Some(Variant::from(a.home_sequence))),
     live!("HomeDirection", enum HOME_DIRECTIONS, |a, _| Some(Variant::from(a.home_direction))),
+    // The operations' status (issue 15): MSO/MAJ/MAM's bits, the limit
+    // switches, the commanded position.
+    live!("ServoActionStatus", Boolean, Plain, |a, _| motion(
+        a,
+        MS_SERVO_ACTION
+    )),
+    live!("JogStatus", Boolean, Plain, |a, _| motion(a, MS_JOGGING)),
+    live!("MoveStatus", Boolean, Plain, |a, _| motion(a, MS_MOVING)),
+    live!("StreamStatus", Boolean, Plain, |a, _| motion(
+        a,
+        MS_STREAMING
+    )),
+    live!("AxisFault", Boolean, Plain, |a, _| motion(a, MS_FAULTED)),
+    live!("NegativeOvertravel", Boolean, Plain, |a, _| motion(
+        a,
+        MS_LIMIT_NEGATIVE
+    )),
+    live!("PositiveOvertravel", Boolean, Plain, |a, _| motion(
+        a,
+        MS_LIMIT_POSITIVE
+    )),
+    live!("CommandPosition", Double, Position, |a, _| {
+        (a.motion & MS_COMMAND != 0 && a.cmd_position.is_finite())
+            .then_some(Variant::from(a.cmd_position))
+    }),
 ];
+
+fn motion(a: &AxisStatusEntry, bit: u16) -> Option<Variant> {
+    Some(Variant::from(a.motion & bit != 0))
+}
 
 /// A configured attribute of an axis (from the machine config, which the
 /// daemon runs with; constant while it runs).
@@ -276,6 +319,30 @@ mod tests {
             assert_eq!(v.data_type, DataTypeId::Double, "{d}");
         }
         assert!(names.contains(&"HomePosition"));
+    }
+
+    #[test]
+    fn axis_names_with_dots_keep_node_ids_apart() {
+        let ns = 2;
+        let mut ids = Vec::new();
+        for axis in ["X", "X.Home", "X.HomedStatus", "gantry.left", "X.Home.Stop"] {
+            ids.push(axis_id(ns, axis));
+            for v in AXIS_LIVE.iter().map(|v| v.name) {
+                ids.push(axis_var_id(ns, axis, v));
+            }
+            for m in crate::methods::METHODS {
+                ids.push(id(ns, &format!("{}.{}", axis_path(axis), m.name)));
+            }
+        }
+        let n = ids.len();
+        ids.sort_by_key(|i| i.to_string());
+        ids.dedup();
+        assert_eq!(n, ids.len(), "two nodes share an id");
+        assert_eq!(axis_id(ns, "X").to_string(), "ns=2;s=Machine.Axes.X");
+        assert_eq!(
+            axis_var_id(ns, "gantry.left", "ER").to_string(),
+            "ns=2;s=Machine.Axes.gantry%2Eleft.ER"
+        );
     }
 
     #[test]

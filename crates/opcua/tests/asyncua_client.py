@@ -178,11 +178,76 @@ async def expect_error(coro):
 
 
 async def anon_call(a):
-    """A method call by an anonymous session, or by `--login` (a viewer)."""
+    """A method call by an anonymous session, or by `--login` (a viewer):
+    Home, and the operations Jog and Enable."""
     async with await client(a, user=a.login, password=a.password) as c:
         ns, ax = await axis_node(c, a.axis)
-        err = await expect_error(ax.call_method(f"{ns}:Home", ua.Variant(0.0, ua.VariantType.Double)))
-        return {"error": err}
+        D = ua.VariantType.Double
+        err = await expect_error(ax.call_method(f"{ns}:Home", ua.Variant(0.0, D)))
+        jog = await expect_error(ax.call_method(f"{ns}:Jog", ua.Variant(5.0, D), ua.Variant(1.0, D)))
+        enable = await expect_error(ax.call_method(f"{ns}:Enable"))
+        return {"error": err, "jog": jog, "enable": enable}
+
+
+async def read(ax, ns, name):
+    dv = await (await ax.get_child([f"{ns}:{name}"])).read_data_value(raise_on_bad_status=False)
+    return dv.Value.Value
+
+
+async def poll(ax, ns, name, pred, timeout):
+    """Reads `name` every 20 ms until `pred(value)`; the last value and whether it held."""
+    until = time.time() + timeout
+    v = await read(ax, ns, name)
+    while not pred(v) and time.time() < until:
+        await asyncio.sleep(0.02)
+        v = await read(ax, ns, name)
+    return v, pred(v)
+
+
+async def enable_move(a):
+    """Operator: Enable, then Move to `--target`; the position reaches it."""
+    async with await client(a, user=a.user, password=a.password) as c:
+        ns, ax = await axis_node(c, a.axis)
+        enable = await ax.call_method(f"{ns}:Enable")
+        _, servo = await poll(ax, ns, "ServoActionStatus", bool, 10)
+        D = ua.VariantType.Double
+        out = await ax.call_method(f"{ns}:Move", ua.Variant(a.target, D),
+                                   ua.Variant(False, ua.VariantType.Boolean), ua.Variant(0.0, D))
+        _, moving = await poll(ax, ns, "MoveStatus", bool, 5)
+        pos, reached = await poll(ax, ns, "ActualPosition",
+                                  lambda p: p is not None and abs(p - a.target) < 0.01, a.timeout)
+        _, done = await poll(ax, ns, "MoveStatus", lambda m: not m, 5)
+        # What the axis says, should it not have got there (a fault, lost
+        # feedback on a loaded machine): the failure explains itself.
+        why = {k: jsonable(await read(ax, ns, k)) for k in ("ER", "ERR", "EXERR", "Message")}
+        return {"enable": [jsonable(x) for x in enable], "servo": servo,
+                "outputs": [jsonable(x) for x in out], "moving_seen": moving or reached,
+                "reached": reached and done, "position": jsonable(pos), "axis": why}
+
+
+async def jog(a):
+    """Operator: Jog at `--speed` for `--duration` s: it runs, then stops by
+    itself while the session stays open. With `--close`: the session
+    closes mid-jog instead (duration 10 s) and a second session sees it stop."""
+    async with await client(a) as watcher:
+        wns, wax = await axis_node(watcher, a.axis)
+        start = await read(wax, wns, "ActualPosition")
+        c = await client(a, user=a.user, password=a.password)
+        await c.connect()
+        ns, ax = await axis_node(c, a.axis)
+        D = ua.VariantType.Double
+        out = await ax.call_method(f"{ns}:Jog", ua.Variant(a.speed, D), ua.Variant(a.duration, D))
+        _, seen = await poll(wax, wns, "JogStatus", bool, 5)
+        t0 = time.time()
+        if a.close:
+            await c.disconnect()
+        _, stopped = await poll(wax, wns, "JogStatus", lambda j: not j, a.timeout)
+        took = time.time() - t0
+        if not a.close:
+            await c.disconnect()
+        end = await read(wax, wns, "ActualPosition")
+        return {"outputs": [jsonable(x) for x in out], "jogging_seen": seen, "stopped": stopped,
+                "took": took, "moved": jsonable(end - start if end is not None and start is not None else None)}
 
 
 async def none_call(a):
@@ -228,6 +293,21 @@ async def fuzz(a):
                                         ua.Variant(0.0, D)]),
             "int_for_bool": (m, "HomeAll", [ua.Variant([], S), ua.Variant(1, ua.VariantType.Int32),
                                             ua.Variant(0.0, D)]),
+            "jog_nan_speed": (ax, "Jog", [ua.Variant(float("nan"), D), ua.Variant(1.0, D)]),
+            "jog_huge_speed": (ax, "Jog", [ua.Variant(1e308, D), ua.Variant(1.0, D)]),
+            "jog_inf_duration": (ax, "Jog", [ua.Variant(1.0, D), ua.Variant(float("inf"), D)]),
+            "jog_long_duration": (ax, "Jog", [ua.Variant(1.0, D), ua.Variant(1e9, D)]),
+            "jog_zero_duration": (ax, "Jog", [ua.Variant(1.0, D), ua.Variant(0.0, D)]),
+            "jog_missing": (ax, "Jog", [ua.Variant(1.0, D)]),
+            "move_nan": (ax, "Move", [ua.Variant(float("nan"), D), ua.Variant(False, B),
+                                      ua.Variant(0.0, D)]),
+            "move_huge": (ax, "Move", [ua.Variant(1e308, D), ua.Variant(False, B),
+                                       ua.Variant(0.0, D)]),
+            "move_negative_speed": (ax, "Move", [ua.Variant(1.0, D), ua.Variant(False, B),
+                                                 ua.Variant(-3.0, D)]),
+            "move_string": (ax, "Move", [ua.Variant("1", S), ua.Variant(False, B),
+                                         ua.Variant(0.0, D)]),
+            "enable_too_many": (ax, "Enable", [ua.Variant(1.0, D)]),
         }
         for name, (obj, meth, args) in cases.items():
             results[name] = await expect_error(obj.call_method(f"{ns}:{meth}", *args))
@@ -274,7 +354,7 @@ async def latency(a):
 
 SCENARIOS = {f.__name__.replace("_", "-"): f for f in
              (gen_cert, endpoints, browse, home, er_event, anon_call, none_call, wrong_password,
-              untrusted, fuzz, connected, latency)}
+              untrusted, fuzz, connected, latency, enable_move, jog)}
 
 
 def main():
@@ -290,6 +370,10 @@ def main():
     p.add_argument("--axis", default="X")
     p.add_argument("--want", default="true")
     p.add_argument("--timeout", type=float, default=30.0)
+    p.add_argument("--target", type=float, default=10.0)
+    p.add_argument("--speed", type=float, default=5.0)
+    p.add_argument("--duration", type=float, default=1.0)
+    p.add_argument("--close", action="store_true")
     a = p.parse_args()
     out = asyncio.run(SCENARIOS[a.scenario](a))
     print(json.dumps(out))

@@ -15,6 +15,8 @@ fn the_unit_follows_the_daemon_and_is_hardened() {
         "CapabilityBoundingSet=",
         "ProtectSystem=strict",
         "RemoveIPC=no",
+        "SystemCallFilter=@system-service",
+        "MemoryMax=",
         "--runtime-dir /run/motion",
     ] {
         assert!(text.contains(line), "missing {line:?}");

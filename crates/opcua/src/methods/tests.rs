@@ -43,11 +43,45 @@ fn check_request(op: &Operation) {
     let r = op.request();
     assert!((r.axis_count as usize) <= MAX_AXES);
     assert!(r.timeout_s.is_finite() && (0.0..=MAX_TIMEOUT_S).contains(&r.timeout_s));
-    assert!(matches!(r.kind, REQ_HOME | REQ_STOP | REQ_UNHOME));
     let names = r.axis_names();
     match op {
-        Operation::Home { axes, .. } | Operation::Stop { axes } | Operation::Unhome { axes } => {
+        Operation::Home { axes, .. }
+        | Operation::Stop { axes }
+        | Operation::Unhome { axes }
+        | Operation::Enable { axes }
+        | Operation::Disable { axes }
+        | Operation::Reset { axes } => {
+            assert!(matches!(
+                r.kind,
+                REQ_HOME | REQ_STOP | REQ_UNHOME | REQ_ENABLE | REQ_DISABLE | REQ_RESET
+            ));
             assert_eq!(&names, axes, "every name carried as given");
+        }
+        Operation::Jog {
+            axis,
+            speed,
+            duration_s,
+        } => {
+            assert_eq!(r.kind, REQ_JOG);
+            assert_eq!(names, vec![axis.clone()]);
+            assert!(speed.is_finite() && speed.abs() <= MAX_ABS && r.speed == *speed);
+            assert!(*duration_s > 0.0 && *duration_s <= MAX_JOG_S);
+            assert_eq!(r.lease_ms, JOG_LEASE_MS);
+        }
+        Operation::Move {
+            axis,
+            position,
+            speed,
+            ..
+        } => {
+            assert_eq!(r.kind, REQ_MOVE);
+            assert_eq!(names, vec![axis.clone()]);
+            assert!(position.is_finite() && r.position == *position);
+            match speed {
+                Some(v) => assert!(*v > 0.0 && v.is_finite() && r.speed == *v),
+                None => assert!(r.speed.is_nan(), "NaN on the wire: the default"),
+            }
+            assert!(r.accel.is_nan() && r.decel.is_nan());
         }
     }
 }
@@ -160,4 +194,85 @@ fn a_home_call_carries_its_timeout_and_refusals_say_why() {
     );
     r.axes[0].reason = REASON_UNKNOWN_AXIS;
     assert_eq!(status_of(&r), StatusCode::BadInvalidArgument);
+}
+
+#[test]
+fn operations_decode_with_their_bounds() {
+    let jog = spec("Jog", Scope::Axis).unwrap();
+    assert_eq!(
+        decode(jog, Some("X"), &[Variant::from(-5.0), Variant::from(2.0)]),
+        Ok(Operation::Jog {
+            axis: "X".into(),
+            speed: -5.0,
+            duration_s: 2.0
+        })
+    );
+    for (speed, dur, bad) in [
+        (
+            f64::NAN,
+            1.0,
+            vec![StatusCode::BadOutOfRange, StatusCode::Good],
+        ),
+        (
+            1e300,
+            1.0,
+            vec![StatusCode::BadOutOfRange, StatusCode::Good],
+        ),
+        (1.0, 0.0, vec![StatusCode::Good, StatusCode::BadOutOfRange]),
+        (
+            1.0,
+            MAX_JOG_S + 0.1,
+            vec![StatusCode::Good, StatusCode::BadOutOfRange],
+        ),
+        (
+            1.0,
+            f64::INFINITY,
+            vec![StatusCode::Good, StatusCode::BadOutOfRange],
+        ),
+    ] {
+        assert_eq!(
+            decode(jog, Some("X"), &[Variant::from(speed), Variant::from(dur)]),
+            Err(CallError::Args(bad)),
+            "{speed} {dur}"
+        );
+    }
+    let mv = spec("Move", Scope::Axis).unwrap();
+    let op = decode(
+        mv,
+        Some("X"),
+        &[Variant::from(12.5), Variant::from(true), Variant::from(0.0)],
+    )
+    .unwrap();
+    assert_eq!(
+        op,
+        Operation::Move {
+            axis: "X".into(),
+            position: 12.5,
+            relative: true,
+            speed: None
+        }
+    );
+    let r = op.request();
+    assert_eq!((r.kind, r.flags & FLAG_RELATIVE), (REQ_MOVE, FLAG_RELATIVE));
+    assert_eq!(
+        decode(
+            mv,
+            Some("X"),
+            &[Variant::from(1.0), Variant::from(1i32), Variant::from(-1.0)]
+        ),
+        Err(CallError::Args(vec![
+            StatusCode::Good,
+            StatusCode::BadTypeMismatch,
+            StatusCode::BadOutOfRange
+        ]))
+    );
+    for (name, kind) in [
+        ("Enable", REQ_ENABLE),
+        ("Disable", REQ_DISABLE),
+        ("Reset", REQ_RESET),
+    ] {
+        let op = decode(spec(name, Scope::Axis).unwrap(), Some("X"), &[]).unwrap();
+        assert_eq!(op.request().kind, kind, "{name}");
+        assert_eq!(op.request().axis_names(), vec!["X".to_string()]);
+    }
 }
