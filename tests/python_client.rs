@@ -49,6 +49,7 @@ fn install(python: &str) -> TempDir {
     let target = dir.file("site");
     let mut cmd = Command::new(python);
     cmd.args(["-m", "pip", "install", "--quiet", "--no-deps", "--no-index"])
+        .env("PYTHONDONTWRITEBYTECODE", "1") // nothing written into python/
         .args([
             "--disable-pip-version-check",
             "--target",
@@ -70,6 +71,7 @@ fn the_ctypes_layouts_match_the_rust_types_field_by_field() {
     };
     let mut cmd = Command::new(&python);
     cmd.args(["-m", "unittest", "discover", "-v", "-s", "tests"])
+        .env("PYTHONDONTWRITEBYTECODE", "1") // the source tree stays as it is
         .current_dir(PACKAGE_DIR);
     let out = Running::start(&mut cmd, "python -m unittest").finish();
     out.expect_code(0);
