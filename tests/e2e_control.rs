@@ -1,6 +1,6 @@
 //! The deployed controller end to end: `motion-supervisor run` commanded and
-//! watched with `motionctl`, several I/O processes attaching and detaching,
-//! and a client nobody here wrote (Python, the iceoryx2 package only).
+//! watched with `motionctl`, several I/O processes attaching and detaching.
+//! (The Python client package against the daemon: `python_client.rs`.)
 //!
 //! The machine is `tests/machines/two_buses.toml`: X (switch then marker,
 //! event -7.5, about 3 s) and Z (a slow switch) on bus0, Y (a slow switch,
@@ -208,99 +208,4 @@ fn an_hmi_outliving_the_daemon_leaves_nothing_behind() {
     let ended = hmi.finish();
     assert_ne!(ended.code(), Some(0), "it must say the supervisor is gone");
     assert_clean(&cfg.prefix);
-}
-
-/// A client nobody here wrote: the Python example, with nothing but the
-/// `iceoryx2` package, reads the status and homes an axis, enables it,
-/// moves and jogs it, resets it, and streams a sine to it
-/// (`stream_sine.py`).
-#[test]
-fn the_python_client_reads_status_and_homes() {
-    let Some(python) = python_with_iceoryx2() else {
-        assert!(
-            std::env::var_os("MOTION_PYTHON_REQUIRED").is_none(),
-            "MOTION_PYTHON_REQUIRED is set but no Python with the iceoryx2 package was found"
-        );
-        eprintln!(
-            "SKIPPED: no Python with the iceoryx2 package (set MOTION_PYTHON; .ci/run makes one)"
-        );
-        return;
-    };
-    let _serial = serial();
-    // a Python program descheduled for more than 50 ms on a busy CI
-    // machine would (rightly) have its stream stopped: 300 ms here
-    let cfg = Machine::fixture("two_buses")
-        .set("axis.X.stream_timeout_ms", 300)
-        .write("py");
-    let d = Daemon::start(&cfg, &["bus0", "bus1"]);
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/python/");
-    let run = |script: &str, args: &[&str]| {
-        let mut cmd = std::process::Command::new(&python);
-        cmd.arg(format!("{dir}{script}")).args(args);
-        Running::start(&mut cmd, "python").finish()
-    };
-    let python = |args: &[&str]| run("motion_client.py", args);
-    let out = python(&["--prefix", &cfg.prefix, "--home", "X"]);
-    out.expect_code(0);
-    assert!(out.stdout.contains("io bus0: attached"), "{}", out.stdout);
-    assert!(out.stdout.contains("X: homed: PC 1"), "{}", out.stdout);
-    assert!(out.stdout.contains("event_raw -7.500000"), "{}", out.stdout);
-    assert!(d.axis("X").pc);
-
-    // the operations
-    let p = cfg.prefix.as_str();
-    python(&["--prefix", p, "--enable", "X"]).expect_code(0);
-    assert!(wait_for(Duration::from_secs(5), || d
-        .axis("X")
-        .servo_action));
-    let out = python(&["--prefix", p, "--move", "X", "--to", "2.5"]);
-    out.expect_code(0);
-    assert!(out.stdout.contains("X: PC 1 ER 0"), "{}", out.stdout);
-    assert_close!(d.axis("X"), position, 2.5, 2.0 * COUNT);
-    let out = python(&["--prefix", p, "--jog", "X", "--speed", "-2", "--for", "0.5"]);
-    out.expect_code(0);
-    let x = d.axis("X");
-    assert!(value(x.position, "X") < 2.0 && !x.jogging, "{x:#?}");
-    python(&["--prefix", p, "--reset", "X"]).expect_code(0);
-    // the stream: a sine of amplitude 1 from where X stands
-    let x0 = value(d.axis("X").position, "X");
-    let out = run(
-        "stream_sine.py",
-        &[
-            "--prefix",
-            p,
-            "--axis",
-            "X",
-            "--amplitude",
-            "1",
-            "--hz",
-            "0.5",
-            "--seconds",
-            "2",
-        ],
-    );
-    out.expect_code(0);
-    assert!(out.stdout.contains("X: ER 0"), "{}", out.stdout);
-    // after 2 s of a 0.5 Hz (1 − cos): back where it started
-    let x = d.axis("X");
-    assert!((value(x.position, "X") - x0).abs() < 0.01, "{x:#?} vs {x0}");
-    assert!(x.owner.is_none() && !x.streaming, "{x:#?}");
-    // and without a supervisor: exit 3
-    python(&["--prefix", "nobody_here"]).expect_code(3);
-    d.stop();
-    assert_clean(&cfg.prefix);
-}
-
-/// `$MOTION_PYTHON`, else `.ci/venv/bin/python`, if it imports iceoryx2.
-fn python_with_iceoryx2() -> Option<String> {
-    let candidates = [
-        std::env::var("MOTION_PYTHON").ok(),
-        Some(concat!(env!("CARGO_MANIFEST_DIR"), "/../.ci/venv/bin/python").to_string()),
-    ];
-    candidates.into_iter().flatten().find(|p| {
-        std::process::Command::new(p)
-            .args(["-c", "import iceoryx2"])
-            .output()
-            .is_ok_and(|o| o.status.success())
-    })
 }

@@ -3,8 +3,9 @@
 //! * [`message`] — the `#[repr(C)]` request and response of the control
 //!   service and the status frame, with a layout version in their iceoryx2
 //!   type names (as the frames have). Plain fixed-size data, so any iceoryx2
-//!   client can speak them — `examples/python/` does, with nothing but the
-//!   `iceoryx2` package.
+//!   client can speak them — the Python package in `python/` does, with
+//!   nothing but the `iceoryx2` package; its ctypes mirrors are checked field
+//!   by field against the description `tests/wire_layout.rs` writes.
 //! * [`request`] — a request as an enum ([`Request`]): decoded from the
 //!   wire once, at the daemon's edge, and encoded from it by Rust clients;
 //!   an unknown kind is an error, never another request.

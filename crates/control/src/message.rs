@@ -6,8 +6,11 @@
 //! so a client of another layout cannot even open the services. Text
 //! (names, messages, report data) is UTF-8, NUL-padded.
 //!
-//! Any client can speak them: `examples/python/motion_client.py` mirrors
-//! them with `ctypes`.
+//! Any client can speak them: `python/motion_supervisor_client/layout.py`
+//! mirrors them with `ctypes`, checked field by field against `layout.json`,
+//! which `tests/wire_layout.rs` writes from these types (and fails on when
+//! it is stale): a change here is a regenerated description away from a
+//! failing Python test.
 
 use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
 

@@ -2,7 +2,7 @@
 //! edge ([`Request::decode`]), so the daemon applies its rules to an enum
 //! and never to kinds and flags; encoded the same way by Rust clients
 //! ([`Request::encode`]). The bytes stay those of [`ControlRequest`]
-//! (`examples/python/motion_client.py` speaks them): an unknown kind is a
+//! (the Python package in `python/` speaks them): an unknown kind is a
 //! decode error, never some other request.
 
 use crate::message::*;

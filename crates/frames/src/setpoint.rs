@@ -8,7 +8,9 @@
 //! compile-time asserts and carried in the iceoryx2 type name
 //! ([`SETPOINT_FRAME_TYPE_NAME`]), so a client of another layout cannot even
 //! open the service. Clients in other languages mirror it field by field
-//! (`examples/python/stream_sine.py` does, with `ctypes`).
+//! (the Python package in `python/` does, with `ctypes`, checked
+//! field by field against the description `crates/control/tests/wire_layout.rs`
+//! writes).
 //!
 //! What the supervisor checks before a setpoint reaches an engine
 //! ([`SetpointFrame::check`], then the cycle's intake): the layout, the
