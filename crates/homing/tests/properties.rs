@@ -477,10 +477,14 @@ fn every_abort_restores_the_drive() {
             prop_assert!(!st.ip);
             // Either the abort came first (ER, not homed) or the sequence had
             // already finished (and a later loss of feedback may have cleared
-            // HomedStatus, as it must).
+            // HomedStatus, as it must; a later drive fault is an axis fault
+            // at rest: ER with `faulted`, the reference kept).
             prop_assert!(st.dn, "{st:?}");
-            if st.er {
+            if st.er && !st.pc {
                 prop_assert!(!st.homed, "{st:?}");
+            }
+            if st.er && st.pc {
+                prop_assert!(st.faulted, "{st:?}");
             }
             let last = o.commands.last().unwrap();
             prop_assert_eq!(last.torque_limit_positive, cfg.torque_limit);
