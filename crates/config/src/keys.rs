@@ -148,32 +148,25 @@ impl<'a> Reader<'a> {
     }
 
     pub fn u32(&mut self, key: &str, default: u32) -> u32 {
-        match self.get(key) {
-            None => default,
-            Some(toml::Value::Integer(i)) => match u32::try_from(*i) {
-                Ok(x) => x,
-                Err(_) => {
-                    self.problem(key, format!("{i} is not a non-negative 32-bit integer"));
-                    default
-                }
-            },
-            Some(v) => {
-                self.wrong_type(key, "an integer", v);
-                default
-            }
-        }
+        self.integer(key, default, "a non-negative 32-bit integer")
     }
 
     pub fn i32(&mut self, key: &str, default: i32) -> i32 {
+        self.integer(key, default, "a 32-bit integer")
+    }
+
+    /// An integer key that must fit `T` (`what` names the range in the
+    /// problem).
+    fn integer<T: TryFrom<i64>>(&mut self, key: &str, default: T, what: &str) -> T {
         match self.get(key) {
             None => default,
-            Some(toml::Value::Integer(i)) => match i32::try_from(*i) {
-                Ok(x) => x,
-                Err(_) => {
-                    self.problem(key, format!("{i} is not a 32-bit integer"));
+            Some(toml::Value::Integer(i)) => {
+                let i = *i;
+                T::try_from(i).unwrap_or_else(|_| {
+                    self.problem(key, format!("{i} is not {what}"));
                     default
-                }
-            },
+                })
+            }
             Some(v) => {
                 self.wrong_type(key, "an integer", v);
                 default
