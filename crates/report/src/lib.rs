@@ -46,6 +46,12 @@ pub fn round(x: f64, digits: i32) -> f64 {
     (x * k).round() / k
 }
 
+/// Nearest-rank percentile `p` (0..=1) of the sorted `v`; `None` if empty.
+pub fn nearest_rank(v: &[f64], p: f64) -> Option<f64> {
+    let k = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len().max(1));
+    v.get(k - 1).copied()
+}
+
 /// Prints `v` as one line of JSON on stdout (and notes that a JSON object
 /// is out: a panic after it prints no second one, see [`panic`]).
 pub fn print_json<T: serde::Serialize>(v: &T) {
