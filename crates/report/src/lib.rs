@@ -65,3 +65,17 @@ pub fn print_json<T: serde::Serialize>(v: &T) {
         ),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn nearest_rank_of_sorted_values() {
+        let v = [1.0, 2.0, 3.0, 4.0];
+        let p = |q| super::nearest_rank(&v, q);
+        assert_eq!(
+            (p(0.0), p(0.25), p(0.5), p(0.99), p(1.0)),
+            (Some(1.0), Some(1.0), Some(2.0), Some(4.0), Some(4.0))
+        );
+        assert_eq!(super::nearest_rank(&[], 0.5), None);
+    }
+}
