@@ -29,97 +29,16 @@
 //! `cycle/1`, `cycle/8`, `cycle/32`, `cycle/64`.
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
-use motion_config::{MachineConfig, DEMO_TOML};
-use motion_frames::{axis_to_command, feedback_to_axis, CommandFrame, FeedbackFrame};
-use motion_homing::{Axis, Feedback, Phase, Request};
-use motion_plant::Plant;
-use motion_supervisor::core::Core;
-use motion_supervisor::shared::Control;
+use motion_harness::engine::{
+    homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
+};
+use motion_homing::{Axis, Phase};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
 
 /// Axis counts of the cycle benchmark.
 const AXES: [usize; 4] = [1, 8, 32, 64];
-/// Cycles of real homing (against the plants) before a cycle is measured.
-const CYCLE_WARMUP: u64 = 400;
-
-fn demo() -> MachineConfig {
-    motion_config::parse(DEMO_TOML).expect("the built-in demo machine parses")
-}
-
-/// The inputs of one real engine step, captured mid-homing.
-struct Captured {
-    axis: Axis,
-    feedback: Feedback,
-    now: u64,
-    request: Request,
-    cycle: u64,
-}
-
-/// Homes the demo axis `name` against its plant, cycle by cycle, until
-/// `stop(axis, feedback)` holds before a step: returns that step's inputs.
-fn home_until(name: &str, mut stop: impl FnMut(&Axis, &Feedback) -> bool) -> Captured {
-    let m = demo();
-    let a = m
-        .axes
-        .iter()
-        .find(|a| a.name == name)
-        .expect("demo axis exists");
-    let mut axis = Axis::new(a.engine);
-    let mut plant = Plant::new(a.sim);
-    let dt_ns = m.supervisor.cycle_ns();
-    let dt = dt_ns as f64 * 1e-9;
-    let mut fb = plant.feedback();
-    for k in 0..200_000u64 {
-        let now = k * dt_ns;
-        // the rung goes high in cycle 1: a rising edge
-        let request = Request {
-            home: k >= 1,
-            ..Request::default()
-        };
-        if k > 1 && stop(&axis, &fb) {
-            return Captured {
-                axis,
-                feedback: fb,
-                now,
-                request,
-                cycle: k,
-            };
-        }
-        let cmd = axis.step(now, Some(&fb), &request);
-        fb = plant.step(&cmd, dt);
-    }
-    panic!("axis {name}: the state to benchmark was never reached");
-}
-
-/// Axis X (switch then marker) in the middle of its first leg: seeking the
-/// switch at Home Speed, past acceleration.
-fn seek_state() -> Captured {
-    home_until("X", |a, fb| {
-        a.status().phase == Phase::Seek && fb.position > -10.0
-    })
-}
-
-/// Axis Z (torque) pushing into its hard stop: torque over the threshold for
-/// 5 cycles, the torque time (20 ms) not yet reached.
-fn torque_state() -> Captured {
-    let m = demo();
-    let threshold = m
-        .axes
-        .iter()
-        .find(|a| a.name == "Z")
-        .expect("demo axis Z")
-        .engine
-        .home_torque_threshold;
-    let mut over = 0;
-    home_until("Z", move |a, fb| {
-        if a.status().phase == Phase::Seek && fb.torque.abs() >= threshold {
-            over += 1;
-        }
-        over > 5
-    })
-}
 
 /// Checks that stepping a copy of `c` is real work in `phase`.
 fn check(name: &str, c: &Captured, phase: Phase) {
@@ -183,82 +102,6 @@ fn engine_step(c: &mut Criterion) {
         }
     }
     g.finish();
-}
-
-/// `n` axes: the demo axes repeated, starting with the moving ones
-/// (X, C, Z, U, X, ...), names made unique.
-fn machine(n: usize) -> MachineConfig {
-    let d = demo();
-    let axes = (0..n)
-        .map(|i| {
-            let mut a = d.axes[(i + 1) % d.axes.len()].clone();
-            a.name = format!("{}{}", a.name, i);
-            a
-        })
-        .collect();
-    MachineConfig {
-        supervisor: d.supervisor.clone(),
-        ios: d.ios.clone(),
-        axes,
-        gantries: Vec::new(),
-        warnings: Vec::new(),
-    }
-}
-
-/// A core homing every axis against its plant for [`CYCLE_WARMUP`] cycles:
-/// the core, the last feedback frame, a command frame and the next cycle's
-/// time.
-fn homing_core(m: &MachineConfig) -> (Core, FeedbackFrame, CommandFrame, u64) {
-    let mut core = Core::new(m);
-    let mut plants: Vec<Plant> = m.axes.iter().map(|a| Plant::new(a.sim)).collect();
-    let mut fb = FeedbackFrame::default();
-    let mut cmd = CommandFrame::default();
-    let dt_ns = m.supervisor.cycle_ns();
-    let dt = dt_ns as f64 * 1e-9;
-    fb.header.axis_count = m.axes.len() as u32;
-    for (i, (a, p)) in m.axes.iter().zip(&plants).enumerate() {
-        fb.axes[i] = feedback_to_axis(&p.feedback(), a.engine.counts_per_unit);
-    }
-    fb.header.origin = 1;
-    for k in 0..CYCLE_WARMUP {
-        if k == 10 {
-            core.control(
-                Control::Home {
-                    id: 1,
-                    mask: u64::MAX >> (64 - m.axes.len()),
-                    parallel: true,
-                    timeout_ns: 0,
-                },
-                k * dt_ns,
-            );
-        }
-        core.step(k * dt_ns, false, &[(k > 0).then_some(&fb)]);
-        core.fill(0, &mut cmd);
-        core.sent(0, k + 1, k * dt_ns);
-        fb.answers_sequence = k + 1;
-        for (i, (a, p)) in m.axes.iter().zip(plants.iter_mut()).enumerate() {
-            let c = axis_to_command(&cmd.axes[i], a.engine.counts_per_unit);
-            let f = p.step(&c, dt);
-            fb.axes[i] = feedback_to_axis(&f, a.engine.counts_per_unit);
-        }
-    }
-    (core, fb, cmd, CYCLE_WARMUP * dt_ns)
-}
-
-fn phases(core: &Core) -> String {
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for a in core.axes() {
-        let n = a.status().phase.name();
-        match counts.iter_mut().find(|c| c.0 == n) {
-            Some(c) => c.1 += 1,
-            None => counts.push((n, 1)),
-        }
-    }
-    counts
-        .iter()
-        .map(|(n, k)| format!("{k} {n}"))
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 fn cycle(c: &mut Criterion) {

@@ -1,8 +1,9 @@
 //! The machine a bench runs on (the facts come from `motion_rt::host`),
 //! other real-time threads seen while it runs, and the bench's own threads
-//! set up like the cycle's.
+//! set up like the cycle's ([`enter_rt`], the harness's placement).
 
 pub use motion_harness::bins::{beside_this_exe, find_in_path, is_executable};
+pub use motion_harness::placement::enter as enter_rt;
 pub use motion_rt::host::{cpus, loadavg, other_rt_tasks, Host};
 use std::collections::BTreeSet;
 
@@ -44,24 +45,4 @@ impl OtherRt {
     pub fn list(&self) -> Vec<String> {
         self.seen.iter().cloned().collect()
     }
-}
-
-/// Pins the calling thread to `cpu` (if given), SCHED_FIFO at `priority`
-/// (if given), memory locked — with the runtime the supervisor uses, so a
-/// bench thread is set up exactly like the cycle. Returns what the OS
-/// refused, as warnings.
-pub fn enter_rt(cpu: Option<usize>, priority: Option<i32>) -> Vec<String> {
-    if let Some(priority) = priority {
-        let cfg = motion_rt::RtConfig {
-            cpu,
-            priority,
-            ..motion_rt::RtConfig::default()
-        };
-        return motion_rt::enter_realtime(&cfg).warnings;
-    }
-    let pinned = cpu.map(motion_rt::pin_to_cpu).and_then(Result::err);
-    use nix::sys::mman::{mlockall, MlockAllFlags as F};
-    let locked = mlockall(F::MCL_CURRENT | F::MCL_FUTURE).err();
-    let locked = locked.map(|e| format!("mlockall: {e}"));
-    pinned.into_iter().chain(locked).collect()
 }

@@ -126,6 +126,25 @@ pub fn start_run(
     }
 }
 
+/// The machine `toml` written as `dir/PREFIX.toml`; its path.
+pub fn write_config(dir: &Path, prefix: &str, toml: &str) -> Result<PathBuf, String> {
+    let cfg = dir.join(format!("{prefix}.toml"));
+    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
+    Ok(cfg)
+}
+
+/// The machine `toml` written to `dir` ([`write_config`]) and [`start_run`]
+/// of it under `prefix` (ready within 20 s); an error names the prefix.
+pub fn start_machine(
+    b: &Binaries,
+    dir: &Path,
+    prefix: &str,
+    toml: &str,
+) -> Result<Running, String> {
+    let cfg = write_config(dir, prefix, toml)?;
+    start_run(b, &cfg, prefix, Duration::from_secs(20)).map_err(|e| format!("{prefix}: {e}"))
+}
+
 /// Asks a running supervisor to stop (SIGTERM) and collects its output.
 pub fn stop_run(r: Running, timeout: Duration) -> Ended {
     r.signal(Signal::SIGTERM);

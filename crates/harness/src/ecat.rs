@@ -69,7 +69,7 @@ impl EcatRig {
         // starts it
         let emu = std::thread::spawn(move || {
             if let Some(cpu) = cpu {
-                crate::placement::enter(cpu, None);
+                crate::placement::enter(Some(cpu), None);
             }
             Emulator::start(cfg)
         })

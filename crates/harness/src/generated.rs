@@ -239,6 +239,36 @@ pub fn demo_with(s: &Supervisor) -> Result<(String, MachineConfig), String> {
     ))
 }
 
+/// `counts_per_unit` of every axis of [`streamed_with`]: 1e5, so that
+/// consecutive setpoints of the stream bench's latency ramp (≥ 25 counts
+/// apart) are told apart in the command frames.
+pub const STREAMED_COUNTS_PER_UNIT: f64 = 1e5;
+
+/// A machine of `n` linear axes `A00`.. for streaming (immediate homing:
+/// homed where they stand, no motion; all `home_order = 0`, travel ±1000,
+/// max_speed 100, stream_acceleration from home_acceleration 1000 →
+/// 10,000 u/s²), not checked (the daemon that runs it checks it).
+pub fn streamed_with(s: &Supervisor, n: usize) -> String {
+    let mut t = format!("# Written by motion-bench stream: {n} linear axes, immediate homing.\n");
+    t += &default_section(s, None);
+    for i in 0..n {
+        let _ = write!(
+            t,
+            "[[axis]]\nname = \"A{i:02}\"\ncounts_per_unit = {STREAMED_COUNTS_PER_UNIT}\n\
+             home_sequence = \"immediate\"\nhome_order = 0\nhome_speed = 10.0\n\
+             home_return_speed = 2.0\nhome_acceleration = 1000.0\nhome_deceleration = 1000.0\n\
+             max_speed = 100.0\ntravel_limits = [-1000.0, 1000.0]\n\
+             [axis.sim]\nstart = 0.0\nhard_stop = [-1100.0, 1100.0]\n\n"
+        );
+    }
+    t
+}
+
+/// The axis names of [`streamed_with`].
+pub fn streamed_names(n: usize) -> Vec<String> {
+    (0..n).map(|i| format!("A{i:02}")).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -273,6 +303,16 @@ mod tests {
         let (_, m) = long_seek_axis_with(&sup("mb_t2"), None, 20.0, 1000.0).unwrap();
         assert_eq!(m.axes.len(), 1);
         assert!(Machine::parse("demo").is_ok() && Machine::parse("x").is_err());
+    }
+
+    #[test]
+    fn streamed_machines_are_valid() {
+        for n in [1, 2, AXES64] {
+            let (_, m) = checked(streamed_with(&sup("mb_ts"), n)).unwrap();
+            let names: Vec<String> = m.axes.iter().map(|a| a.name.clone()).collect();
+            assert_eq!(names, streamed_names(n));
+            assert!(m.axes.iter().all(|a| a.home_order == Some(0)));
+        }
     }
 
     #[test]

@@ -19,13 +19,18 @@
 //! * [`peer`] — the supervisor's side of a `motion-io`, played by a test.
 //! * [`homing`] — homing runs, their tally, homings repeated while a
 //!   daemon is measured, a traced homing (the benches); [`runs`] — a
-//!   timed daemon run and what it measured, read back (the slice benches);
+//!   timed daemon run and what it measured, read back (the slice benches),
+//!   [`slices`] those of one variant merged;
 //!   [`clients`] — a deployed machine's motionctl clients as a load.
 //! * [`procs`] — processes found in `/proc`; stress-ng.
 //! * [`spy`] — the frame spy on one I/O process's topics; [`bare`] — plain
 //!   iceoryx2 ports of the frames' sizes and their echo (the IPC bench's floor).
 //! * [`cyclictest`] — the jitter bench's reference: its command and histogram.
+//! * [`stream`] — a streaming program: axes homed and enabled, a thread
+//!   publishing setpoints at the stream's rate.
 //! * [`ecat`] — the EtherCAT veth rig with emulated drives.
+//! * [`engine`] — engine states reached by real homing against the plants
+//!   (the engine bench's inputs).
 //!
 //! Invariants: every process it starts ends (SIGTERM, then SIGKILL) when
 //! its handle goes, also when a test panics; every test config has a
@@ -42,16 +47,19 @@ pub mod commands;
 pub mod cyclictest;
 pub mod daemon;
 pub mod ecat;
+pub mod engine;
 pub mod generated;
 pub mod homing;
 pub mod leftovers;
 pub mod machines;
 pub mod peer;
-mod placement;
+pub mod placement;
 pub mod process;
 pub mod procs;
 pub mod runs;
+pub mod slices;
 pub mod spy;
+pub mod stream;
 pub mod temp;
 
 use std::sync::atomic::{AtomicU32, Ordering};

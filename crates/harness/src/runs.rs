@@ -11,7 +11,7 @@ use motion_report::RunReport;
 use motion_supervisor::hlog;
 
 use crate::bins::Binaries;
-use crate::daemon::run_command;
+use crate::daemon::{run_command, write_config};
 use crate::process::{tail, Ended, Running};
 
 /// Starts the daemon of the machine `toml` (written to `dir/TAG.toml`)
@@ -25,10 +25,9 @@ pub fn start(
     extra: &[&str],
 ) -> Result<(Running, PathBuf), String> {
     let (cfg, log) = (
-        dir.join(format!("{tag}.toml")),
+        write_config(dir, tag, toml)?,
         dir.join(format!("{tag}.hlog")),
     );
-    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
     let mut cmd = run_command(b, &cfg, prefix);
     cmd.args(["--duration", &len.to_string(), "--hlog"])
         .arg(&log);

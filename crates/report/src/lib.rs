@@ -46,6 +46,12 @@ pub fn round(x: f64, digits: i32) -> f64 {
     (x * k).round() / k
 }
 
+/// Nearest-rank percentile `p` (0..=1) of the sorted `v`; `None` if empty.
+pub fn nearest_rank(v: &[f64], p: f64) -> Option<f64> {
+    let k = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len().max(1));
+    v.get(k - 1).copied()
+}
+
 /// Prints `v` as one line of JSON on stdout (and notes that a JSON object
 /// is out: a panic after it prints no second one, see [`panic`]).
 pub fn print_json<T: serde::Serialize>(v: &T) {
@@ -57,5 +63,19 @@ pub fn print_json<T: serde::Serialize>(v: &T) {
             "{{\"errors\":[{{\"axis\":null,\"key\":null,\"err\":null,\"exerr\":null,\"message\":\"report could not be serialized: {}\"}}]}}",
             e.to_string().replace('"', "'")
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn nearest_rank_of_sorted_values() {
+        let v = [1.0, 2.0, 3.0, 4.0];
+        let p = |q| super::nearest_rank(&v, q);
+        assert_eq!(
+            (p(0.0), p(0.25), p(0.5), p(0.99), p(1.0)),
+            (Some(1.0), Some(1.0), Some(2.0), Some(4.0), Some(4.0))
+        );
+        assert_eq!(super::nearest_rank(&[], 0.5), None);
     }
 }

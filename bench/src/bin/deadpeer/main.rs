@@ -14,6 +14,7 @@ use motion_bench::flags::{Cycle, Files};
 use motion_bench::outcome::{self, with, write_json, Bench};
 use motion_bench::proc;
 use motion_bench::table::{line, Text};
+use motion_report::nearest_rank as pct;
 use serde::Serialize;
 use serde_json::{json, Value};
 use trial::Trial;
@@ -155,12 +156,6 @@ fn progress(o: &Opts, t: &Trial) {
         code(t.exerr),
         t.error.as_deref().unwrap_or("")
     );
-}
-
-/// Nearest-rank percentile of sorted `v`.
-fn pct(v: &[f64], p: f64) -> Option<f64> {
-    let k = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len().max(1));
-    v.get(k - 1).copied()
 }
 
 /// The columns of the report's table.

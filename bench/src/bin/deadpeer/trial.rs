@@ -83,10 +83,7 @@ fn cruising(c: &Cmd, cruise: f64) -> bool {
 fn daemon(o: &Opts, b: &Binaries, tmp: &Path, prefix: &str) -> Result<(Running, u32), String> {
     let s = o.cycle.supervisor(prefix);
     let (toml, _) = machine::long_seek_axis_with(&s, tmp.to_str(), o.speed, o.speed * 60.0)?;
-    let cfg = tmp.join(format!("{prefix}.toml"));
-    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
-    let daemon = drive::start_run(b, &cfg, prefix, Duration::from_secs(20))
-        .map_err(|e| format!("{prefix}: {e}"))?;
+    let daemon = drive::start_machine(b, tmp, prefix, &toml)?;
     match drive::io_children(daemon.pid()).as_slice() {
         [p] => Ok((daemon, *p)),
         io => {

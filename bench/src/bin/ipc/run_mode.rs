@@ -35,8 +35,7 @@ fn peer(
         cmd.args(echo::args(prefix, o.peer_cpu(), priority));
         return Ok((cmd, 0));
     }
-    let cfg = tmp.join(format!("{prefix}.toml"));
-    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
+    let cfg = motion_bench::drive::write_config(tmp, prefix, &toml)?;
     let mut cmd = Command::new(io_bin.ok_or("no motion-io binary")?);
     cmd.args(["--backend", "sim", "--config"]).arg(&cfg);
     cmd.args([

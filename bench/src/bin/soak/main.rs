@@ -108,9 +108,7 @@ impl Ctx {
 
     /// The machine `text` written to the temporary directory for `prefix`.
     pub fn config(&self, prefix: &str, text: &str) -> Result<PathBuf, String> {
-        let cfg = self.tmp.join(format!("{prefix}.toml"));
-        std::fs::write(&cfg, text).map_err(|e| format!("{}: {e}", cfg.display()))?;
-        Ok(cfg)
+        drive::write_config(&self.tmp, prefix, text)
     }
 
     /// Reports what `prefix` left behind, then cleans it (see

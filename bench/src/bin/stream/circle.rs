@@ -8,12 +8,13 @@
 //! command), and the contour error (the actual point's distance from the
 //! circle − r).
 
-use crate::latency::pct;
-use crate::rig::{self, Streamer};
 use crate::Opts;
 use motion_bench::drive::{self, Binaries};
+use motion_bench::machine::{streamed_names, streamed_with};
 use motion_bench::outcome::Bench;
+use motion_bench::stream::{home_and_enable, Streamer};
 use motion_control::{Client, MS_COMMAND, MS_STREAMING, ST_FEEDBACK};
+use motion_report::nearest_rank as pct;
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
@@ -49,7 +50,7 @@ pub struct Circle {
 pub fn run(o: &Opts, b: &Binaries, bench: &Bench) -> Result<Circle, String> {
     let prefix = format!("mbs{}o", std::process::id());
     let sup = o.cycle.supervisor(&prefix);
-    let d = rig::daemon(b, &bench.tmp, &prefix, &rig::machine(&sup, 2))?;
+    let d = drive::start_machine(b, &bench.tmp, &prefix, &streamed_with(&sup, 2))?;
     let result = measure(o, &prefix);
     let _ = drive::stop_run(d, Duration::from_secs(20));
     let _ = drive::clean_leftovers(&prefix);
@@ -57,14 +58,14 @@ pub fn run(o: &Opts, b: &Binaries, bench: &Bench) -> Result<Circle, String> {
 }
 
 fn measure(o: &Opts, prefix: &str) -> Result<Circle, String> {
-    rig::prepare(prefix, 2)?;
+    home_and_enable(prefix, 2)?;
     let (r, hz) = (o.radius, o.hz);
     let w = 2.0 * std::f64::consts::PI * hz;
     let period = u64::from(o.cycle.period_us) * 1000;
     let dt = period as f64 * 1e-9;
     let streamer = Streamer::start(
         prefix,
-        rig::names(2),
+        streamed_names(2),
         period,
         (o.cycle.other_cpu(), o.client_priority),
         Box::new(move |k| {

@@ -4,11 +4,12 @@
 //! read back as the other slice benches read theirs; both variants home and
 //! enable the axes the same way, only the stream differs), as ratios.
 
-use crate::rig::{self, Streamer};
 use crate::Opts;
 use motion_bench::drive::{self, runs, Binaries};
+use motion_bench::machine::{streamed_names, streamed_with};
 use motion_bench::outcome::Bench;
 use motion_bench::slice::{Group, Slice};
+use motion_bench::stream::{home_and_enable, Streamer};
 use serde_json::{json, Value};
 use std::time::Duration;
 
@@ -64,7 +65,7 @@ fn one(
 ) -> Result<Slice, String> {
     let tag = format!("mbs{}c{i}{}", std::process::id(), u8::from(with_stream));
     let sup = o.cycle.supervisor(&tag);
-    let toml = rig::machine(&sup, AXES);
+    let toml = streamed_with(&sup, AXES);
     let start = bench.t0.elapsed();
     let (mut d, hlog) = runs::start(b, &bench.tmp, (&tag, &toml, &tag), len, &[])?;
     if let Err(e) = drive::wait_until_ready(&b.motionctl, &tag, &mut d, Duration::from_secs(20)) {
@@ -72,9 +73,9 @@ fn one(
         let _ = drive::clean_leftovers(&tag);
         return Err(format!("{tag}: {e} ({})", ended.describe()));
     }
-    rig::prepare(&tag, AXES)?;
+    home_and_enable(&tag, AXES)?;
     if with_stream {
-        let names = rig::names(AXES);
+        let names = streamed_names(AXES);
         let streamer = Streamer::start(
             &tag,
             names,

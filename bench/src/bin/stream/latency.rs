@@ -12,11 +12,13 @@
 //! setpoint overtaken in the same cycle by the next one (the program woke
 //! twice between two cycles) is never commanded exactly: counted apart.
 
-use crate::rig::{self, Streamer, COUNTS_PER_UNIT};
 use crate::Opts;
 use motion_bench::drive::{self, Binaries};
+use motion_bench::machine::{streamed_names, streamed_with, STREAMED_COUNTS_PER_UNIT};
 use motion_bench::outcome::Bench;
 use motion_bench::spy::Spy;
+use motion_bench::stream::{home_and_enable, Streamer};
+use motion_report::nearest_rank as pct;
 use serde::Serialize;
 use std::time::Duration;
 
@@ -37,12 +39,6 @@ pub struct Latency {
     pub spy_missed: u64,
 }
 
-/// Nearest-rank percentile of sorted `v`.
-pub fn pct(v: &[f64], p: f64) -> Option<f64> {
-    let k = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len().max(1));
-    v.get(k - 1).copied()
-}
-
 /// Runs one rate: a daemon at `period_us`, the spy, the ramp for `secs`.
 pub fn run(o: &Opts, b: &Binaries, bench: &Bench, period_us: u32) -> Result<Latency, String> {
     let prefix = format!("mbs{}l{period_us}", std::process::id());
@@ -50,7 +46,7 @@ pub fn run(o: &Opts, b: &Binaries, bench: &Bench, period_us: u32) -> Result<Late
         cycle_us: period_us,
         ..o.cycle.supervisor(&prefix)
     };
-    let d = rig::daemon(b, &bench.tmp, &prefix, &rig::machine(&sup, 1))?;
+    let d = drive::start_machine(b, &bench.tmp, &prefix, &streamed_with(&sup, 1))?;
     let result = measure(o, &prefix, period_us);
     let ended = drive::stop_run(d, Duration::from_secs(20));
     let _ = drive::clean_leftovers(&prefix);
@@ -62,14 +58,14 @@ pub fn run(o: &Opts, b: &Binaries, bench: &Bench, period_us: u32) -> Result<Late
 }
 
 fn measure(o: &Opts, prefix: &str, period_us: u32) -> Result<Latency, String> {
-    rig::prepare(prefix, 1)?;
+    home_and_enable(prefix, 1)?;
     let period = u64::from(period_us) * 1000;
     let step = 1.0 * period as f64 * 1e-9; // 1 unit/s
     let cap = (o.seconds * 1e6 / f64::from(period_us)) as usize * 2 + 1000;
     let mut spy = Spy::start(prefix, "io", o.cycle.other_cpu(), 70, cap, |_| {})?;
     let streamer = Streamer::start(
         prefix,
-        rig::names(1),
+        streamed_names(1),
         period,
         (o.cycle.other_cpu(), o.client_priority),
         Box::new(move |k| vec![k as f64 * step]),
@@ -81,7 +77,7 @@ fn measure(o: &Opts, prefix: &str, period_us: u32) -> Result<Latency, String> {
     if let Some(e) = rec.error {
         return Err(format!("spy: {e}"));
     }
-    let counts = |k: usize| ((k as f64 + 1.0) * step * COUNTS_PER_UNIT).round() as i64;
+    let counts = |k: usize| ((k as f64 + 1.0) * step * STREAMED_COUNTS_PER_UNIT).round() as i64;
     let (mut cycles, mut us, mut overtaken) = (Vec::new(), Vec::new(), 0);
     for (k, &t) in sent.iter().enumerate() {
         let after = rec.cmds.partition_point(|c| c.ts < t);

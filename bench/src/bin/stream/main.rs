@@ -6,13 +6,13 @@
 //! plant streaming a circle on two axes ([`circle`]). See `bench/README.md`
 //! and README "Performance".
 //!
-//! This file is the command line, the sequence and the report; [`rig`] is
-//! what the parts share (machine, daemon, the streaming program).
+//! This file is the command line, the sequence and the report; the machine
+//! and the streaming program are the harness's (`motion_harness::generated`,
+//! `motion_harness::stream`).
 
 mod circle;
 mod cost;
 mod latency;
-mod rig;
 
 use clap::Parser;
 use motion_bench::drive::Binaries;

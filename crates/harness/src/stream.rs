@@ -1,64 +1,21 @@
-//! What every part of the stream bench shares: the machine (N linear axes,
-//! immediate homing: homed where they stand, no motion), a daemon started
-//! and ready, its axes homed and enabled through the control service, and
-//! the streaming program — a thread of this process at the stream's rate
-//! that takes the axes over and publishes one setpoint per axis per tick
-//! through `motion_control`'s [`Stream`](motion_control::stream::Stream),
-//! the Rust client the issue asks for.
+//! A streaming program played by a test or bench: its axes homed and
+//! enabled through the control service ([`home_and_enable`]), then a thread
+//! of this process at the stream's rate ([`Streamer`]) that takes the axes
+//! over and publishes one setpoint per axis per tick through
+//! `motion_control`'s [`Stream`](motion_control::stream::Stream) — the
+//! Rust client a program uses, so what is measured is what a program sees.
 
-use motion_bench::drive::{self, Binaries};
-use motion_bench::machine::Supervisor;
-use motion_bench::proc::Running;
-use motion_control::{Axes, Client, Request, RESULT_ACCEPTED};
+use motion_control::{Axes, Client, Request, MS_SERVO_ACTION, RESULT_ACCEPTED, ST_HOMED};
 use motion_rt::{enter_realtime, now_ns, PeriodicTimer, RtConfig};
-use std::fmt::Write as _;
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-/// `counts_per_unit` of every axis: 1e5, so consecutive setpoints of the
-/// latency ramp (≥ 25 counts apart) are told apart in the command frames.
-pub const COUNTS_PER_UNIT: f64 = 1e5;
-
-/// A machine of `n` axes `A00`.. (immediate homing, all `home_order = 0`,
-/// travel ±1000, max_speed 100, stream_acceleration from home_acceleration
-/// 1000 → 10,000 u/s²).
-pub fn machine(s: &Supervisor, n: usize) -> String {
-    let mut t = format!(
-        "# Written by motion-bench stream: {n} linear axes, immediate homing.\n\
-         [supervisor]\ncycle_us = {}\ncpu = {}\npriority = {}\nio = \"sim\"\nservice_prefix = \"{}\"\n\n",
-        s.cycle_us, s.cpu, s.priority, s.service_prefix
-    );
-    for i in 0..n {
-        let _ = write!(
-            t,
-            "[[axis]]\nname = \"A{i:02}\"\ncounts_per_unit = {COUNTS_PER_UNIT}\n\
-             home_sequence = \"immediate\"\nhome_order = 0\nhome_speed = 10.0\n\
-             home_return_speed = 2.0\nhome_acceleration = 1000.0\nhome_deceleration = 1000.0\n\
-             max_speed = 100.0\ntravel_limits = [-1000.0, 1000.0]\n\
-             [axis.sim]\nstart = 0.0\nhard_stop = [-1100.0, 1100.0]\n\n"
-        );
-    }
-    t
-}
-
-/// The axis names of [`machine`].
-pub fn names(n: usize) -> Vec<String> {
-    (0..n).map(|i| format!("A{i:02}")).collect()
-}
-
-/// A daemon of `toml` under `prefix`, ready with its I/O process attached.
-pub fn daemon(b: &Binaries, tmp: &Path, prefix: &str, toml: &str) -> Result<Running, String> {
-    let cfg = tmp.join(format!("{prefix}.toml"));
-    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
-    drive::start_run(b, &cfg, prefix, Duration::from_secs(20)).map_err(|e| format!("{prefix}: {e}"))
-}
-
-/// Homes (immediate: no motion) and enables every axis, and waits until
-/// all are homed with their drives enabled.
-pub fn prepare(prefix: &str, n: usize) -> Result<(), String> {
+/// Homes (immediate homing: no motion) and enables every axis of the
+/// daemon under `prefix`, and waits until its first `n` axes are homed with
+/// their drives enabled.
+pub fn home_and_enable(prefix: &str, n: usize) -> Result<(), String> {
     let mut c = Client::connect(prefix, None).map_err(|e| e.to_string())?;
     let all = Axes::All;
     let home = Request::Home {
@@ -79,9 +36,8 @@ pub fn prepare(prefix: &str, n: usize) -> Result<(), String> {
         let st = c
             .status(Duration::from_secs(2))
             .map_err(|e| e.to_string())?;
-        let ready = st.axes().iter().take(n).all(|a| {
-            a.has(motion_control::ST_HOMED) && a.motion_has(motion_control::MS_SERVO_ACTION)
-        });
+        let ready =
+            (st.axes().iter().take(n)).all(|a| a.has(ST_HOMED) && a.motion_has(MS_SERVO_ACTION));
         if ready {
             return Ok(());
         }

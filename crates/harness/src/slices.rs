@@ -3,10 +3,11 @@
 //! (`motion_harness::runs` starts one and reads it back) and report each
 //! variant as one.
 
-use crate::drive::Measured;
-use crate::{histogram, hlog, percentiles};
+use crate::runs::Measured;
 use hdrhistogram::Histogram;
 use motion_report::{Latency, Percentiles};
+use motion_supervisor::hlog;
+use motion_supervisor::stats::{histogram, percentiles};
 use serde_json::{json, Value};
 use std::time::Duration;
 
