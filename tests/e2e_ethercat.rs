@@ -632,7 +632,28 @@ fn drive_side_homing_in_mode_6() {
     let Some(b) = Bus::start("ecat_drivehome", &machine, |_| {}) else {
         return;
     };
-    let (v, stderr) = home(&b);
+    // A homing the host broke (the bus thread or the emulator descheduled
+    // for several cycles: the drive counted lost, its homing aborted 12/46,
+    // the summary counts the loss) is made again, at most twice more: the
+    // subject here is the drive's homing, not a starved host. Any other
+    // failure fails the test.
+    let mut attempt = 0;
+    let (v, stderr) = loop {
+        attempt += 1;
+        let run = supervisor(&["home", "--json", "--config", b.cfg.arg()]);
+        let lost = !run.stderr.contains(" 0 drive loss(es)");
+        if run.status.and_then(|s| s.code()) == Some(1) && lost && attempt < 3 {
+            eprintln!(
+                "attempt {attempt}: a drive was lost (host stall), again:\n{}",
+                run.stderr
+            );
+            assert_clean(&b.cfg.prefix);
+            continue;
+        }
+        let v: HomeReport = run.expect_code(0).report();
+        assert_clean(&b.cfg.prefix);
+        break (v, run.stderr);
+    };
     assert!(
         stderr.contains("drive homing: method 19 (positive home switch)"),
         "{stderr}"

@@ -296,8 +296,10 @@ fn stop_time(r: &mut Rig) -> (f64, u64, f64) {
     let c0 = r.backend.bus_status().cycles;
     let mut fb = motion_frames::FeedbackFrame::ZERO;
     loop {
-        std::thread::sleep(CYCLE);
+        // the stop right after the last set-point (a sleep first would let
+        // the bus repeat that set-point: an ideal follower then stands still)
         r.backend.watchdog_stop(0.001, &mut fb);
+        std::thread::sleep(CYCLE);
         let v = r.drive(0);
         if v.state == State::SwitchOnDisabled {
             let cycles = r.backend.bus_status().cycles.saturating_sub(c0);

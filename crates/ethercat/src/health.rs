@@ -37,6 +37,13 @@ pub const PROBE_INTERVAL_NS: u64 = 200_000_000;
 /// Frames in a row that nobody answered before every SubDevice counts as
 /// not answering.
 pub const SILENT_FRAMES: u32 = 3;
+/// Cycles in a row a SubDevice must be out of OP (or not answer in a frame
+/// that came back) before it is lost. One such cycle is only a missing
+/// sample (its axes' data is invalid that cycle): a late frame matched to
+/// the wrong cycle reads every AL status as unanswered, and on a loaded
+/// host that happened about once in 2,000 cycles — a "lost" drive in the
+/// middle of a drive-side homing.
+pub const LOST_CYCLES: u32 = 3;
 
 /// The SubDevices of the group.
 pub(crate) struct Devices {
@@ -51,6 +58,8 @@ pub(crate) struct Devices {
     silent_frames: u32,
     /// Lost this cycle.
     lost: Vec<bool>,
+    /// Cycles in a row out of OP or not answering (see [`LOST_CYCLES`]).
+    quiet: Vec<u32>,
     health: Vec<Health>,
     last_recovery: Vec<u64>,
     last_probe: Vec<u64>,
@@ -69,6 +78,7 @@ impl Devices {
             states: vec![SubDeviceState::None; count],
             silent_frames: 0,
             lost: vec![false; count],
+            quiet: vec![0; count],
             health: vec![Health::Ok; count],
             last_recovery: vec![0; count],
             last_probe: vec![0; count],
@@ -96,6 +106,8 @@ impl Devices {
         self.silent_frames = self.silent_frames.saturating_add(1);
         if self.silent_frames >= SILENT_FRAMES {
             for i in 0..self.count() {
+                // the silent frames were the wait: lost at once
+                self.quiet[i] = self.quiet[i].max(LOST_CYCLES);
                 self.answering[i] = false;
                 self.states[i] = SubDeviceState::None;
                 self.not_op_since[i].get_or_insert(done);
@@ -108,6 +120,11 @@ impl Devices {
         self.silent_frames = 0;
         self.answering[i] = state != SubDeviceState::None;
         self.states[i] = state;
+        self.quiet[i] = if state == SubDeviceState::Op {
+            0
+        } else {
+            self.quiet[i].saturating_add(1)
+        };
         match (state == SubDeviceState::Op, self.not_op_since[i]) {
             (true, Some(_)) => {
                 self.not_op_since[i] = None;
@@ -123,7 +140,10 @@ impl Devices {
     /// publishes every change of health.
     pub fn update(&mut self, shared: &Shared, counting: bool) {
         for i in 0..self.count() {
-            self.lost[i] = counting && self.mapped[i] && self.not_op_since[i].is_some();
+            self.lost[i] = counting
+                && self.mapped[i]
+                && self.not_op_since[i].is_some()
+                && self.quiet[i] >= LOST_CYCLES;
             if !counting || !self.mapped[i] {
                 continue;
             }

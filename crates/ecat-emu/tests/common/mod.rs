@@ -13,7 +13,8 @@ use motion_config::EthercatBus;
 use motion_ethercat::EthercatBackend;
 use motion_frames::backend::Backend;
 use motion_frames::{
-    AxisCommand, AxisFeedback, CommandFrame, FeedbackFrame, CW_ENABLE, SW_ENABLED, SW_NO_DATA,
+    AxisCommand, AxisFeedback, CommandFrame, FeedbackFrame, CW_ENABLE, CW_FAULT_RESET, SW_ENABLED,
+    SW_FAULT, SW_NO_DATA,
 };
 
 pub const CYCLE: Duration = Duration::from_millis(1);
@@ -155,6 +156,17 @@ impl Rig {
         let a = self.axis(i);
         a.target_position = at;
         a.control_word = CW_ENABLE;
+        // A drive that a stalled host made "lost" while it enabled comes
+        // back faulted (never enabled by itself): reset it, as an operator
+        // would, and enable again.
+        self.until_axis(i, "enabled or faulted", |a| {
+            a.status_word & (SW_ENABLED | SW_FAULT) != 0
+        });
+        if self.fb.axes[i].status_word & SW_ENABLED == 0 {
+            self.axis(i).control_word = CW_ENABLE | CW_FAULT_RESET;
+            self.until_axis(i, "reset", |a| a.status_word & SW_FAULT == 0);
+            self.axis(i).control_word = CW_ENABLE;
+        }
         self.until_axis(i, "enabled", |a| a.status_word & SW_ENABLED != 0);
     }
 
