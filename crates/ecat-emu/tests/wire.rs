@@ -398,10 +398,19 @@ fn watchdog_stop_ramps_down_then_disables_with_a_fault() {
         assert!(t0.elapsed() < Duration::from_secs(3), "{:?}", fb.axes[0]);
     }
     eprintln!("watchdog stop done after {calls} calls");
-    let v = r.drive(0);
+    // done as the backend sees it; a drive a stalled host made "lost" for
+    // a few cycles is not waited for (its ramp and SM watchdog stop it):
+    // the drive itself comes to rest, disabled, soon after either way
+    let t1 = Instant::now();
+    let v = loop {
+        let v = r.drive(0);
+        if v.velocity == 0.0 && !v.enabled {
+            break v;
+        }
+        assert!(t1.elapsed() < Duration::from_secs(2), "not at rest: {v:?}");
+        std::thread::sleep(CYCLE);
+    };
     eprintln!("stopped at {} (last set-point 4.0): {v:?}", v.position);
-    assert_eq!(v.velocity, 0.0);
-    assert!(!v.enabled);
     // where it stops depends on where the quick stop found it (a late test
     // thread lets the bus repeat a set-point, i.e. stop the axis, first):
     // not asserted
