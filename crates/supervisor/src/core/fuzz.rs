@@ -222,13 +222,18 @@ fn garbage_feedback_never_becomes_feedback_nor_motion() {
                         let d = axis_to_feedback(&f.axes[j], a.engine.counts_per_unit);
                         let virtual_axis = a.engine.configuration == AxisConfiguration::Virtual;
                         if bad(&d, a.engine.max_position) && !virtual_axis {
+                            // never taken as a position: the one before
+                            // stays, or none is known any more (bad samples
+                            // count as missing: enough of them are a loss)
                             let after = b.core.axes()[j].engine().raw_position();
-                            prop_assert_eq!(
-                                after.map(f64::to_bits),
-                                before[j].map(f64::to_bits),
-                                "axis {} took {:?}",
+                            prop_assert!(
+                                after.is_none()
+                                    || after.map(f64::to_bits) == before[j].map(f64::to_bits),
+                                "axis {} took {:?}: {:?} -> {:?}",
                                 a.name,
-                                d
+                                d,
+                                before[j],
+                                after
                             );
                         }
                     }
