@@ -351,7 +351,9 @@ mod tests {
         let cut = Instant::now() + Duration::from_secs(30);
         let mut a = attach(&motionctl, "p", &plan, cut).unwrap();
         let t = Instant::now();
-        while t.elapsed() < Duration::from_millis(600) {
+        // long enough for every kind to be made at least once on a loaded
+        // host (a fork and exec of the fake motionctl per request)
+        while t.elapsed() < Duration::from_millis(1500) {
             a.poll();
             std::thread::sleep(Duration::from_millis(5));
         }
@@ -363,7 +365,7 @@ mod tests {
             "{c:?}"
         );
         assert!(
-            (3..=13).contains(&status.made) && status.failed == 0,
+            (3..=31).contains(&status.made) && status.failed == 0,
             "{c:?}"
         );
         assert_eq!(status.ms.len() as u64, status.made);
