@@ -200,35 +200,18 @@ impl SetpointPublisher {
         t_ns: u64,
         fill: impl FnOnce(&mut [SetpointAxis; MAX_AXES]) -> usize,
     ) -> Result<u64, IpcError> {
-        let mut uninit = self
-            .publisher
-            .loan_uninit()
-            .map_err(|error| IpcError::Loan {
-                service: self.label.clone(),
-                error,
-            })?;
-        // SAFETY: the loaned payload is a properly aligned, exclusively
-        // owned SetpointFrame; `placement_default` writes every field (no
-        // implicit padding), so it is initialized before `assume_init`.
-        let mut sample = unsafe {
-            SetpointFrame::placement_default(uninit.payload_mut().as_mut_ptr());
-            uninit.assume_init()
-        };
-        let f = sample.payload_mut();
-        let count = fill(&mut f.axes).min(MAX_AXES);
         self.seq += 1;
-        f.layout_version = SETPOINT_LAYOUT;
-        f.session = self.session;
-        f.key = self.key;
-        f.token = token;
-        f.seq = self.seq;
-        f.t_ns = t_ns;
-        f.count = count as u32;
-        sample.send().map_err(|error| IpcError::Send {
-            service: self.label.clone(),
-            error,
+        let (seq, session, key) = (self.seq, self.session, self.key);
+        self.publish_raw(|f| {
+            f.count = fill(&mut f.axes).min(MAX_AXES) as u32;
+            f.layout_version = SETPOINT_LAYOUT;
+            f.session = session;
+            f.key = key;
+            f.token = token;
+            f.seq = seq;
+            f.t_ns = t_ns;
         })?;
-        Ok(self.seq)
+        Ok(seq)
     }
 
     /// Publishes a frame exactly as `fill` writes it (on an all-zero frame;
