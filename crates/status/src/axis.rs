@@ -230,6 +230,12 @@ impl AxisStatusEntry {
         self.flags & motion_mask() != 0
     }
 
+    /// Which operation moves the axis, by its row's name (`jogging`,
+    /// `moving`, `streaming`), if one does.
+    pub fn in_motion_as(&self) -> Option<&'static str> {
+        IN_MOTION.iter().copied().find(|n| self.flags & mask(&[n]) != 0)
+    }
+
     /// The row named `name`.
     pub fn row(name: &str) -> Option<&'static crate::schema::Row> {
         ROWS.iter().find(|r| r.name == name)

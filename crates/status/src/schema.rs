@@ -351,7 +351,8 @@ pub fn get<S, T>(source: &S, getter: impl Fn(&S) -> T) -> T {
 /// * the typed JSON row `$json` (`name`, `io`, `phase`, then a field per
 ///   row named as the row, its key the row's JSON key, then `owner`,
 ///   `error`, `warnings`), `$json::from_entry` (the rows' part) and
-///   `$json::marks` (the flags column of `motionctl status`).
+///   `$json::marks` (the flags column of `motionctl status`) with its
+///   header `$json::marks_header`.
 #[macro_export]
 macro_rules! status_table {
     (
@@ -437,6 +438,11 @@ macro_rules! status_table {
                 $crate::schema::marks(&[$(
                     ($crate::__opt!($mark), $crate::__flag!($ty, self.$name)),
                 )+])
+            }
+
+            /// The flags column's header: every mark.
+            pub fn marks_header() -> String {
+                $crate::schema::marks(&[$(($crate::__opt!($mark), true),)+])
             }
         }
     };
