@@ -32,7 +32,7 @@ fn wait_axis(d: &Daemon, name: &str, secs: u64, f: impl Fn(&AxisStatus) -> bool)
 
 /// At rest: no operation motion, not stopping.
 fn at_rest(a: &AxisStatus) -> bool {
-    !a.jogging && !a.moving && !a.streaming && !a.stopping && !a.op.ip
+    !a.jogging && !a.moving && !a.streaming && !a.stopping && !a.op_ip
 }
 
 fn pos(a: &AxisStatus) -> f64 {

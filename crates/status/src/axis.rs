@@ -23,6 +23,7 @@
 //! CIP attributes and bits where CIP has one.
 
 use crate::entry::AxisStatusEntry;
+use crate::schema::{Area, Row};
 use crate::snap::{LostCause, Source, W_DRIFT, W_REFERENCE_INVALIDATED, W_SWITCH_DRIFT};
 use motion_homing::{effective_search_limit, HomeDirection, HomeMode, HomeSequence};
 use motion_homing::{OpKind, StopCause};
@@ -224,7 +225,28 @@ pub fn motion_mask() -> u64 {
     mask(IN_MOTION)
 }
 
+/// A row's value in an entry, by the row's type (for the layers that walk
+/// the table: OPC UA).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Reading {
+    Flag(bool),
+    /// A number; `None`: no value (a NaN or infinite one is none either).
+    Number(Option<f64>),
+    /// An integer or an enumeration's number.
+    Int(u32),
+}
+
 impl AxisStatusEntry {
+    /// The value of `row` in this entry.
+    pub fn reading(&self, row: &Row) -> Reading {
+        let p = row.place as usize;
+        match row.ty.area() {
+            Area::Flags => Reading::Flag(p < 64 && self.flags >> p & 1 != 0),
+            Area::Ints => Reading::Int(self.ints.get(p).copied().unwrap_or(0)),
+            Area::Values => Reading::Number(self.values.get(p).copied().filter(|v| v.is_finite())),
+        }
+    }
+
     /// An operation moves the axis (a jog, a move or a stream runs).
     pub fn in_motion(&self) -> bool {
         self.flags & motion_mask() != 0
@@ -237,7 +259,7 @@ impl AxisStatusEntry {
     }
 
     /// The row named `name`.
-    pub fn row(name: &str) -> Option<&'static crate::schema::Row> {
+    pub fn row(name: &str) -> Option<&'static Row> {
         ROWS.iter().find(|r| r.name == name)
     }
 }

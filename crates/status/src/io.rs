@@ -197,3 +197,22 @@ const _: () = {
     assert!(offset_of!(IoStatusEntry, start_error) == 144);
     assert!(size_of::<IoStatusEntry>() == 144 + START_ERROR_LEN);
 };
+
+/// A report row reads as its counters (`io.frames_received`): they are its
+/// body, the name and the rest only label them.
+impl core::ops::Deref for IoReport {
+    type Target = IoCounters;
+
+    fn deref(&self) -> &IoCounters {
+        &self.counters
+    }
+}
+
+/// As [`IoReport`]'s.
+impl core::ops::Deref for IoStatus {
+    type Target = IoCounters;
+
+    fn deref(&self) -> &IoCounters {
+        &self.counters
+    }
+}

@@ -6,7 +6,7 @@
 use super::{AxisKeep, AxisNote};
 use crate::shared::Snapshot;
 use motion_config::MachineConfig;
-use motion_control::{W_DRIFT, W_SWITCH_DRIFT};
+use motion_status::snap::{W_DRIFT, W_SWITCH_DRIFT};
 use motion_homing::{HomeMode, HomeSequence};
 use motion_state::{RecordEntry, RecordKind};
 
