@@ -89,7 +89,12 @@ fn a_snapshot_travels_through_the_entry_into_the_json_row() {
     assert_eq!(v["jogging"], true);
     assert_eq!(v["command"], 12.25, "the JSON key, not the field's name");
     assert!(v["event_raw"].is_null(), "a value that is not there is null");
-    assert_eq!(j.marks(), ".. .. .. .. .. .J......s.");
+    let (marks, header) = (j.marks(), AxisStatus::marks_header());
+    assert!(header.starts_with("EN DN ER IP PC SJMTxF-+sm"), "{header}");
+    assert_eq!(marks.len(), header.len());
+    let set = marks.chars().zip(header.chars()).filter(|&(m, _)| m != '.' && m != ' ');
+    let set: String = set.map(|(m, h)| if m == h { m } else { '?' }).collect();
+    assert_eq!(set, "Js", "{marks} under {header}");
 }
 
 #[test]
