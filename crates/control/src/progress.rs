@@ -72,7 +72,12 @@ impl Progress {
     /// move, stream).
     pub fn show_motion(&mut self, st: &StatusFrame, members: &[usize]) {
         let shown = motion_status::axis::mask(&["er", "stopping", "op_pc"]);
-        self.draw(st, members, Self::motion_line, shown | motion_status::axis::motion_mask());
+        self.draw(
+            st,
+            members,
+            Self::motion_line,
+            shown | motion_status::axis::motion_mask(),
+        );
     }
 
     /// Shows the axes `members` of `st`.

@@ -198,7 +198,11 @@ impl StatusFrame {
             cycle: self.cycle,
             cycle_us: self.cycle_us,
             uptime_ms: self.uptime_ns / 1_000_000,
-            axes: self.axes().iter().map(|a| a.to_status(&names, &ios)).collect(),
+            axes: self
+                .axes()
+                .iter()
+                .map(|a| a.to_status(&names, &ios))
+                .collect(),
             io: self.ios().iter().map(IoStatusEntry::to_status).collect(),
             stream: self.stream,
         }

@@ -36,8 +36,7 @@ pub fn home_and_enable(prefix: &str, n: usize) -> Result<(), String> {
         let st = c
             .status(Duration::from_secs(2))
             .map_err(|e| e.to_string())?;
-        let ready =
-            (st.axes().iter().take(n)).all(|a| a.homed() && a.servo_action());
+        let ready = (st.axes().iter().take(n)).all(|a| a.homed() && a.servo_action());
         if ready {
             return Ok(());
         }

@@ -149,7 +149,9 @@ pub static AXIS_LIVE: LazyLock<Vec<LiveVar>> = LazyLock::new(|| {
     let rows = motion_status::axis::ROWS.iter().filter_map(LiveVar::row);
     rows.chain([
         LiveVar::text("Phase", |a, _| a.phase_text()),
-        LiveVar::text("Message", |a, names| a.error_text(names).unwrap_or_default()),
+        LiveVar::text("Message", |a, names| {
+            a.error_text(names).unwrap_or_default()
+        }),
         LiveVar::text("Warnings", |a, _| a.warning_texts().join("; ")),
     ])
     .collect()
@@ -210,15 +212,23 @@ pub const IO_VARS: &[IoVar] = &[
         data_type: DataTypeId::Boolean,
         read: |i| Variant::from(i.attached != 0),
     },
-    io_var!("FramesReceived", |i| Variant::from(i.counters.frames_received)),
-    io_var!("FramesMissing", |i| Variant::from(i.counters.frames_missing)),
-    io_var!("FramesRefused", |i| Variant::from(i.counters.frames_refused)),
+    io_var!("FramesReceived", |i| Variant::from(
+        i.counters.frames_received
+    )),
+    io_var!("FramesMissing", |i| Variant::from(
+        i.counters.frames_missing
+    )),
+    io_var!("FramesRefused", |i| Variant::from(
+        i.counters.frames_refused
+    )),
     io_var!("Attachments", |i| Variant::from(i.counters.attachments)),
     io_var!("Gaps1", |i| Variant::from(i.counters.gaps.one)),
     io_var!("Gaps2To3", |i| Variant::from(i.counters.gaps.two_to_three)),
     io_var!("Gaps4To10", |i| Variant::from(i.counters.gaps.four_to_ten)),
     io_var!("GapsOver10", |i| Variant::from(i.counters.gaps.over_ten)),
-    io_var!("LongestGapCycles", |i| Variant::from(i.counters.gaps.longest_cycles)),
+    io_var!("LongestGapCycles", |i| Variant::from(
+        i.counters.gaps.longest_cycles
+    )),
     io_var!("GapCycles", |i| Variant::from(i.counters.gap_cycles)),
 ];
 
@@ -244,8 +254,14 @@ mod tests {
     #[test]
     fn names_are_unique_and_cover_the_spec() {
         let mut names: Vec<&str> = AXIS_LIVE.iter().map(|v| v.name).collect();
-        let published = motion_status::axis::ROWS.iter().filter(|r| r.opcua.is_some());
-        assert_eq!(AXIS_LIVE.len(), published.count() + 3, "every named row, and the texts");
+        let published = motion_status::axis::ROWS
+            .iter()
+            .filter(|r| r.opcua.is_some());
+        assert_eq!(
+            AXIS_LIVE.len(),
+            published.count() + 3,
+            "every named row, and the texts"
+        );
         names.extend(AXIS_CONFIG.iter().map(|v| v.name));
         let n = names.len();
         names.sort();
@@ -261,7 +277,10 @@ mod tests {
             assert_eq!(v.data_type, DataTypeId::UInt16, "{i}");
         }
         let modes = AXIS_LIVE.iter().find(|v| v.name == "HomeMode").unwrap();
-        assert_eq!(modes.enum_names.as_deref(), Some(&["passive", "active", "absolute"][..]));
+        assert_eq!(
+            modes.enum_names.as_deref(),
+            Some(&["passive", "active", "absolute"][..])
+        );
         for t in ["Phase", "Message", "Warnings"] {
             let v = AXIS_LIVE.iter().find(|v| v.name == t).unwrap();
             assert_eq!(v.data_type, DataTypeId::String, "{t}");

@@ -255,7 +255,10 @@ impl AxisStatusEntry {
     /// Which operation moves the axis, by its row's name (`jogging`,
     /// `moving`, `streaming`), if one does.
     pub fn in_motion_as(&self) -> Option<&'static str> {
-        IN_MOTION.iter().copied().find(|n| self.flags & mask(&[n]) != 0)
+        IN_MOTION
+            .iter()
+            .copied()
+            .find(|n| self.flags & mask(&[n]) != 0)
     }
 
     /// The row named `name`.

@@ -17,7 +17,9 @@ fn cell(s: &str) -> String {
 }
 
 fn code(s: Option<&str>) -> String {
-    s.map_or("–".to_string(), |s| format!("`{}`", s.replace('|', "\\|")))
+    s.map_or("–".to_string(), |s| {
+        format!("`{}`", s.replace('|', "\\|"))
+    })
 }
 
 /// `docs/status.md`: every status field of an axis with its JSON key, OPC UA

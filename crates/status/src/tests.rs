@@ -13,18 +13,34 @@ fn every_place_key_and_name_is_unique_and_in_the_room() {
     let (mut names, mut keys, mut opcua) = (HashSet::new(), HashSet::new(), HashSet::new());
     for r in ROWS {
         let area = r.ty.area();
-        assert!((r.place as usize) < area.room(), "{}: past the room of {area:?}", r.name);
-        assert!(places.insert((area, r.place)), "{}: its place is taken", r.name);
+        assert!(
+            (r.place as usize) < area.room(),
+            "{}: past the room of {area:?}",
+            r.name
+        );
+        assert!(
+            places.insert((area, r.place)),
+            "{}: its place is taken",
+            r.name
+        );
         assert!(names.insert(r.name), "{} twice", r.name);
         assert!(keys.insert(r.json), "JSON key {} twice", r.json);
         if let Some(o) = r.opcua {
             assert!(opcua.insert(o), "OPC UA name {o} twice");
         }
-        assert!(r.mark.is_none() || area == Area::Flags, "{}: a mark on a non-flag", r.name);
+        assert!(
+            r.mark.is_none() || area == Area::Flags,
+            "{}: a mark on a non-flag",
+            r.name
+        );
         assert!(!r.doc_line().is_empty(), "{}: no doc", r.name);
     }
     // The spec's names, with these types.
-    for (name, key) in [("homed", "HomedStatus"), ("homing", "HomingStatus"), ("pc", "PC")] {
+    for (name, key) in [
+        ("homed", "HomedStatus"),
+        ("homing", "HomingStatus"),
+        ("pc", "PC"),
+    ] {
         let r = AxisStatusEntry::row(name).unwrap();
         assert!(matches!(r.ty, Type::Flag) && r.opcua == Some(key), "{name}");
     }
@@ -77,22 +93,43 @@ fn a_snapshot_travels_through_the_entry_into_the_json_row() {
     fill(&mut e, &Source::new(&a, &cfg, &note, 9_000_000_000));
     assert!(e.homed() && e.jogging() && e.in_motion() && e.switch() && e.feedback());
     assert!(!e.enabled() && e.drive_lost() && !e.moving() && e.warn_drift());
-    assert_eq!((e.err(), e.exerr(), e.op_id(), e.aborted_by()), (12, 40, 7, 3));
-    assert_eq!((e.home_mode(), e.op_kind(), e.last_stop()), ("active", "jog", "lease_expired"));
-    assert_eq!((e.position(), e.cmd_position(), e.elapsed_s()), (Some(12.5), Some(12.25), 2.5));
-    assert_eq!((e.event_raw(), e.skew(), e.drift()), (None, None, Some(0.125)));
+    assert_eq!(
+        (e.err(), e.exerr(), e.op_id(), e.aborted_by()),
+        (12, 40, 7, 3)
+    );
+    assert_eq!(
+        (e.home_mode(), e.op_kind(), e.last_stop()),
+        ("active", "jog", "lease_expired")
+    );
+    assert_eq!(
+        (e.position(), e.cmd_position(), e.elapsed_s()),
+        (Some(12.5), Some(12.25), 2.5)
+    );
+    assert_eq!(
+        (e.event_raw(), e.skew(), e.drift()),
+        (None, None, Some(0.125))
+    );
 
     let j = AxisStatus::from_entry(&e);
     assert!(j.homed && j.jogging && !j.moving && j.warn_drift);
-    assert_eq!((j.position, j.event_raw, j.home_mode.as_str()), (Some(12.5), None, "active"));
+    assert_eq!(
+        (j.position, j.event_raw, j.home_mode.as_str()),
+        (Some(12.5), None, "active")
+    );
     let v = serde_json::to_value(&j).unwrap();
     assert_eq!(v["jogging"], true);
     assert_eq!(v["command"], 12.25, "the JSON key, not the field's name");
-    assert!(v["event_raw"].is_null(), "a value that is not there is null");
+    assert!(
+        v["event_raw"].is_null(),
+        "a value that is not there is null"
+    );
     let (marks, header) = (j.marks(), AxisStatus::marks_header());
     assert!(header.starts_with("EN DN ER IP PC SJMTxF-+sm"), "{header}");
     assert_eq!(marks.len(), header.len());
-    let set = marks.chars().zip(header.chars()).filter(|&(m, _)| m != '.' && m != ' ');
+    let set = marks
+        .chars()
+        .zip(header.chars())
+        .filter(|&(m, _)| m != '.' && m != ' ');
     let set: String = set.map(|(m, h)| if m == h { m } else { '?' }).collect();
     assert_eq!(set, "Js", "{marks} under {header}");
 }

@@ -21,8 +21,8 @@ mod outcome;
 use crate::shared::{Ack, Snapshot};
 use absolute::Absolute;
 use motion_config::MachineConfig;
-use motion_status::snap::{W_DRIFT, W_SWITCH_DRIFT};
 use motion_state::{DriftHistory, HomingRecord, RecordEntry, StateDir};
+use motion_status::snap::{W_DRIFT, W_SWITCH_DRIFT};
 
 pub use identity::identity;
 
