@@ -75,7 +75,7 @@ impl Type {
     /// An enumeration's spellings by number, from 0 (empty for other types).
     pub fn enum_names(&self) -> Vec<&'static str> {
         match self {
-            Type::Enum(name) => (0..).map_while(|n| name(n)).collect(),
+            Type::Enum(name) => (0..).map_while(name).collect(),
             _ => Vec::new(),
         }
     }
