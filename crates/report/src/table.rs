@@ -91,15 +91,15 @@ fn opt(x: Option<f64>, width: usize) -> String {
     }
 }
 
+/// The width of the first column: the longest axis name (at least the
+/// header's "axis"), and two spaces.
+fn name_width<'a>(names: impl Iterator<Item = &'a str>) -> usize {
+    names.map(|n| n.chars().count()).max().unwrap_or(4).max(4) + 2
+}
+
 /// One row per axis, as `home` prints it; errors and warnings on a line below.
 pub fn axis_results(rows: &[AxisResult]) -> String {
-    let w = rows
-        .iter()
-        .map(|r| r.name.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4)
-        + 2;
+    let w = name_width(rows.iter().map(|r| r.name.as_str()));
     let mut s = format!(
         "{:<w$}{:<8}{:<20}{:<24}{:>4}{:>4}{:>10}{:>7}{:>12}{:>12}{:>12}{:>9}\n",
         "axis",
@@ -151,14 +151,7 @@ pub fn axis_results(rows: &[AxisResult]) -> String {
 /// column is the status table's marks (`motion_status::axis`: each marked
 /// flag's mark when set, dots when not; the legend is `docs/status.md`).
 pub fn status(r: &crate::StatusReport) -> String {
-    let w = r
-        .axes
-        .iter()
-        .map(|a| a.name.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4)
-        + 2;
+    let w = name_width(r.axes.iter().map(|a| a.name.as_str()));
     let every = crate::AxisStatus::marks_header();
     let fw = every.chars().count() + 2;
     let mut s = format!(
@@ -257,13 +250,7 @@ pub fn status(r: &crate::StatusReport) -> String {
 
 /// One row per axis, as `move`, `jog` and `stream` print how they ended.
 pub fn motion_rows(rows: &[crate::MotionRow]) -> String {
-    let w = rows
-        .iter()
-        .map(|r| r.name.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4)
-        + 2;
+    let w = name_width(rows.iter().map(|r| r.name.as_str()));
     let mut s = format!(
         "{:<w$}{:>4}{:>4}{:>10}{:>12}{:>14}{:>12}\n",
         "axis", "PC", "ER", "ERR/EXERR", "position", "follow err max", "final err"
