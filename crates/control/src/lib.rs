@@ -13,8 +13,8 @@
 //!   [`Reason`]); the `REASON_*`/`RESULT_*` numbers are written there.
 //! * [`client`] — what `motionctl` (and any Rust HMI) uses: join the
 //!   supervisor's domain through its session file, send requests, read status.
-//! * [`ops`] — enable, disable, reset, move and the hold-to-run [`Jog`]
-//!   for Rust clients; [`stream`] — the supervised setpoint stream's
+//! * [`ops`] — any operation of the engine with its spec, and the
+//!   hold-to-run [`Jog`], for Rust clients; [`stream`] — the supervised setpoint stream's
 //!   [`stream::Stream`] handle and the acquire answer's axis map;
 //!   [`follow`] — following operations to their end in the status.
 //! * [`server`] — the daemon's side: serve requests and publish status, off
@@ -40,7 +40,8 @@ pub mod stream;
 
 pub use client::{Client, ClientError};
 pub use message::*;
-pub use ops::{Jog, JogSpec, MoveSpec, OpError};
+pub use motion_homing::{JogSpec, MoveSpec, OpKind, Operation};
+pub use ops::{Jog, OpError};
 pub use request::{Axes, DecodeError, Request, Since};
 pub use response::{AxisOutcome, Reason};
 pub use server::{Server, ServerError};
