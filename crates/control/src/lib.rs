@@ -40,7 +40,7 @@ pub mod stream;
 
 pub use client::{Client, ClientError};
 pub use message::*;
-pub use motion_homing::{JogSpec, MoveSpec, OpKind, Operation};
+pub use motion_homing::{params, JogSpec, MoveSpec, OpKind, Operation};
 pub use ops::{Jog, OpError};
 pub use request::{Axes, DecodeError, Request, Since};
 pub use response::{AxisOutcome, Reason};
