@@ -1,6 +1,6 @@
 """ctypes mirrors of the supervisor's wire structs and their numbers.
 
-The control plane's messages (crates/control/src/message.rs, layout 3) and
+The control plane's messages (crates/control/src/message.rs, layout 4) and
 the setpoint frame (crates/frames/src/setpoint.rs, layout 1). Every struct,
 field and constant here is compared, field by field (name, offset, size,
 alignment, type), against `layout.json`, which the Rust side writes from
@@ -15,7 +15,7 @@ This module needs nothing but the standard library.
 import ctypes
 
 # ---- sizes and versions ---------------------------------------------------
-CONTROL_LAYOUT = 3
+CONTROL_LAYOUT = 4
 SETPOINT_LAYOUT = 1
 NAME_LEN = 32
 MAX_AXES = 64
@@ -26,15 +26,15 @@ DATA_LEN = 32 * 1024
 PHASE_LEN = 16
 NO_INDEX = 0xFFFF
 NO_AXIS = 0xFF
+OP_SLOTS = 8
 
 # ---- request kinds, flags, results, refusal reasons -----------------------
 REQ_HOME, REQ_STOP, REQ_UNHOME, REQ_STATUS = 1, 2, 3, 4
 REQ_STATS, REQ_TRACE, REQ_TRACE_FETCH, REQ_HLOG = 5, 6, 7, 8
-REQ_ENABLE, REQ_DISABLE, REQ_RESET = 9, 10, 11
-REQ_JOG, REQ_JOG_RENEW, REQ_MOVE = 12, 13, 14
+REQ_OPERATE, REQ_JOG_RENEW = 9, 13
 REQ_STREAM_ACQUIRE, REQ_STREAM_RELEASE = 15, 16
 FLAG_RESET, FLAG_SINCE_RESET, FLAG_PARALLEL = 1, 2, 4
-FLAG_RELATIVE, FLAG_SUPERSEDE, FLAG_END = 8, 16, 32
+FLAG_END = 32
 RESULT_ACCEPTED, RESULT_REFUSED, RESULT_BAD_REQUEST = 0, 1, 2
 RESULT_FORBIDDEN, RESULT_NOT_READY = 3, 4
 REASON_NONE, REASON_UNKNOWN_AXIS, REASON_ALREADY_HOMING = 0, 1, 2
@@ -66,21 +66,18 @@ class ControlRequest(ctypes.Structure):
         ("axis_count", ctypes.c_uint32),
         ("offset", ctypes.c_uint64),
         ("timeout_s", ctypes.c_double),
-        ("position", ctypes.c_double),
-        ("speed", ctypes.c_double),
-        ("accel", ctypes.c_double),
-        ("decel", ctypes.c_double),
         ("token", ctypes.c_uint64),
         ("node_id", ctypes.c_uint64 * 2),
-        ("lease_ms", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
-        ("owner", ctypes.c_uint8 * NAME_LEN),
+        ("op", ctypes.c_uint32),
+        ("switches", ctypes.c_uint32),
+        ("values", ctypes.c_double * OP_SLOTS),
+        ("name", ctypes.c_uint8 * NAME_LEN),
         ("axes", (ctypes.c_uint8 * NAME_LEN) * MAX_AXES),
     ]
 
     @staticmethod
     def type_name() -> str:
-        return "motion_control::ControlRequest@3"
+        return "motion_control::ControlRequest@4"
 
 
 class AxisAnswer(ctypes.Structure):
@@ -116,7 +113,7 @@ class ControlResponse(ctypes.Structure):
 
     @staticmethod
     def type_name() -> str:
-        return "motion_control::ControlResponse@3"
+        return "motion_control::ControlResponse@4"
 
 
 class AxisStatusEntry(ctypes.Structure):
@@ -213,7 +210,7 @@ class StatusFrame(ctypes.Structure):
 
     @staticmethod
     def type_name() -> str:
-        return "motion_control::StatusFrame@3"
+        return "motion_control::StatusFrame@4"
 
 
 class SetpointAxis(ctypes.Structure):
