@@ -7,7 +7,7 @@ package from PyPI (the same version as the Rust crate, 0.10.0).
     r = sup.home(["X"])                   # a ControlResponse
     entry = sup.wait_homed("X", r)        # X's AxisStatusEntry once done
     sup.enable(["X"]); sup.move("X", 12.5); sup.stop(); sup.unhome(["X"])
-    sup.move("X", 2.0, relative=True, speed=5.0, supersede=True)
+    sup.move("X", 2.0, relative=True, speed=5.0)
     with sup.jog("X", speed=-2.0) as jog:  # hold to run
         jog.hold(1.5)                      # renews the lease for 1.5 s
     with sup.stream(["X"], owner="me") as s:
@@ -245,8 +245,8 @@ class Supervisor:
 
     def move(self, axis: str, *args, **params) -> ControlResponse:
         """MAM: a trapezoidal move of `axis`; the parameters are the
-        engine's (`OPERATIONS["move"]`): target, relative, speed, accel,
-        decel, supersede — `move("X", 12.5)`, `move("X", 2, relative=True)`."""
+        engine's (`OPERATIONS["move"]`, in order: the target first) —
+        `move("X", 12.5)`, `move("X", 2, relative=True, speed=5)`."""
         return self.operate("move", [axis], *args, **params)
 
     def jog(self, axis: str, *args, **params) -> "Jog":

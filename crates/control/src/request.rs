@@ -369,20 +369,15 @@ mod tests {
             Request::Operate {
                 axes: named(&["Y"]),
                 op: Operation::Move(MoveSpec {
-                    target: 12.5,
                     relative: true,
                     speed: Some(3.0),
                     accel: Some(100.0),
-                    decel: None,
-                    supersede: false,
+                    ..MoveSpec::to(12.5)
                 }),
             },
             Request::Operate {
                 axes: named(&["Y"]),
-                op: Operation::Move(MoveSpec {
-                    supersede: true,
-                    ..MoveSpec::to(-1.0)
-                }),
+                op: Operation::Move(MoveSpec::to(-1.0)),
             },
             Request::StreamAcquire {
                 axes: named(&["X", "Y"]),

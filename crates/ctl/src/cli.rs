@@ -133,7 +133,7 @@ pub struct MoveArgs {
     #[arg(value_name = "AXIS", value_parser = axis)]
     pub axis: String,
     /// The move's parameters (the engine's `MoveSpec`): (--to P | --by D)
-    /// [--speed V] [--accel A] [--decel D] [--supersede].
+    /// [--speed V] [--accel A] [--decel D] and its switches.
     #[command(flatten)]
     pub spec: SpecArgs<MoveSpec>,
     /// Return once the move is accepted, without following it.

@@ -1,7 +1,7 @@
 //! An operation's flags, derived from its spec (`motion_homing::params`):
 //! `SpecArgs<MoveSpec>` flattened into a subcommand gives it one flag per
-//! parameter the operator sets — `--speed V`, `--supersede`, `--to P |
-//! --by D` — with the parameter's doc as help, and parses them back into
+//! parameter the operator sets — `--speed V`, a switch's `--flag`, `--to P
+//! | --by D` — with the parameter's doc as help, and parses them back into
 //! the spec the engine declared. A parameter added to a spec is a flag
 //! here (and in the man page and completions) without a line of this
 //! crate changing.
@@ -190,15 +190,23 @@ mod tests {
 
     #[test]
     fn a_move_s_flags_are_its_spec_s_fields() {
-        let m: Move = parse("--to -2.5 --speed 3 --supersede").unwrap();
+        let m: Move = parse("--to -2.5 --speed 3").unwrap();
         assert_eq!(
             m.spec.spec,
             MoveSpec {
                 speed: Some(3.0),
-                supersede: true,
                 ..MoveSpec::to(-2.5)
             }
         );
+        // Each switch of the spec is a bare flag setting its bit.
+        for p in MoveSpec::PARAMS {
+            if let (Form::Flag { flag, .. }, Place::Bit(b)) = (p.form, p.place) {
+                let m: Move = parse(&format!("--to 1 --{flag}")).unwrap();
+                let mut c = Carried::EMPTY;
+                m.spec.spec.carry(&mut c);
+                assert_eq!(c.switches, 1 << b, "{flag}");
+            }
+        }
         let m: Move = parse("--by 4 --accel 100 --decel 200").unwrap();
         assert_eq!(
             m.spec.spec,

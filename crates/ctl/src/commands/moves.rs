@@ -1,5 +1,5 @@
 //! `move AXIS (--to P | --by D) [--speed V] [--accel A] [--decel D]
-//! [--no-wait] [--json] [--supersede]` (MAM; the flags are the engine's
+//! [--no-wait] [--json]` (MAM; the flags are the engine's
 //! `MoveSpec`, `spec_args.rs`): waits like `home`; exit 0 only when every
 //! axis ended at its target.
 
