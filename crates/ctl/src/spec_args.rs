@@ -7,9 +7,10 @@
 //! crate changing.
 //!
 //! Every number goes through the same parser as the rest of the command
-//! line (finite, within ±1e9); whether a value is allowed (a negative
-//! speed, a deceleration above `max_deceleration`) is the engine's to
-//! judge, with its ERR / EXERR. A hold-to-run operation's lease is not a
+//! line (finite, within ±1e9; an optional one, a magnitude, unsigned);
+//! whether a value is allowed (a speed above `max_speed`, a deceleration
+//! above `max_deceleration`) is the engine's to judge, with its ERR /
+//! EXERR. A hold-to-run operation's lease is not a
 //! flag: the tool renews it.
 
 use clap::builder::PossibleValuesParser;
@@ -48,9 +49,12 @@ fn args_of(p: &Param, params: &[Param]) -> Vec<Arg> {
                 .value_names(["LO", "HI"])
                 .allow_negative_numbers(true)
                 .value_parser(number),
+            // A number that must be given may be signed (a jog's speed, a
+            // target); the optional ones are magnitudes (speeds,
+            // accelerations), as on every command line before.
             Kind::Number | Kind::Optional => a
                 .value_name(metavar)
-                .allow_negative_numbers(true)
+                .allow_negative_numbers(p.kind == Kind::Number)
                 .value_parser(number)
                 .required(p.kind == Kind::Number),
         }

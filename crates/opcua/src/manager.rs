@@ -104,7 +104,7 @@ impl MachineManager {
                     return Err("the session that started it is gone");
                 };
                 let s = s.read();
-                if s.deadline() <= Instant::now() {
+                if !s.is_activated() || s.deadline() <= Instant::now() {
                     return Err("the session that started it is gone");
                 }
                 if s.client_certificate().is_some_and(|c| !crate::pki::still_trusted(&pki, c)) {

@@ -16,11 +16,12 @@
 //! engine declared ([`Call::Operate`]). A new operation is a method here
 //! without a line of this file changing.
 //!
-//! Arguments after the last one that must be given may be left out, and a
-//! number, switch or pair may be given as null: left out, the engine
-//! applies the axis's default (Move's Speed: the axis's `home_speed`).
-//! Jog is hold to run: its Duration is its lease, at most [`MAX_JOG_S`],
-//! renewed by calling Jog again (`jogs.rs`, `bridge.rs`).
+//! Arguments after the last one that must be given may be left out, and an
+//! optional number, a switch or a pair may be given as null: left out, the
+//! engine applies the axis's default (Move's Speed: the axis's
+//! `home_speed`). Jog is hold to run: its Duration is its lease, which the
+//! caller must state, at most [`MAX_JOG_S`], renewed by calling Jog again
+//! (`jogs.rs`, `bridge.rs`).
 
 use motion_control::params::{Carried, Form, Kind, Param, Place};
 use motion_control::*;
@@ -96,7 +97,7 @@ fn param_arg(p: &Param) -> ArgSpec {
     if p.form == Form::Lease {
         doc += &format!(" At most {MAX_JOG_S} s here: call again within it to go on (hold to run).");
     }
-    if matches!(p.kind, Kind::Optional | Kind::Switch | Kind::Pair) {
+    if !given(p) {
         doc += " Null or left out: not given.";
     }
     ArgSpec {
@@ -310,10 +311,7 @@ fn decode_own(
 /// An operation of the engine: each argument by its parameter.
 fn decode_op(kind: OpKind, axis: String, args: &[Variant]) -> Result<Call, CallError> {
     let params = kind.params();
-    let needed = params
-        .iter()
-        .rposition(|p| matches!(p.kind, Kind::Number | Kind::Choice(_) | Kind::Axis))
-        .map_or(0, |i| i + 1);
+    let needed = params.iter().rposition(given).map_or(0, |i| i + 1);
     if args.len() < needed {
         return Err(CallError::Status(StatusCode::BadArgumentsMissing));
     }
@@ -331,6 +329,13 @@ fn decode_op(kind: OpKind, axis: String, args: &[Variant]) -> Result<Call, CallE
     Ok(Call::Operate { axis, op })
 }
 
+/// A parameter a call must give: a number, choice or axis that has no
+/// default — and the lease of a hold-to-run call, which its caller states
+/// (it is the one that renews it).
+fn given(p: &Param) -> bool {
+    matches!(p.kind, Kind::Number | Kind::Choice(_) | Kind::Axis) || p.form == Form::Lease
+}
+
 /// One argument of an operation into `c`, where its parameter is carried.
 fn param(p: &Param, v: &Variant, c: &mut Carried) -> Result<(), StatusCode> {
     let slot = match p.place {
@@ -339,6 +344,7 @@ fn param(p: &Param, v: &Variant, c: &mut Carried) -> Result<(), StatusCode> {
     };
     let empty = matches!(v, Variant::Empty);
     match p.kind {
+        _ if empty && given(p) => Err(StatusCode::BadTypeMismatch),
         Kind::Optional | Kind::Switch | Kind::Pair if empty => Ok(()),
         Kind::Number | Kind::Optional => {
             let lease = p.form == Form::Lease;

@@ -197,13 +197,14 @@ fn operations_decode_with_their_bounds() {
             })
         })
     );
-    // The lease left out: the default (0.5 s), within the bound.
+    // The lease is the caller's to state: hold to run.
     assert_eq!(
         decode(jog, Some("X"), &[Variant::from(2.0)]),
-        Ok(Call::Operate {
-            axis: "X".into(),
-            op: Operation::Jog(JogSpec::at(2.0))
-        })
+        Err(CallError::Status(StatusCode::BadArgumentsMissing))
+    );
+    assert_eq!(
+        decode(jog, Some("X"), &[Variant::from(2.0), Variant::Empty]),
+        Err(CallError::Args(vec![StatusCode::Good, StatusCode::BadTypeMismatch]))
     );
     for (speed, dur, bad) in [
         (f64::NAN, 1.0, [StatusCode::BadOutOfRange, StatusCode::Good]),
