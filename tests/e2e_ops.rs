@@ -587,7 +587,8 @@ impl StoppedRt {
             .unwrap()
             .flatten()
             .find(|t| {
-                std::fs::read_to_string(t.path().join("comm")).is_ok_and(|c| c.trim() == "motion-rt")
+                std::fs::read_to_string(t.path().join("comm"))
+                    .is_ok_and(|c| c.trim() == "motion-rt")
             })
             .and_then(|t| t.file_name().to_str()?.parse::<i32>().ok())
             .expect("the daemon's motion-rt thread");
@@ -624,15 +625,21 @@ fn a_request_the_stalled_cycle_did_not_take_is_never_applied() {
     };
     let e: ErrorReport = r.expect_code(1).report();
     assert!(
-        e.errors.iter().any(|x| x.message.contains("nothing was applied")),
+        e.errors
+            .iter()
+            .any(|x| x.message.contains("nothing was applied")),
         "{}",
         r.stdout
     );
     // The cycle runs again: well past the moment it took its queue.
-    assert!(wait_for(Duration::from_secs(10), || d.status().cycle > stalled_at + 500));
+    assert!(wait_for(Duration::from_secs(10), || d.status().cycle
+        > stalled_at + 500));
     let after = wait_axis(&d, "X", 10, |a| a.position.is_some());
     assert_eq!(after.op, before.op, "the move never reached the engine");
     assert!(!after.moving);
-    assert!((pos(&after) - pos(&before)).abs() <= 2.0 * COUNT, "{after:#?}");
+    assert!(
+        (pos(&after) - pos(&before)).abs() <= 2.0 * COUNT,
+        "{after:#?}"
+    );
     d.stop();
 }

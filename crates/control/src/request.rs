@@ -280,7 +280,6 @@ impl Request {
         };
         m.set_axes(names).then_some(m)
     }
-
 }
 
 #[cfg(test)]
@@ -406,7 +405,13 @@ mod tests {
     fn an_operation_is_a_client_s_kind_with_its_spec_s_parameters() {
         let mut m = ControlRequest::zeroed();
         m.kind = REQ_OPERATE;
-        for op in [0, OpKind::StreamStart as u32, OpKind::Stop as u32, 99, 256 + 1] {
+        for op in [
+            0,
+            OpKind::StreamStart as u32,
+            OpKind::Stop as u32,
+            99,
+            256 + 1,
+        ] {
             m.op = op;
             assert_eq!(
                 Request::decode(&m),

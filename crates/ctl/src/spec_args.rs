@@ -62,7 +62,10 @@ fn args_of(p: &Param, params: &[Param]) -> Vec<Arg> {
     match p.form {
         Form::Flag { flag: f, metavar } => vec![flag(f, metavar)],
         Form::Either { off, on, switch } => {
-            let switched = params.iter().find(|q| q.name == switch).map_or(String::new(), help);
+            let switched = params
+                .iter()
+                .find(|q| q.name == switch)
+                .map_or(String::new(), help);
             vec![
                 flag(off.0, off.1).required(false),
                 flag(on.0, on.1)
@@ -102,7 +105,12 @@ fn carry(p: &Param, params: &[Param], m: &ArgMatches, c: &mut Carried) {
                 }
             }
             Kind::Pair => {
-                let pair: Vec<f64> = m.get_many::<f64>(flag).into_iter().flatten().copied().collect();
+                let pair: Vec<f64> = m
+                    .get_many::<f64>(flag)
+                    .into_iter()
+                    .flatten()
+                    .copied()
+                    .collect();
                 if let (Place::Slot(s), [lo, hi]) = (p.place, pair.as_slice()) {
                     (c.values[s], c.values[s + 1]) = (*lo, *hi);
                 }
@@ -221,7 +229,13 @@ mod tests {
                 ..MoveSpec::to(4.0)
             }
         );
-        for bad in ["", "--to 1 --by 2", "--to nan", "--to 1 --relative", "--by 1 --lease 2"] {
+        for bad in [
+            "",
+            "--to 1 --by 2",
+            "--to nan",
+            "--to 1 --relative",
+            "--by 1 --lease 2",
+        ] {
             assert!(parse::<Move>(bad).is_err(), "{bad}");
         }
     }

@@ -215,8 +215,10 @@ macro_rules! take_op {
 trait Carrier {
     fn carry_dyn(&self, c: &mut Carried);
     fn resolve_dyn(&mut self, cfg: &AxisConfig);
-    fn resolve_axes_dyn(&mut self, lookup: &mut dyn FnMut(&str) -> Option<u16>)
-        -> Result<(), Refused>;
+    fn resolve_axes_dyn(
+        &mut self,
+        lookup: &mut dyn FnMut(&str) -> Option<u16>,
+    ) -> Result<(), Refused>;
 }
 
 impl<T: Spec> Carrier for T {

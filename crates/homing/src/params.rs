@@ -475,7 +475,7 @@ impl Carry for AxisRef {
         }
     }
     fn resolve_axis(&mut self, lookup: &mut dyn FnMut(&str) -> Option<u16>) -> bool {
-        match self.name().map(|n| lookup(n)) {
+        match self.name().map(&mut *lookup) {
             Some(Some(i)) => {
                 *self = AxisRef::Index(i);
                 true
@@ -518,10 +518,7 @@ pub trait Spec: Sized + Copy {
     fn resolve(&mut self, cfg: &AxisConfig);
     /// Every axis named by a parameter: its index (`Err`: the parameter
     /// naming no axis of the machine).
-    fn resolve_axes(
-        &mut self,
-        lookup: &mut dyn FnMut(&str) -> Option<u16>,
-    ) -> Result<(), Refused>;
+    fn resolve_axes(&mut self, lookup: &mut dyn FnMut(&str) -> Option<u16>) -> Result<(), Refused>;
 }
 
 /// Declares an operation's spec: the struct (`Clone, Copy, Debug,
@@ -727,12 +724,30 @@ mod tests {
             EveryKind::take(&c).map(|_| ())
         };
         let err = |param, why| Err(Refused { param, why });
-        assert_eq!(refused(&|c| c.values[0] = f64::NAN), err("ratio", Why::Missing));
-        assert_eq!(refused(&|c| c.values[2] = 2.0), err("edge", Why::UnknownChoice));
-        assert_eq!(refused(&|c| c.values[2] = 0.5), err("edge", Why::UnknownChoice));
-        assert_eq!(refused(&|c| c.values[2] = -1.0), err("edge", Why::UnknownChoice));
-        assert_eq!(refused(&|c| c.values[4] = f64::NAN), err("window", Why::HalfPair));
-        assert_eq!(refused(&|c| c.name = [0; AXIS_NAME_LEN]), err("master", Why::BadName));
+        assert_eq!(
+            refused(&|c| c.values[0] = f64::NAN),
+            err("ratio", Why::Missing)
+        );
+        assert_eq!(
+            refused(&|c| c.values[2] = 2.0),
+            err("edge", Why::UnknownChoice)
+        );
+        assert_eq!(
+            refused(&|c| c.values[2] = 0.5),
+            err("edge", Why::UnknownChoice)
+        );
+        assert_eq!(
+            refused(&|c| c.values[2] = -1.0),
+            err("edge", Why::UnknownChoice)
+        );
+        assert_eq!(
+            refused(&|c| c.values[4] = f64::NAN),
+            err("window", Why::HalfPair)
+        );
+        assert_eq!(
+            refused(&|c| c.name = [0; AXIS_NAME_LEN]),
+            err("master", Why::BadName)
+        );
         assert_eq!(refused(&|c| c.name[0] = 0xff), err("master", Why::BadName));
         assert_eq!(refused(&|c| c.name[5] = b'x'), err("master", Why::BadName));
         // Unknown switches and slots no parameter uses are not read.

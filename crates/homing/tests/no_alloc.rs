@@ -310,20 +310,24 @@ fn operations_make_no_allocation() {
         ..PlantConfig::default()
     });
     let mut fb = plant.feedback();
-    let jog = |speed: f64| Operation::Jog(JogSpec {
-        speed,
-        accel: Some(500.0),
-        decel: Some(500.0),
-        lease: Some(time::ns_to_s(300 * T)),
-    });
-    let mv = |target: f64, supersede: bool| Operation::Move(MoveSpec {
-        target,
-        relative: false,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
-        supersede,
-    });
+    let jog = |speed: f64| {
+        Operation::Jog(JogSpec {
+            speed,
+            accel: Some(500.0),
+            decel: Some(500.0),
+            lease: Some(time::ns_to_s(300 * T)),
+        })
+    };
+    let mv = |target: f64, supersede: bool| {
+        Operation::Move(MoveSpec {
+            target,
+            relative: false,
+            speed: Some(20.0),
+            accel: Some(500.0),
+            decel: Some(500.0),
+            supersede,
+        })
+    };
     // (step, request) of the script; every other step is empty.
     let sp = |t_ms: u64, p: f64| Request {
         setpoint: Some(Setpoint {

@@ -49,7 +49,10 @@ fn a_jog_without_a_lease_holds_half_a_second() {
     assert!(r.axis.status().jogging);
     r.run(3);
     let s = *r.axis.status();
-    assert!(!s.jogging && s.last_stop == StopCause::LeaseExpired, "{s:?}");
+    assert!(
+        !s.jogging && s.last_stop == StopCause::LeaseExpired,
+        "{s:?}"
+    );
     assert_eq!(s.op.id, id);
 }
 

@@ -223,12 +223,14 @@ fn a_jog_replaces_a_jog_and_may_not_replace_a_move() {
 fn a_jog_checks_every_operand() {
     let mut r = Rig::at(0.0);
     r.enable_and_home();
-    let j = |speed: f64, accel: f64, decel: f64, lease_ns: u64| Operation::Jog(JogSpec {
-        speed,
-        accel: Some(accel),
-        decel: Some(decel),
-        lease: Some(secs(lease_ns)),
-    });
+    let j = |speed: f64, accel: f64, decel: f64, lease_ns: u64| {
+        Operation::Jog(JogSpec {
+            speed,
+            accel: Some(accel),
+            decel: Some(decel),
+            lease: Some(secs(lease_ns)),
+        })
+    };
     let p = ERR_PARAMETER_OUT_OF_RANGE;
     for (op, code) in [
         (j(0.0, 500.0, 500.0, 500 * MS), (p, EX_PARAM_SPEED)),

@@ -55,14 +55,16 @@ fn targets_outside_the_travel_limits_are_refused_while_homed() {
     r.enable_and_home();
     assert_eq!(r.op(move_to(10.001)), target);
     assert_eq!(r.op(move_to(-11.0)), target);
-    let by = |d: f64| Operation::Move(MoveSpec {
-        target: d,
-        relative: true,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
-        supersede: false,
-    });
+    let by = |d: f64| {
+        Operation::Move(MoveSpec {
+            target: d,
+            relative: true,
+            speed: Some(20.0),
+            accel: Some(500.0),
+            decel: Some(500.0),
+            supersede: false,
+        })
+    };
     assert_eq!(r.op(by(10.5)), target);
     assert_eq!(r.op(by(1e308)), target);
     assert_eq!(
@@ -115,11 +117,8 @@ fn a_move_on_a_jogging_or_moving_axis_needs_supersede() {
     let Operation::Move(sup) = sup else {
         unreachable!()
     };
-    r.op(Operation::Move(MoveSpec {
-        target: 0.0,
-        ..sup
-    }))
-    .unwrap();
+    r.op(Operation::Move(MoveSpec { target: 0.0, ..sup }))
+        .unwrap();
     assert!(r.run_until(2000, |s| s.op.pc));
     assert_eq!(r.cmd_axis(), 0.0);
 }

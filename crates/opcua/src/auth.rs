@@ -26,10 +26,10 @@ use opcua::server::authenticator::{
     user_pass_security_policy_id, AuthManager, Password, UserToken,
 };
 use opcua::server::ServerEndpoint;
-use std::sync::RwLock;
 use opcua::types::{
     Error, MessageSecurityMode, NodeId, StatusCode, UAString, UserTokenPolicy, UserTokenType,
 };
+use std::sync::RwLock;
 
 /// The anonymous token's policy id (the stack's spelling).
 const ANONYMOUS_POLICY: &str = "anonymous";
@@ -80,7 +80,11 @@ impl Roles {
         if token.is_anonymous() {
             return "anonymous (read-only)";
         }
-        let role = self.users().iter().find(|u| u.name == token.0).map(|u| u.role);
+        let role = self
+            .users()
+            .iter()
+            .find(|u| u.name == token.0)
+            .map(|u| u.role);
         match role {
             Some(Role::Operator) => "operator",
             Some(Role::Viewer) => "viewer (read-only)",

@@ -96,7 +96,11 @@ impl MachineManager {
     /// read again on SIGHUP) — what a call is checked for.
     fn watch(&self, ctx: &RequestContext) -> Watch {
         let session = Arc::downgrade(&ctx.session);
-        let (roles, pki, token) = (self.roles.clone(), self.pki.clone(), ctx.user_token().clone());
+        let (roles, pki, token) = (
+            self.roles.clone(),
+            self.pki.clone(),
+            ctx.user_token().clone(),
+        );
         Watch {
             session: ctx.session_id(),
             may_run: Box::new(move || {
@@ -107,7 +111,9 @@ impl MachineManager {
                 if !s.is_activated() || s.deadline() <= Instant::now() {
                     return Err("the session that started it is gone");
                 }
-                if s.client_certificate().is_some_and(|c| !crate::pki::still_trusted(&pki, c)) {
+                if s.client_certificate()
+                    .is_some_and(|c| !crate::pki::still_trusted(&pki, c))
+                {
                     return Err("its client certificate is no longer trusted");
                 }
                 if !roles.may_call(&token) {
@@ -218,7 +224,6 @@ impl MachineManager {
         }
     }
 }
-
 
 /// The refusal's reasons in one line.
 fn describe(resp: &motion_control::ControlResponse) -> String {

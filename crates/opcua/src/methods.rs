@@ -95,7 +95,8 @@ fn param_arg(p: &Param) -> ArgSpec {
         doc += &format!(" One of: {}.", c.join(", "));
     }
     if p.form == Form::Lease {
-        doc += &format!(" At most {MAX_JOG_S} s here: call again within it to go on (hold to run).");
+        doc +=
+            &format!(" At most {MAX_JOG_S} s here: call again within it to go on (hold to run).");
     }
     if !given(p) {
         doc += " Null or left out: not given.";
@@ -163,7 +164,13 @@ pub fn methods() -> &'static [MethodSpec] {
                 ],
                 "home the named axes (all by default), like `motionctl home`",
             ),
-            own("StopAll", Scope::Machine, Verb::Stop, vec![], "MAS on every axis"),
+            own(
+                "StopAll",
+                Scope::Machine,
+                Verb::Stop,
+                vec![],
+                "MAS on every axis",
+            ),
         ];
         for k in OpKind::ALL.iter().copied().filter(|k| k.client()) {
             all.push(MethodSpec {
@@ -179,7 +186,9 @@ pub fn methods() -> &'static [MethodSpec] {
 }
 
 pub fn spec(name: &str, scope: Scope) -> Option<&'static MethodSpec> {
-    methods().iter().find(|m| m.name == name && m.scope == scope)
+    methods()
+        .iter()
+        .find(|m| m.name == name && m.scope == scope)
 }
 
 /// Longest Timeout accepted (the range of `home_timeout`).
@@ -348,7 +357,9 @@ fn param(p: &Param, v: &Variant, c: &mut Carried) -> Result<(), StatusCode> {
         Kind::Optional | Kind::Switch | Kind::Pair if empty => Ok(()),
         Kind::Number | Kind::Optional => {
             let lease = p.form == Form::Lease;
-            let x = bounded(v, |x| x.abs() <= MAX_ABS && (!lease || (x > 0.0 && x <= MAX_JOG_S)))?;
+            let x = bounded(v, |x| {
+                x.abs() <= MAX_ABS && (!lease || (x > 0.0 && x <= MAX_JOG_S))
+            })?;
             c.values[slot] = x;
             Ok(())
         }

@@ -236,7 +236,10 @@ pub fn reload_users(config: &std::path::Path, roles: &Roles) {
         }
     }
     let n = roles.reload(&cfg);
-    log::info!("SIGHUP: the users were read again from {} ({n})", config.display());
+    log::info!(
+        "SIGHUP: the users were read again from {} ({n})",
+        config.display()
+    );
 }
 
 #[cfg(test)]

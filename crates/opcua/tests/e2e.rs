@@ -477,7 +477,11 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         "jog-hold",
         &["--password", "op-secret", "--duration", "1", "--hold", "3"],
     );
-    assert_eq!(j["first"], serde_json::json!([true, "accepted", 0, 0]), "{j}");
+    assert_eq!(
+        j["first"],
+        serde_json::json!([true, "accepted", 0, 0]),
+        "{j}"
+    );
     assert_eq!(j["refused"], Value::Null, "{j}");
     assert!(j["polls"].as_u64().unwrap() >= 5, "{j}");
     assert_eq!(

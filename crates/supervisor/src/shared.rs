@@ -129,7 +129,8 @@ impl Gate {
 
     /// Control thread, before sending request `id`: it is pending.
     pub fn offer(&self, id: u32) {
-        self.0.store(Self::word(id, Self::PENDING), Ordering::Release);
+        self.0
+            .store(Self::word(id, Self::PENDING), Ordering::Release);
     }
 
     /// Cycle: takes request `id` to apply it; false when the control thread

@@ -12,8 +12,8 @@ mod trace;
 
 use crate::cli::{Cli, Command, Target};
 use motion_control::{Client, ClientError, Operation, REQ_STOP, REQ_UNHOME};
-use simple::Simple;
 use motion_report::ErrorEntry;
+use simple::Simple;
 use std::path::PathBuf;
 
 /// How a command fails: a refused command line, and every other failure.

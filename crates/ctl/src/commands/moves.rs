@@ -16,7 +16,7 @@ use std::time::Duration;
 const FOLLOW_WALL: Duration = Duration::from_secs(86_400);
 
 pub fn move_axis(client: &mut Client, a: &MoveArgs) -> i32 {
-    let resp = match client.operate(&[a.axis.clone()], Operation::Move(a.spec.spec)) {
+    let resp = match client.operate(std::slice::from_ref(&a.axis), Operation::Move(a.spec.spec)) {
         Ok(r) => r,
         Err(e) => return op_error(a.json, "move", &e),
     };

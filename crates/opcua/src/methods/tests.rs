@@ -204,7 +204,10 @@ fn operations_decode_with_their_bounds() {
     );
     assert_eq!(
         decode(jog, Some("X"), &[Variant::from(2.0), Variant::Empty]),
-        Err(CallError::Args(vec![StatusCode::Good, StatusCode::BadTypeMismatch]))
+        Err(CallError::Args(vec![
+            StatusCode::Good,
+            StatusCode::BadTypeMismatch
+        ]))
     );
     for (speed, dur, bad) in [
         (f64::NAN, 1.0, [StatusCode::BadOutOfRange, StatusCode::Good]),
@@ -212,8 +215,16 @@ fn operations_decode_with_their_bounds() {
         (1.0, 0.0, [StatusCode::Good, StatusCode::BadOutOfRange]),
         // Hold to run: a lease longer than a second is refused.
         (1.0, 10.0, [StatusCode::Good, StatusCode::BadOutOfRange]),
-        (1.0, MAX_JOG_S + 0.1, [StatusCode::Good, StatusCode::BadOutOfRange]),
-        (1.0, f64::INFINITY, [StatusCode::Good, StatusCode::BadOutOfRange]),
+        (
+            1.0,
+            MAX_JOG_S + 0.1,
+            [StatusCode::Good, StatusCode::BadOutOfRange],
+        ),
+        (
+            1.0,
+            f64::INFINITY,
+            [StatusCode::Good, StatusCode::BadOutOfRange],
+        ),
     ] {
         assert_eq!(
             decode(jog, Some("X"), &[Variant::from(speed), Variant::from(dur)]),

@@ -6,8 +6,8 @@
 
 use super::answer::{outcome, reason};
 use super::ControlThread;
-use crate::hub::TraceBuf;
 use super::Unanswered;
+use crate::hub::TraceBuf;
 use crate::shared::{Ack, Ask, AxisAck};
 use motion_control::{Axes, AxisOutcome, ControlResponse, Reason, MAX_AXES, RESULT_ACCEPTED};
 

@@ -390,7 +390,10 @@ fn a_request_the_cycle_reaches_after_its_deadline_is_never_applied() {
     assert!(ack.axes.iter().all(|a| *a == AxisAck::NotNamed));
     b.run(1000);
     let after = b.snap().axes[0];
-    assert_eq!(after.status.op, before.status.op, "never reached the engine");
+    assert_eq!(
+        after.status.op, before.status.op,
+        "never reached the engine"
+    );
     assert!(!after.status.moving);
     assert_eq!(after.cmd_position, before.cmd_position);
     // The same request within its deadline moves the axis by 2.
