@@ -40,7 +40,10 @@ pub mod stream;
 
 pub use client::{Client, ClientError};
 pub use message::*;
-pub use motion_homing::{params, JogSpec, MoveSpec, OpKind, Operation};
+// The engine's operations as clients ask for them: every spec type the
+// engine declares, whatever its table adds.
+pub use motion_homing::operation::*;
+pub use motion_homing::params;
 pub use ops::{Jog, OpError};
 pub use request::{Axes, DecodeError, Request, Since};
 pub use response::{AxisOutcome, Reason};

@@ -50,9 +50,8 @@ pub use op_limits::{
     effective_max_deceleration, effective_stream_acceleration, effective_stream_timeout_ns,
     effective_unhomed_speed, OpLimits,
 };
-pub use operation::{
-    Dynamics, JogSpec, MoveSpec, OpKind, OpStatus, Operation, Setpoint, StopCause,
-};
+// Every operation, its verbs and its spec types, whatever the table adds.
+pub use operation::*;
 pub use params::{AxisRef, Carried, Param, Spec};
 pub use status::{Implausible, Phase, Status};
 pub use validate::{

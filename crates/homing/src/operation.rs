@@ -72,59 +72,18 @@ macro_rules! operations {
             /// Every operation, in the table's order.
             pub const ALL: &'static [OpKind] = &[$( OpKind::$variant ),*];
 
-            /// Its OPC UA method's name.
-            pub const fn title(self) -> &'static str {
+            /// Its row of the table.
+            pub const fn traits(self) -> OpTraits {
                 match self {
-                    OpKind::None => "",
-                    $( OpKind::$variant => $title, )*
-                }
-            }
-
-            /// A client may ask for it (the control service, OPC UA,
-            /// Python, motionctl): the others are the daemon's own (the
-            /// stream's start and end go with its acquire and release; a
-            /// client stops with the control service's stop).
-            pub const fn client(self) -> bool {
-                match self {
-                    OpKind::None => false,
-                    $( OpKind::$variant => $client, )*
-                }
-            }
-
-            /// It moves the axis (or takes it over to be moved): the cycle
-            /// refuses it on an axis a program owns, that a home sequence
-            /// will start or whose I/O process is not attached, and a
-            /// gantry takes it on every side or on none.
-            pub const fn moves(self) -> bool {
-                match self {
-                    OpKind::None => false,
-                    $( OpKind::$variant => $moves, )*
-                }
-            }
-
-            /// Hold to run: it runs while its client renews it (a token
-            /// names it), on one axis or one gantry.
-            pub const fn held(self) -> bool {
-                match self {
-                    OpKind::None => false,
-                    $( OpKind::$variant => $held, )*
-                }
-            }
-
-            /// Asked for without naming an axis, it applies to every axis
-            /// (else it needs one).
-            pub const fn all_by_default(self) -> bool {
-                match self {
-                    OpKind::None => false,
-                    $( OpKind::$variant => $all, )*
-                }
-            }
-
-            /// What it does, in a line (OPC UA's method description).
-            pub const fn summary(self) -> &'static str {
-                match self {
-                    OpKind::None => "",
-                    $( OpKind::$variant => $summary, )*
+                    OpKind::None => OpTraits::NONE,
+                    $( OpKind::$variant => OpTraits {
+                        title: $title,
+                        client: $client,
+                        moves: $moves,
+                        held: $held,
+                        all_by_default: $all,
+                        summary: $summary,
+                    }, )*
                 }
             }
 
@@ -167,6 +126,71 @@ macro_rules! operations {
             }
         }
     };
+}
+
+/// What the layers around the engine need to know of an operation: its
+/// row of the [`operations!`] table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OpTraits {
+    /// Its OPC UA method's name.
+    pub title: &'static str,
+    /// A client may ask for it (the control service, OPC UA, Python,
+    /// motionctl): the others are the daemon's own (the stream's start and
+    /// end go with its acquire and release; a client stops with the
+    /// control service's stop).
+    pub client: bool,
+    /// It moves the axis (or takes it over to be moved): the cycle refuses
+    /// it on an axis a program owns, that a home sequence will start or
+    /// whose I/O process is not attached, and a gantry takes it on every
+    /// side or on none.
+    pub moves: bool,
+    /// Hold to run: it runs while its client renews it (a token names it),
+    /// on one axis or one gantry.
+    pub held: bool,
+    /// Asked for without naming an axis, it applies to every axis (else it
+    /// needs one).
+    pub all_by_default: bool,
+    /// What it does, in a line (OPC UA's method description).
+    pub summary: &'static str,
+}
+
+impl OpTraits {
+    /// [`OpKind::None`]'s: nothing.
+    const NONE: OpTraits = OpTraits {
+        title: "",
+        client: false,
+        moves: false,
+        held: false,
+        all_by_default: false,
+        summary: "",
+    };
+}
+
+impl OpKind {
+    /// See [`OpTraits::title`].
+    pub const fn title(self) -> &'static str {
+        self.traits().title
+    }
+    /// See [`OpTraits::client`].
+    pub const fn client(self) -> bool {
+        self.traits().client
+    }
+    /// See [`OpTraits::moves`].
+    pub const fn moves(self) -> bool {
+        self.traits().moves
+    }
+    /// See [`OpTraits::held`].
+    pub const fn held(self) -> bool {
+        self.traits().held
+    }
+    /// See [`OpTraits::all_by_default`].
+    pub const fn all_by_default(self) -> bool {
+        self.traits().all_by_default
+    }
+    /// See [`OpTraits::summary`].
+    pub const fn summary(self) -> &'static str {
+        self.traits().summary
+    }
 }
 
 /// `_` for a variant's spec in a pattern.
@@ -367,6 +391,16 @@ operations! {
     }
 }
 
+/// A motion's acceleration (a jog's, a move's): one parameter, whichever
+/// operation carries it.
+const ACCEL: Param = Param::new("Accel", Unit::Acceleration)
+    .or(Fallback::HomeAcceleration)
+    .flag("accel", "A");
+/// A motion's deceleration.
+const DECEL: Param = Param::new("Decel", Unit::Acceleration)
+    .or(Fallback::HomeDeceleration)
+    .flag("decel", "D");
+
 crate::op_spec! {
     /// MAJ / MC_Jog, hold to run: runs in the sign of `speed` until stopped
     /// (a stop, a limit, a fault, or the lease running out): the jog stops
@@ -381,13 +415,9 @@ crate::op_spec! {
             .or(Fallback::JogLease)
             .form(Form::Lease),
         /// Acceleration, units/s²; left out: the axis's `home_acceleration`.
-        accel: Option<f64> = Param::new("Accel", Unit::Acceleration)
-            .or(Fallback::HomeAcceleration)
-            .flag("accel", "A"),
+        accel: Option<f64> = ACCEL,
         /// Deceleration, units/s²; left out: the axis's `home_deceleration`.
-        decel: Option<f64> = Param::new("Decel", Unit::Acceleration)
-            .or(Fallback::HomeDeceleration)
-            .flag("decel", "D"),
+        decel: Option<f64> = DECEL,
     }
 }
 
@@ -412,13 +442,9 @@ crate::op_spec! {
             .or(Fallback::HomeSpeed)
             .flag("speed", "V"),
         /// Acceleration, units/s²; left out: the axis's `home_acceleration`.
-        accel: Option<f64> = Param::new("Accel", Unit::Acceleration)
-            .or(Fallback::HomeAcceleration)
-            .flag("accel", "A"),
+        accel: Option<f64> = ACCEL,
         /// Deceleration, units/s²; left out: the axis's `home_deceleration`.
-        decel: Option<f64> = Param::new("Decel", Unit::Acceleration)
-            .or(Fallback::HomeDeceleration)
-            .flag("decel", "D"),
+        decel: Option<f64> = DECEL,
         /// Replace a jog or move in progress (without it such an axis
         /// refuses with ERR 3).
         supersede: bool = Param::new("Supersede", Unit::None).flag("supersede", ""),

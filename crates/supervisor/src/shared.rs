@@ -133,31 +133,26 @@ impl Gate {
             .store(Self::word(id, Self::PENDING), Ordering::Release);
     }
 
+    /// Request `id`, still pending, is now `state`; false when it was not
+    /// pending (the other side decided first, or it is not the one).
+    fn decide(&self, id: u32, state: u64) -> bool {
+        let (pending, decided) = (Self::word(id, Self::PENDING), Self::word(id, state));
+        (self.0)
+            .compare_exchange(pending, decided, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+    }
+
     /// Cycle: takes request `id` to apply it; false when the control thread
     /// gave up on it first (or has moved on to another): drop it unapplied.
     pub fn take(&self, id: u32) -> bool {
-        self.0
-            .compare_exchange(
-                Self::word(id, Self::PENDING),
-                Self::word(id, Self::TAKEN),
-                Ordering::AcqRel,
-                Ordering::Acquire,
-            )
-            .is_ok()
+        self.decide(id, Self::TAKEN)
     }
 
     /// Control thread, at the deadline: gives up on request `id`; true when
     /// the cycle had not taken it (it never will), false when it had (its
     /// answer will come).
     pub fn abandon(&self, id: u32) -> bool {
-        self.0
-            .compare_exchange(
-                Self::word(id, Self::PENDING),
-                Self::word(id, Self::ABANDONED),
-                Ordering::AcqRel,
-                Ordering::Acquire,
-            )
-            .is_ok()
+        self.decide(id, Self::ABANDONED)
     }
 }
 
