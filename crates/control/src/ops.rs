@@ -1,6 +1,6 @@
 //! The operations of a running supervisor as a Rust client calls them:
 //! any operation of the engine with its spec ([`Client::operate`]: enable,
-//! disable, reset, a move's [`MoveSpec`] …, exactly as the engine declares
+//! disable, reset, a move's [`MoveSpec`](crate::MoveSpec) …, exactly as the engine declares
 //! them), and the hold-to-run jog ([`Jog`], a handle that renews the jog's
 //! lease from a thread of its own and ends the jog when dropped). The
 //! setpoint stream is in [`crate::stream`].
