@@ -570,3 +570,80 @@ fn a_gantry_jogs_moves_and_streams_as_one_axis_never_a_side_alone() {
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
 }
+
+/// The daemon's real-time thread (`motion-rt`), held stopped by ptrace
+/// while this lives: only that thread stops (a SIGSTOP would stop the
+/// whole process, the control thread with it), exactly where it is, for as
+/// long as the test says — a stall of the cycle on demand, no sleeps.
+struct StoppedRt(nix::unistd::Pid);
+
+impl StoppedRt {
+    #[track_caller]
+    fn stop(daemon_pid: u32) -> StoppedRt {
+        use nix::sys::ptrace;
+        use nix::sys::wait::{waitpid, WaitPidFlag};
+        let task = format!("/proc/{daemon_pid}/task");
+        let tid = std::fs::read_dir(&task)
+            .unwrap()
+            .flatten()
+            .find(|t| {
+                std::fs::read_to_string(t.path().join("comm"))
+                    .is_ok_and(|c| c.trim() == "motion-rt")
+            })
+            .and_then(|t| t.file_name().to_str()?.parse::<i32>().ok())
+            .expect("the daemon's motion-rt thread");
+        let tid = nix::unistd::Pid::from_raw(tid);
+        ptrace::seize(tid, ptrace::Options::empty()).expect("ptrace seize");
+        ptrace::interrupt(tid).expect("ptrace interrupt");
+        waitpid(tid, Some(WaitPidFlag::__WALL)).expect("the thread stops");
+        StoppedRt(tid)
+    }
+}
+
+impl Drop for StoppedRt {
+    fn drop(&mut self) {
+        let _ = nix::sys::ptrace::detach(self.0, None);
+    }
+}
+
+/// The cycle stalls with a move on its way: the control thread gives up at
+/// the request's deadline and says nothing was applied — and when the
+/// cycle runs again the move is indeed never made (an HMI that retries
+/// `move --by` after that answer moves once, not twice).
+#[test]
+fn a_request_the_stalled_cycle_did_not_take_is_never_applied() {
+    let _serial = serial();
+    let cfg = ops("ops_stalled");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["home", "X"]).expect_code(0);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    let before = wait_axis(&d, "X", 5, |a| a.homed && a.servo_action && at_rest(a));
+    let stalled_at = d.status().cycle;
+    let r = {
+        let _stopped = StoppedRt::stop(d.pid());
+        d.ctl(&["move", "X", "--by", "2", "--json"])
+    };
+    let e: ErrorReport = r.expect_code(1).report();
+    assert!(
+        e.errors
+            .iter()
+            .any(|x| x.message.contains("nothing was applied")),
+        "{}",
+        r.stdout
+    );
+    // The cycle runs again: well past the moment it took its queue.
+    assert!(wait_for(Duration::from_secs(10), || d.status().cycle
+        > stalled_at + 500));
+    let after = wait_axis(&d, "X", 10, |a| a.position.is_some());
+    assert_eq!(
+        (after.op_id, &after.op_kind),
+        (before.op_id, &before.op_kind),
+        "the move never reached the engine"
+    );
+    assert!(!after.moving);
+    assert!(
+        (pos(&after) - pos(&before)).abs() <= 2.0 * COUNT,
+        "{after:#?}"
+    );
+    d.stop();
+}

@@ -106,7 +106,7 @@ def jog(sup, axis: str, speed: float, duration: float) -> int:
     seconds, then the jog is ended (only this jog) and followed to rest."""
     from .client import accepted
 
-    with sup.jog(axis, speed, lease_ms=500) as j:
+    with sup.jog(axis, speed, lease=0.5) as j:
         if not accepted(j.answer):
             return refused("jog", j.answer)
         if not j.hold(duration):

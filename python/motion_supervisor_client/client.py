@@ -7,10 +7,17 @@ package from PyPI (the same version as the Rust crate, 0.10.0).
     r = sup.home(["X"])                   # a ControlResponse
     entry = sup.wait_homed("X", r)        # X's AxisStatusEntry once done
     sup.enable(["X"]); sup.move("X", 12.5); sup.stop(); sup.unhome(["X"])
+    sup.move("X", 2.0, relative=True, speed=5.0)
     with sup.jog("X", speed=-2.0) as jog:  # hold to run
         jog.hold(1.5)                      # renews the lease for 1.5 s
     with sup.stream(["X"], owner="me") as s:
         s.publish([(s.index["X"], 1.0, 0.0)])
+
+An operation's parameters are the engine's: `OPERATIONS` (read from
+`layout.json`, which the Rust side writes from the operations' specs)
+names each operation's parameters in order, with their kinds, units and
+defaults; `move`, `jog` and `operate` take them positionally or by name,
+and a parameter left out (or None, or NaN) is the axis's default.
 
 An operation's answer is a ControlResponse: `accepted(r)` says whether it
 was accepted for every axis, `refusals(r)` why not.
@@ -18,21 +25,68 @@ was accepted for every axis, `refusals(r)` why not.
 
 import ctypes
 import json
+import math
 import os
 import time
 
 import iceoryx2 as iox2
 
+from .check import load_description
 from .layout import (
-    CONTROL_LAYOUT, FLAG_END, FLAG_PARALLEL, FLAG_RELATIVE, FLAG_SUPERSEDE,
-    NAME_LEN, NO_INDEX,
-    REQ_DISABLE, REQ_ENABLE, REQ_HOME, REQ_JOG, REQ_JOG_RENEW, REQ_MOVE,
-    REQ_RESET, REQ_STOP, REQ_STREAM_ACQUIRE, REQ_STREAM_RELEASE, REQ_UNHOME,
-    RESULT_ACCEPTED, SETPOINT_LAYOUT, SP_VELOCITY,
-    ControlRequest, ControlResponse, SetpointFrame,
-    StatusFrame, put_text, text,
+    CONTROL_LAYOUT, FLAG_END, FLAG_PARALLEL, NAME_LEN, NO_INDEX, OP_SLOTS,
+    REQ_HOME, REQ_JOG_RENEW, REQ_OPERATE, REQ_STOP, REQ_STREAM_ACQUIRE,
+    REQ_STREAM_RELEASE, REQ_UNHOME, RESULT_ACCEPTED, SETPOINT_LAYOUT,
+    SP_VELOCITY, ControlRequest, ControlResponse, SetpointFrame, StatusFrame,
+    put_text, text,
 )
 from .paths import default_runtime_dir
+
+#: The operations a client may ask for, by name, as the engine declares
+#: them: {"op": number, "all_by_default": bool, "held": bool, "params":
+#: [{"name", "kind", "slot" | "bit" | "name_field", "unit", "default",
+#: "doc", ...}]}.
+OPERATIONS = {o["name"]: o for o in load_description()["operations"]}
+
+
+def carried(op: str, args=(), params=None) -> dict:
+    """The request fields of operation `op` (`op`, `switches`, `values`,
+    `name`) from its parameters, positional (`args`, in the spec's order)
+    and by name (`params`), each put where the spec carries it. A
+    parameter left out, None or NaN is not given (the axis's default
+    applies); one that must be given, unknown or given twice is a
+    TypeError; a choice that is none of its choices a ValueError."""
+    spec = OPERATIONS[op]
+    names = [p["name"] for p in spec["params"]]
+    if len(args) > len(names):
+        raise TypeError(f"{op}() takes at most {len(names)} parameters ({', '.join(names)})")
+    given = dict(zip(names, args))
+    for k, v in (params or {}).items():
+        if k not in names:
+            raise TypeError(f"{op}() has no parameter {k!r} (it has: {', '.join(names) or 'none'})")
+        if k in given:
+            raise TypeError(f"{op}() got {k!r} twice")
+        given[k] = v
+    values = (ctypes.c_double * OP_SLOTS)(*([float("nan")] * OP_SLOTS))
+    fields = {"op": spec["op"], "switches": 0, "values": values}
+    for p in spec["params"]:
+        v = given.get(p["name"])
+        if v is None or (isinstance(v, float) and math.isnan(v)):
+            if p["kind"] in ("number", "choice", "axis"):
+                raise TypeError(f"{op}() needs {p['name']} ({p['doc']})")
+            continue
+        if p["kind"] == "switch":
+            fields["switches"] |= (1 << p["bit"]) if v else 0
+        elif p["kind"] in ("number", "optional"):
+            values[p["slot"]] = float(v)
+        elif p["kind"] == "choice":
+            values[p["slot"]] = float(p["choices"].index(v))
+        elif p["kind"] == "pair":
+            values[p["slot"]], values[p["slot"] + 1] = (float(x) for x in v)
+        elif p["kind"] == "axis":
+            name = (ctypes.c_uint8 * NAME_LEN)()
+            put_text(name, v)
+            fields["name"] = name
+    return fields
 
 
 class NoSupervisor(Exception):
@@ -112,16 +166,15 @@ class Supervisor:
                 raise TimeoutError("no status frame")
             time.sleep(0.005)
 
-    def request(self, kind: int, axes=(), timeout: float = 3.0, **params) -> ControlResponse:
-        """One control request with the session key; its response. `params`
-        are fields of the request (position, speed, accel, decel, token,
-        lease_ms, flags, timeout_s, node_id, owner); an operation parameter
-        not given is NaN: the axis's default. No axes: every axis."""
+    def request(self, kind: int, axes=(), timeout: float = 3.0, **fields) -> ControlResponse:
+        """One control request with the session key; its response. `fields`
+        are fields of the request (flags, timeout_s, token, node_id, name;
+        an operation's op, switches, values: see `operate`). No axes: every
+        axis."""
         req = ControlRequest()
         req.layout_version = CONTROL_LAYOUT
         req.kind = kind
-        req.position = req.speed = req.accel = req.decel = float("nan")
-        for k, v in params.items():
+        for k, v in fields.items():
             setattr(req, k, v)
         req.key[0], req.key[1] = self.key
         req.request_id = self.next_id
@@ -172,30 +225,36 @@ class Supervisor:
         raise TimeoutError(f"{axis}: no result within {timeout} s")
 
     # ---- the operations --------------------------------------------------
+    def operate(self, op: str, axes=(), *args, **params) -> ControlResponse:
+        """Operation `op` (a name of `OPERATIONS`) for `axes` with its
+        parameters (see `carried`); no axes: every axis for an operation
+        that says so (`all_by_default`), else refused."""
+        return self.request(REQ_OPERATE, list(axes), **carried(op, args, params))
+
     def enable(self, axes=()) -> ControlResponse:
         """MSO: enable the drives (none: every axis), holding position."""
-        return self.request(REQ_ENABLE, axes)
+        return self.operate("enable", axes)
 
     def disable(self, axes=()) -> ControlResponse:
         """MSF: disable the drives (none: every axis)."""
-        return self.request(REQ_DISABLE, axes)
+        return self.operate("disable", axes)
 
     def reset(self, axes=()) -> ControlResponse:
         """MAFR: clear the axis faults (none: every axis)."""
-        return self.request(REQ_RESET, axes)
+        return self.operate("reset", axes)
 
-    def move(self, axis: str, position: float, relative: bool = False, speed: float = float("nan"),
-             accel: float = float("nan"), decel: float = float("nan"), supersede: bool = False) -> ControlResponse:
-        """MAM: a trapezoidal move to `position` (relative: by it); NaN
-        speed/accel/decel: the axis's homing values."""
-        flags = (FLAG_RELATIVE if relative else 0) | (FLAG_SUPERSEDE if supersede else 0)
-        return self.request(REQ_MOVE, [axis], position=position, speed=speed, accel=accel, decel=decel, flags=flags)
+    def move(self, axis: str, *args, **params) -> ControlResponse:
+        """MAM: a trapezoidal move of `axis`; the parameters are the
+        engine's (`OPERATIONS["move"]`, in order: the target first) —
+        `move("X", 12.5)`, `move("X", 2, relative=True, speed=5)`."""
+        return self.operate("move", [axis], *args, **params)
 
-    def jog(self, axis: str, speed: float, lease_ms: int = 500, accel: float = float("nan"),
-            decel: float = float("nan")) -> "Jog":
-        """MAJ, hold to run: a Jog whose lease the caller renews
-        (`Jog.renew`, `Jog.hold`); it stops when the renewals stop."""
-        return Jog(self, self.request(REQ_JOG, [axis], speed=speed, lease_ms=lease_ms, accel=accel, decel=decel))
+    def jog(self, axis: str, *args, **params) -> "Jog":
+        """MAJ, hold to run: a Jog of `axis` whose lease the caller renews
+        (`Jog.renew`, `Jog.hold`); it stops when the renewals stop. The
+        parameters are the engine's (`OPERATIONS["jog"]`): speed, lease
+        (s), accel, decel — `jog("X", -2.0)`."""
+        return Jog(self, self.operate("jog", [axis], *args, **params))
 
     def stream(self, axes, owner: str = "python") -> "SetpointStream":
         """Takes `axes` over for the supervised setpoint stream."""
@@ -279,7 +338,7 @@ class SetpointStream:
             REQ_STREAM_ACQUIRE,
             list(axes),
             node_id=(ctypes.c_uint64 * 2)(node_id & (2**64 - 1), node_id >> 64),
-            owner=owner_field,
+            name=owner_field,
         )
         self.token = self.answer.token
         #: axis name -> the index its setpoints address

@@ -17,8 +17,8 @@
 //!   ([`AxisReport`]: `status --json`'s and `home --json`'s rows, errors and
 //!   warnings in words). The status entries and their fields are
 //!   `motion-status`'s table.
-//! * [`ops`] — enable, disable, reset, move and the hold-to-run [`Jog`]
-//!   for Rust clients; [`stream`] — the supervised setpoint stream's
+//! * [`ops`] — any operation of the engine with its spec, and the
+//!   hold-to-run [`Jog`], for Rust clients; [`stream`] — the supervised setpoint stream's
 //!   [`stream::Stream`] handle and the acquire answer's axis map;
 //!   [`follow`] — following operations to their end in the status.
 //! * [`server`] — the daemon's side: serve requests and publish status, off
@@ -44,7 +44,11 @@ pub mod stream;
 pub use client::{Client, ClientError};
 pub use follow::OpOutcome;
 pub use message::*;
-pub use ops::{Jog, JogSpec, MoveSpec, OpError};
+// The engine's operations as clients ask for them: every spec type the
+// engine declares, whatever its table adds.
+pub use motion_homing::operation::*;
+pub use motion_homing::params;
+pub use ops::{Jog, OpError};
 pub use report::AxisReport;
 pub use request::{Axes, DecodeError, Request, Since};
 pub use response::{AxisOutcome, Reason};

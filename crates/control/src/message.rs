@@ -16,9 +16,10 @@
 use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
 
 /// Layout version of every type in this file and of the status entries
-/// (`motion-status`). Bump it on any change of a struct, and when a status
-/// row moves, is removed or changes its type; a status row added in the
-/// room of its area moves nothing and needs no bump (see
+/// (`motion-status`). Bump it on any change of a struct, on a change of an
+/// operation's parameters' slots (`layout.json` describes them too), and
+/// when a status row moves, is removed or changes its type; a status row
+/// added in the room of its area moves nothing and needs no bump (see
 /// `motion_status::schema`).
 pub const CONTROL_LAYOUT: u32 = 4;
 
@@ -53,27 +54,18 @@ pub const REQ_TRACE: u32 = 6;
 pub const REQ_TRACE_FETCH: u32 = 7;
 /// The latency histograms as an HdrHistogram log in `data`, paged.
 pub const REQ_HLOG: u32 = 8;
-/// MSO: enable the drives of the named axes (all: every axis), holding
-/// position.
-pub const REQ_ENABLE: u32 = 9;
-/// MSF: disable the drives of the named axes (all: every axis); a moving
-/// axis is stopped first.
-pub const REQ_DISABLE: u32 = 10;
-/// MAFR: clear the axis fault of the named axes (all: every axis) and ask
-/// their drives for a fault reset. Never enables, never moves.
-pub const REQ_RESET: u32 = 11;
-/// MAJ, hold to run: jog the one named axis (or gantry) at `speed` (its sign
-/// is the direction) with `accel`/`decel`, for as long as the client renews
-/// the lease (`lease_ms`, 50..=5000) with [`REQ_JOG_RENEW`]. The answer's
-/// `token` names this jog.
-pub const REQ_JOG: u32 = 12;
+/// An operation of the engine for the named axes (`op`: its
+/// `motion_homing::OpKind` number — enable, disable, reset, jog, move …;
+/// its parameters in `switches`, `values` and `name`, where its spec
+/// places them: `layout.json`'s `operations` lists them). Named no axis:
+/// every axis for enable, disable and reset; the others need one (a jog:
+/// exactly one axis or gantry, and the answer's `token` names it for
+/// [`REQ_JOG_RENEW`]).
+pub const REQ_OPERATE: u32 = 9;
 /// Renew the lease of the jog `token` on the named axes (none: wherever
 /// that jog runs).
 pub const REQ_JOG_RENEW: u32 = 13;
-/// MAM: a trapezoidal move of the named axes (or gantry) to `position` (with
-/// [`FLAG_RELATIVE`]: by `position`) at `speed`, `accel`, `decel`.
-pub const REQ_MOVE: u32 = 14;
-/// Take the named axes over for the supervised setpoint stream: `owner`
+/// Take the named axes over for the supervised setpoint stream: `name`
 /// names the program, `node_id` its iceoryx2 node (the one that publishes;
 /// the supervisor releases the axes when it is gone). The answer's `token`
 /// is the owner token every setpoint frame must carry, and its `data` maps
@@ -91,11 +83,6 @@ pub const FLAG_RESET: u32 = 1 << 0;
 pub const FLAG_SINCE_RESET: u32 = 1 << 1;
 /// `REQ_HOME`: start every named axis at once, ignoring the home order.
 pub const FLAG_PARALLEL: u32 = 1 << 2;
-/// `REQ_MOVE`: `position` is a distance from where the move starts.
-pub const FLAG_RELATIVE: u32 = 1 << 3;
-/// `REQ_MOVE`: replace a running jog or move (without it, ERR 3 Execution
-/// Collision). (A jog replaces a running jog by itself and never a move.)
-pub const FLAG_SUPERSEDE: u32 = 1 << 4;
 /// `REQ_JOG_RENEW`: end the jog now instead (a stop of this jog only: if
 /// it no longer runs, nothing is stopped).
 pub const FLAG_END: u32 = 1 << 5;
@@ -159,10 +146,8 @@ pub fn reason_text(reason: u8) -> &'static str {
 
 /// A request to the control service. Zero it, set `kind`, `flags`, the axes
 /// and `offset`; the client sets `layout_version`, `key` and `request_id`.
-/// The operation parameters (`position` .. `owner`) are read only by the
-/// kinds that name them; an `f64` parameter that is NaN means "the axis's
-/// default" (`speed`: `home_speed`, `accel`: `home_acceleration`, `decel`:
-/// `home_deceleration`; a jog's `speed` and a move's `position` have none).
+/// The parameters (`timeout_s` .. `name`) are read only by the kinds that
+/// name them.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
 #[type_name("motion_control::ControlRequest@4")]
@@ -183,31 +168,29 @@ pub struct ControlRequest {
     /// Optional: seconds `REQ_HOME` may take before the axes are stopped
     /// (0 = the axes' own `home_timeout` only).
     pub timeout_s: f64,
-    /// `REQ_MOVE`: target in axis coordinates, units (with `FLAG_RELATIVE`:
-    /// the distance).
-    pub position: f64,
-    /// `REQ_JOG`: signed speed (the sign is the direction); `REQ_MOVE`: the
-    /// speed's magnitude; units/s. NaN (move): `home_speed`.
-    pub speed: f64,
-    /// `REQ_JOG`, `REQ_MOVE`: acceleration and deceleration, units/s²;
-    /// NaN: `home_acceleration` / `home_deceleration`.
-    pub accel: f64,
-    pub decel: f64,
-    /// `REQ_JOG_RENEW`: the jog's token (from the `REQ_JOG` answer);
+    /// `REQ_JOG_RENEW`: the jog's token (from the `REQ_OPERATE` answer);
     /// `REQ_STREAM_RELEASE`: the owner token.
     pub token: u64,
     /// `REQ_STREAM_ACQUIRE`: the publishing program's iceoryx2 node id
     /// (`UniqueNodeId::value()`, a u128): `[low 64 bits, high 64 bits]`.
     pub node_id: [u64; 2],
-    /// `REQ_JOG`: the hold-to-run lease, ms (50..=5000): the jog stops when
-    /// no renewal came for this long.
-    pub lease_ms: u32,
-    pub reserved: u32,
+    /// `REQ_OPERATE`: the operation (`motion_homing::OpKind` number).
+    pub op: u32,
+    /// `REQ_OPERATE`: the operation's switches, a bit each where its spec
+    /// places them.
+    pub switches: u32,
+    /// `REQ_OPERATE`: the operation's numbers, by the slot its spec gives
+    /// each; NaN: left out (the axis's default where it has one).
+    pub values: [f64; OP_SLOTS],
     /// `REQ_STREAM_ACQUIRE`: the program's name (shown in the status as the
-    /// axes' owner), UTF-8, NUL-padded.
-    pub owner: [u8; NAME_LEN],
+    /// axes' owner); `REQ_OPERATE`: the operation's axis parameter. UTF-8,
+    /// NUL-padded.
+    pub name: [u8; NAME_LEN],
     pub axes: [[u8; NAME_LEN]; MAX_AXES],
 }
+
+/// Number slots of an operation's parameters ([`ControlRequest::values`]).
+pub const OP_SLOTS: usize = motion_homing::params::SLOTS;
 
 /// One axis of a response.
 #[repr(C)]
@@ -224,8 +207,7 @@ pub struct AxisAnswer {
     /// The axis's index in the configuration (config order, from 0: what a
     /// setpoint frame addresses); [`NO_INDEX`] for a name that is no axis.
     pub index: u16,
-    /// The operation id the engine gave an accepted jog, move, enable,
-    /// disable, reset or stream (the status's `op_id` shows it while it
+    /// The operation id the engine gave an accepted operation or stream (the status's `op_id` shows it while it
     /// runs and how it ended); 0 otherwise.
     pub op_id: u32,
     pub reserved: u32,
@@ -254,7 +236,7 @@ pub struct ControlResponse {
     /// The real-time cycle in which the request took effect (home, stop,
     /// unhome, trace): status frames of this cycle or later show its effect.
     pub cycle: u64,
-    /// `REQ_JOG`: the jog's token (for `REQ_JOG_RENEW`);
+    /// A jog (`REQ_OPERATE`): the jog's token (for `REQ_JOG_RENEW`);
     /// `REQ_STREAM_ACQUIRE`: the owner token (for every setpoint frame and
     /// `REQ_STREAM_RELEASE`); random, never 0 when accepted.
     pub token: u64,
@@ -373,20 +355,19 @@ const _: () = {
         CONTROL_LAYOUT == 4,
         "update the layout asserts together with CONTROL_LAYOUT"
     );
-    assert!(size_of::<ControlRequest>() == 152 + MAX_AXES * NAME_LEN);
+    assert!(NAME_LEN == motion_homing::params::AXIS_NAME_LEN);
+    assert!(size_of::<ControlRequest>() == 184 + MAX_AXES * NAME_LEN);
     assert!(offset_of!(ControlRequest, key) == 8);
     assert!(offset_of!(ControlRequest, request_id) == 24);
     assert!(offset_of!(ControlRequest, offset) == 40);
     assert!(offset_of!(ControlRequest, timeout_s) == 48);
-    assert!(offset_of!(ControlRequest, position) == 56);
-    assert!(offset_of!(ControlRequest, speed) == 64);
-    assert!(offset_of!(ControlRequest, accel) == 72);
-    assert!(offset_of!(ControlRequest, decel) == 80);
-    assert!(offset_of!(ControlRequest, token) == 88);
-    assert!(offset_of!(ControlRequest, node_id) == 96);
-    assert!(offset_of!(ControlRequest, lease_ms) == 112);
-    assert!(offset_of!(ControlRequest, owner) == 120);
-    assert!(offset_of!(ControlRequest, axes) == 152);
+    assert!(offset_of!(ControlRequest, token) == 56);
+    assert!(offset_of!(ControlRequest, node_id) == 64);
+    assert!(offset_of!(ControlRequest, op) == 80);
+    assert!(offset_of!(ControlRequest, switches) == 84);
+    assert!(offset_of!(ControlRequest, values) == 88);
+    assert!(offset_of!(ControlRequest, name) == 152);
+    assert!(offset_of!(ControlRequest, axes) == 184);
     assert!(align_of::<ControlRequest>() == 8);
 
     assert!(size_of::<AxisAnswer>() == 48);

@@ -1,7 +1,9 @@
 //! The operations of a running supervisor as a Rust client calls them:
-//! enable, disable, reset, move, and the hold-to-run jog ([`Jog`], a handle
-//! that renews the jog's lease from a thread of its own and ends the jog
-//! when dropped). The setpoint stream is in [`crate::stream`].
+//! any operation of the engine with its spec ([`Client::operate`]: enable,
+//! disable, reset, a move's [`MoveSpec`](crate::MoveSpec) …, exactly as the engine declares
+//! them), and the hold-to-run jog ([`Jog`], a handle that renews the jog's
+//! lease from a thread of its own and ends the jog when dropped). The
+//! setpoint stream is in [`crate::stream`].
 //!
 //! Every call answers per axis (accepted, or refused with a reason and the
 //! instruction's ERR / EXERR): a refusal is an [`OpError::Refused`] with the
@@ -16,6 +18,8 @@ use std::time::{Duration, Instant};
 use crate::client::{Client, ClientError};
 use crate::message::*;
 use crate::request::{Axes, Request};
+use motion_homing::params::JOG_LEASE_S;
+use motion_homing::{JogSpec, Operation};
 
 /// How long a request waits for its answer.
 const ANSWER: Duration = Duration::from_secs(3);
@@ -54,75 +58,23 @@ fn accepted(resp: Box<ControlResponse>) -> Result<Box<ControlResponse>, OpError>
     }
 }
 
-/// A trapezoidal move (MAM).
-#[derive(Clone, Debug, PartialEq)]
-pub struct MoveSpec {
-    /// One axis or one gantry (or several: each moves on its own).
-    pub axes: Vec<String>,
-    /// Target in axis coordinates, or the distance with `relative`.
-    pub position: f64,
-    pub relative: bool,
-    /// `None`: the axis's `home_speed`, `home_acceleration`,
-    /// `home_deceleration`.
-    pub speed: Option<f64>,
-    pub accel: Option<f64>,
-    pub decel: Option<f64>,
-    /// Replace a running jog or move (else ERR 3).
-    pub supersede: bool,
-}
-
-/// A hold-to-run jog (MAJ).
-#[derive(Clone, Debug, PartialEq)]
-pub struct JogSpec {
-    /// One axis or one gantry.
-    pub axis: String,
-    /// Signed: the sign is the direction.
-    pub speed: f64,
-    pub accel: Option<f64>,
-    pub decel: Option<f64>,
-    /// The jog stops when no renewal came for this long (50..=5000 ms).
-    pub lease: Duration,
-    /// How often the handle renews (well inside the lease).
-    pub renew_every: Duration,
-}
-
-impl JogSpec {
-    /// `motionctl jog`'s lease and renewal: 500 ms, renewed every 100 ms.
-    pub fn new(axis: &str, speed: f64) -> Self {
-        Self {
-            axis: axis.to_string(),
-            speed,
-            accel: None,
-            decel: None,
-            lease: Duration::from_millis(500),
-            renew_every: Duration::from_millis(100),
-        }
-    }
-}
+/// How many renewals a jog's handle sends per lease: one may be lost (or
+/// late on a busy host) four times in a row before the jog stops.
+const RENEWALS_PER_LEASE: u32 = 5;
 
 impl Client {
-    /// MSO: enable the drives of `axes` (empty: every axis).
-    pub fn enable(&mut self, axes: &[String]) -> Result<Box<ControlResponse>, OpError> {
-        let r = Request::Enable {
+    /// Any operation of the engine for `axes` (empty: every axis for
+    /// enable, disable and reset; the others need one); the answers carry
+    /// the operation ids to follow ([`crate::follow`]). A jog is better
+    /// started with [`Client::jog`], whose handle renews it.
+    pub fn operate(
+        &mut self,
+        axes: &[String],
+        op: Operation,
+    ) -> Result<Box<ControlResponse>, OpError> {
+        let r = Request::Operate {
             axes: Axes::from_names(axes),
-        };
-        accepted(self.send(&r, ANSWER)?)
-    }
-
-    /// MSF: disable the drives of `axes` (empty: every axis); a moving axis
-    /// is stopped first.
-    pub fn disable(&mut self, axes: &[String]) -> Result<Box<ControlResponse>, OpError> {
-        let r = Request::Disable {
-            axes: Axes::from_names(axes),
-        };
-        accepted(self.send(&r, ANSWER)?)
-    }
-
-    /// MAFR: clear the axis faults of `axes` (empty: every axis) and ask
-    /// their drives for a fault reset.
-    pub fn reset(&mut self, axes: &[String]) -> Result<Box<ControlResponse>, OpError> {
-        let r = Request::Reset {
-            axes: Axes::from_names(axes),
+            op,
         };
         accepted(self.send(&r, ANSWER)?)
     }
@@ -135,38 +87,19 @@ impl Client {
         accepted(self.send(&r, ANSWER)?)
     }
 
-    /// MAM: start a move; the answers carry the operation ids to follow
-    /// ([`crate::follow`]).
-    pub fn move_axes(&mut self, m: &MoveSpec) -> Result<Box<ControlResponse>, OpError> {
-        let r = Request::Move {
-            axes: Axes::Named(m.axes.clone()),
-            position: m.position,
-            relative: m.relative,
-            speed: m.speed,
-            accel: m.accel,
-            decel: m.decel,
-            supersede: m.supersede,
-        };
-        accepted(self.send(&r, ANSWER)?)
-    }
-
-    /// MAJ: start a hold-to-run jog. It runs while the returned [`Jog`]
-    /// lives (its thread renews the lease); dropping it ends the jog.
-    pub fn jog(&mut self, j: &JogSpec) -> Result<Jog, OpError> {
-        let r = Request::Jog {
-            axes: Axes::Named(vec![j.axis.clone()]),
-            speed: j.speed,
-            accel: j.accel,
-            decel: j.decel,
-            lease_ms: j.lease.as_millis().min(u32::MAX as u128) as u32,
-        };
-        let resp = accepted(self.send(&r, ANSWER)?)?;
+    /// MAJ: start a hold-to-run jog of `axis` (an axis or a gantry). It
+    /// runs while the returned [`Jog`] lives (its thread renews the lease
+    /// five times per lease); dropping it ends the jog.
+    pub fn jog(&mut self, axis: &str, j: JogSpec) -> Result<Jog, OpError> {
+        let resp = self.operate(&[axis.to_string()], Operation::Jog(j))?;
+        let lease = j.lease.unwrap_or(JOG_LEASE_S);
+        let every = Duration::from_secs_f64(lease.clamp(0.05, 5.0)) / RENEWALS_PER_LEASE;
         let domain = self.domain();
         Ok(Jog::start(
             domain.prefix.clone(),
             domain.runtime_dir.clone(),
             resp,
-            j.renew_every,
+            every,
         ))
     }
 }

@@ -4,8 +4,15 @@
 //! ([`Request::encode`]). The bytes stay those of [`ControlRequest`]
 //! (the Python package in `python/` speaks them): an unknown kind is a
 //! decode error, never some other request.
+//!
+//! An operation of the engine ([`Request::Operate`]) is carried as the
+//! engine declares it: its kind's number and its spec's parameters in the
+//! slots the spec gives them ([`motion_homing::params`]), so this file
+//! names no operation's parameter and a new operation needs nothing here.
 
 use crate::message::*;
+use motion_homing::params::{Carried, Refused};
+use motion_homing::{OpKind, Operation};
 
 /// The axes a request names.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -76,38 +83,14 @@ pub enum Request {
     TraceFetch { axis: Option<String>, offset: u64 },
     /// The latency histograms as an HdrHistogram log, a page from `offset`.
     Hlog { since: Since, offset: u64 },
-    /// MSO: enable the drives of `axes`, holding position.
-    Enable { axes: Axes },
-    /// MSF: disable the drives of `axes` (a moving axis is stopped first).
-    Disable { axes: Axes },
-    /// MAFR: clear the axis faults of `axes`, ask their drives for a fault
-    /// reset.
-    Reset { axes: Axes },
-    /// MAJ, hold to run: jog `axes` (one axis or one gantry) at `speed`
-    /// (signed) while the lease is renewed; `accel`/`decel` `None`: the
-    /// axis's homing ones. (A jog replaces a running jog; on a moving axis
-    /// it is refused, ERR 3: nothing supersedes a move but another move.)
-    Jog {
-        axes: Axes,
-        speed: f64,
-        accel: Option<f64>,
-        decel: Option<f64>,
-        lease_ms: u32,
-    },
+    /// An operation of the engine (enable, disable, reset, jog, move, …)
+    /// for `axes`, with its parameters as the client gave them (left out:
+    /// the axis's default, filled by the engine). A jog is hold to run on
+    /// one axis or gantry; its answer's token names it for `JogRenew`.
+    Operate { axes: Axes, op: Operation },
     /// Renew the lease of jog `token` (on `axes`; none: wherever it runs);
     /// `end`: end that jog now instead.
     JogRenew { axes: Axes, token: u64, end: bool },
-    /// MAM: move `axes` to `position` (`relative`: by it); `None`: the
-    /// axis's homing speed, acceleration, deceleration.
-    Move {
-        axes: Axes,
-        position: f64,
-        relative: bool,
-        speed: Option<f64>,
-        accel: Option<f64>,
-        decel: Option<f64>,
-        supersede: bool,
-    },
     /// Take `axes` over for the setpoint stream of program `owner`, whose
     /// publishing iceoryx2 node is `node_id`.
     StreamAcquire {
@@ -124,19 +107,32 @@ pub enum Request {
 pub enum DecodeError {
     #[error("unknown request kind {0}")]
     UnknownKind(u32),
+    #[error("no operation a client may ask for has the number {0}")]
+    UnknownOperation(u32),
+    #[error("{op}: {refused}")]
+    Param { op: &'static str, refused: Refused },
 }
 
 /// Longest `timeout_s` taken (a day); longer ones are cut to it.
 const TIMEOUT_MAX_S: f64 = 86_400.0;
 
-/// NaN on the wire: "the axis's default".
-fn param(x: f64) -> Option<f64> {
-    (!x.is_nan()).then_some(x)
-}
-
-/// A parameter for the wire: `None` is NaN.
-fn wire(x: Option<f64>) -> f64 {
-    x.unwrap_or(f64::NAN)
+/// The operation a message carries (`REQ_OPERATE`): a kind clients may
+/// ask for, and its parameters as its spec reads them.
+fn operation(m: &ControlRequest) -> Result<Operation, DecodeError> {
+    let kind = u8::try_from(m.op)
+        .ok()
+        .and_then(OpKind::from_number)
+        .filter(|k| k.client())
+        .ok_or(DecodeError::UnknownOperation(m.op))?;
+    let carried = Carried {
+        values: m.values,
+        switches: m.switches,
+        name: m.name,
+    };
+    Operation::take(kind, &carried).map_err(|refused| DecodeError::Param {
+        op: kind.name(),
+        refused,
+    })
 }
 
 impl Request {
@@ -174,33 +170,18 @@ impl Request {
                 since,
                 offset: m.offset,
             },
-            REQ_ENABLE => Request::Enable { axes: axes() },
-            REQ_DISABLE => Request::Disable { axes: axes() },
-            REQ_RESET => Request::Reset { axes: axes() },
-            REQ_JOG => Request::Jog {
+            REQ_OPERATE => Request::Operate {
                 axes: axes(),
-                speed: m.speed,
-                accel: param(m.accel),
-                decel: param(m.decel),
-                lease_ms: m.lease_ms,
+                op: operation(m)?,
             },
             REQ_JOG_RENEW => Request::JogRenew {
                 axes: axes(),
                 token: m.token,
                 end: m.flags & FLAG_END != 0,
             },
-            REQ_MOVE => Request::Move {
-                axes: axes(),
-                position: m.position,
-                relative: m.flags & FLAG_RELATIVE != 0,
-                speed: param(m.speed),
-                accel: param(m.accel),
-                decel: param(m.decel),
-                supersede: m.flags & FLAG_SUPERSEDE != 0,
-            },
             REQ_STREAM_ACQUIRE => Request::StreamAcquire {
                 axes: axes(),
-                owner: get_str(&m.owner),
+                owner: get_str(&m.name),
                 node_id: u128::from(m.node_id[0]) | u128::from(m.node_id[1]) << 64,
             },
             REQ_STREAM_RELEASE => Request::StreamRelease { token: m.token },
@@ -265,19 +246,13 @@ impl Request {
                 m.offset = *offset;
                 &[]
             }
-            Request::Enable { axes } => {
-                m.kind = REQ_ENABLE;
+            Request::Operate { axes, op } => {
+                m.kind = REQ_OPERATE;
+                m.op = u32::from(op.kind() as u8);
+                let c = op.carried();
+                (m.values, m.switches, m.name) = (c.values, c.switches, c.name);
                 axes.names()
             }
-            Request::Disable { axes } => {
-                m.kind = REQ_DISABLE;
-                axes.names()
-            }
-            Request::Reset { axes } => {
-                m.kind = REQ_RESET;
-                axes.names()
-            }
-            Request::Jog { .. } | Request::Move { .. } => return self.encode_motion(m),
             Request::JogRenew { axes, token, end } => {
                 m.kind = REQ_JOG_RENEW;
                 m.token = *token;
@@ -293,7 +268,7 @@ impl Request {
                     return None;
                 }
                 m.kind = REQ_STREAM_ACQUIRE;
-                put_str(&mut m.owner, owner);
+                put_str(&mut m.name, owner);
                 m.node_id = [*node_id as u64, (*node_id >> 64) as u64];
                 axes.names()
             }
@@ -305,48 +280,12 @@ impl Request {
         };
         m.set_axes(names).then_some(m)
     }
-
-    /// `encode` of a jog or a move (the motion parameters; NaN for a
-    /// default).
-    fn encode_motion(&self, mut m: Box<ControlRequest>) -> Option<Box<ControlRequest>> {
-        let supersede = |s: bool| if s { FLAG_SUPERSEDE } else { 0 };
-        let names = match self {
-            Request::Jog {
-                axes,
-                speed,
-                accel,
-                decel,
-                lease_ms,
-            } => {
-                m.kind = REQ_JOG;
-                (m.speed, m.accel, m.decel) = (*speed, wire(*accel), wire(*decel));
-                m.lease_ms = *lease_ms;
-                axes.names()
-            }
-            Request::Move {
-                axes,
-                position,
-                relative,
-                speed,
-                accel,
-                decel,
-                supersede: s,
-            } => {
-                m.kind = REQ_MOVE;
-                m.flags = supersede(*s) | if *relative { FLAG_RELATIVE } else { 0 };
-                m.position = *position;
-                (m.speed, m.accel, m.decel) = (wire(*speed), wire(*accel), wire(*decel));
-                axes.names()
-            }
-            _ => return None,
-        };
-        m.set_axes(names).then_some(m)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use motion_homing::{JogSpec, MoveSpec};
 
     fn named(n: &[&str]) -> Axes {
         Axes::Named(n.iter().map(|s| s.to_string()).collect())
@@ -395,19 +334,26 @@ mod tests {
                 since: Since::Reset,
                 offset: 7,
             },
-            Request::Enable { axes: Axes::All },
-            Request::Disable {
-                axes: named(&["X"]),
+            Request::Operate {
+                axes: Axes::All,
+                op: Operation::Enable,
             },
-            Request::Reset {
+            Request::Operate {
+                axes: named(&["X"]),
+                op: Operation::Disable,
+            },
+            Request::Operate {
                 axes: named(&["X", "Y"]),
+                op: Operation::Reset,
             },
-            Request::Jog {
+            Request::Operate {
                 axes: named(&["X"]),
-                speed: -2.5,
-                accel: None,
-                decel: Some(40.0),
-                lease_ms: 500,
+                op: Operation::Jog(JogSpec {
+                    speed: -2.5,
+                    lease: Some(0.5),
+                    accel: None,
+                    decel: Some(40.0),
+                }),
             },
             Request::JogRenew {
                 axes: Axes::All,
@@ -419,23 +365,18 @@ mod tests {
                 token: 1,
                 end: true,
             },
-            Request::Move {
+            Request::Operate {
                 axes: named(&["Y"]),
-                position: 12.5,
-                relative: true,
-                speed: Some(3.0),
-                accel: Some(100.0),
-                decel: None,
-                supersede: false,
+                op: Operation::Move(MoveSpec {
+                    relative: true,
+                    speed: Some(3.0),
+                    accel: Some(100.0),
+                    ..MoveSpec::to(12.5)
+                }),
             },
-            Request::Move {
+            Request::Operate {
                 axes: named(&["Y"]),
-                position: -1.0,
-                relative: false,
-                speed: None,
-                accel: None,
-                decel: None,
-                supersede: true,
+                op: Operation::Move(MoveSpec::to(-1.0)),
             },
             Request::StreamAcquire {
                 axes: named(&["X", "Y"]),
@@ -451,11 +392,43 @@ mod tests {
 
     #[test]
     fn an_unknown_kind_is_an_error_not_another_request() {
-        for k in [0, 17, 99, u32::MAX] {
+        for k in [0, 10, 14, 17, 99, u32::MAX] {
             let mut m = ControlRequest::zeroed();
             m.kind = k;
             assert_eq!(Request::decode(&m), Err(DecodeError::UnknownKind(k)));
         }
+    }
+
+    /// An operation's number must be one a client may ask for; its
+    /// parameters are its spec's, each refused by name.
+    #[test]
+    fn an_operation_is_a_client_s_kind_with_its_spec_s_parameters() {
+        let mut m = ControlRequest::zeroed();
+        m.kind = REQ_OPERATE;
+        for op in [
+            0,
+            OpKind::StreamStart as u32,
+            OpKind::Stop as u32,
+            99,
+            256 + 1,
+        ] {
+            m.op = op;
+            assert_eq!(
+                Request::decode(&m),
+                Err(DecodeError::UnknownOperation(op)),
+                "{op}"
+            );
+        }
+        // A jog's speed must be given: NaN is left out.
+        m.op = OpKind::Jog as u32;
+        m.values = [f64::NAN; OP_SLOTS];
+        let e = Request::decode(&m).unwrap_err();
+        assert_eq!(e.to_string(), "jog: speed must be given");
+        m.values[0] = 3.0;
+        let Ok(Request::Operate { op, .. }) = Request::decode(&m) else {
+            panic!("a jog");
+        };
+        assert_eq!(op, Operation::Jog(JogSpec::at(3.0)));
     }
 
     #[test]

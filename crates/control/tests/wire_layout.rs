@@ -145,8 +145,7 @@ fn structs() -> Vec<Struct> {
     vec![
         describe!(ControlRequest, iox_name::<ControlRequest>(), {
             layout_version, kind, key, request_id, flags, axis_count, offset,
-            timeout_s, position, speed, accel, decel, token, node_id, lease_ms,
-            reserved, owner, axes,
+            timeout_s, token, node_id, op, switches, values, name, axes,
         }),
         describe!(AxisAnswer, None, {
             name, accepted, reason, err, exerr, index, op_id, reserved,
@@ -207,6 +206,7 @@ fn constants() -> Vec<(&'static str, u64)> {
         FLAG_BITS,
         INT_SLOTS,
         VALUE_SLOTS,
+        OP_SLOTS,
         REQ_HOME,
         REQ_STOP,
         REQ_UNHOME,
@@ -215,19 +215,13 @@ fn constants() -> Vec<(&'static str, u64)> {
         REQ_TRACE,
         REQ_TRACE_FETCH,
         REQ_HLOG,
-        REQ_ENABLE,
-        REQ_DISABLE,
-        REQ_RESET,
-        REQ_JOG,
+        REQ_OPERATE,
         REQ_JOG_RENEW,
-        REQ_MOVE,
         REQ_STREAM_ACQUIRE,
         REQ_STREAM_RELEASE,
         FLAG_RESET,
         FLAG_SINCE_RESET,
         FLAG_PARALLEL,
-        FLAG_RELATIVE,
-        FLAG_SUPERSEDE,
         FLAG_END,
         RESULT_ACCEPTED,
         RESULT_REFUSED,
@@ -282,6 +276,61 @@ fn quoted(s: &str) -> String {
     serde_json::to_string(s).expect("a string serializes")
 }
 
+/// The operations a client may ask for (`REQ_OPERATE`), each with its
+/// parameters as the engine's spec declares them: where each is carried
+/// (a number's slot in `values`, a switch's bit in `switches`, an axis in
+/// `name`), its kind, unit, default and doc — what the Python client
+/// builds its calls from. One line per parameter.
+fn operations() -> String {
+    use motion_homing::params::{Kind, Place};
+    let ops: Vec<OpKind> = OpKind::ALL.iter().copied().filter(|k| k.client()).collect();
+    let mut out = String::from("  \"operations\": [\n");
+    for (i, k) in ops.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "    {{\"name\": {}, \"op\": {}, \"all_by_default\": {}, \"held\": {}, \"params\": [",
+            quoted(k.name()),
+            *k as u8,
+            k.all_by_default(),
+            k.held()
+        );
+        let params = k.params();
+        for (n, p) in params.iter().enumerate() {
+            let (kind, choices) = match p.kind {
+                Kind::Number => ("number", None),
+                Kind::Optional => ("optional", None),
+                Kind::Switch => ("switch", None),
+                Kind::Choice(c) => ("choice", Some(c)),
+                Kind::Axis => ("axis", None),
+                Kind::Pair => ("pair", None),
+            };
+            let place = match p.place {
+                Place::Slot(s) => format!("\"slot\": {s}"),
+                Place::Bit(b) => format!("\"bit\": {b}"),
+                Place::Name => "\"name_field\": true".to_string(),
+            };
+            let choices = choices.map_or(String::new(), |c| {
+                let c: Vec<String> = c.iter().map(|x| quoted(x)).collect();
+                format!(", \"choices\": [{}]", c.join(", "))
+            });
+            let default = p.fallback.describe().map_or("null".to_string(), quoted);
+            let doc = p.doc.lines().map(str::trim).collect::<Vec<_>>().join(" ");
+            let comma = if n + 1 < params.len() { "," } else { "" };
+            let _ = writeln!(
+                out,
+                "      {{\"name\": {}, \"kind\": \"{kind}\", {place}{choices}, \"unit\": {}, \"default\": {default}, \"doc\": {}}}{comma}",
+                quoted(p.name),
+                quoted(p.unit.symbol()),
+                quoted(doc.trim())
+            );
+        }
+        let comma = if i + 1 < ops.len() { "," } else { "" };
+        let _ = writeln!(out, "    ]}}{comma}");
+    }
+    out += "  ]\n";
+    out
+}
+
 /// The description as JSON: one line per field and constant, so a change
 /// shows as a readable diff.
 fn description() -> String {
@@ -322,7 +371,9 @@ fn description() -> String {
         let comma = if i + 1 < structs.len() { "," } else { "" };
         let _ = writeln!(out, "    ]}}{comma}");
     }
-    out += "  ]\n}\n";
+    out += "  ],\n";
+    out += &operations();
+    out += "}\n";
     out
 }
 

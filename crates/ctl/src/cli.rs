@@ -1,7 +1,9 @@
 //! `motionctl`'s command line (interface.md), parsed with clap.
 
+use crate::spec_args::SpecArgs;
 use clap::{Args, Parser, Subcommand};
-use motion_config::args::{axis, number, runtime_dir, seconds, service_prefix};
+use motion_config::args::{axis, runtime_dir, seconds, service_prefix};
+use motion_control::{JogSpec, MoveSpec};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -114,15 +116,10 @@ pub struct JogArgs {
     /// The axis or gantry to jog.
     #[arg(value_name = "AXIS", value_parser = axis)]
     pub axis: String,
-    /// Units/s; the sign is the direction.
-    #[arg(long, value_name = "V", allow_negative_numbers = true, value_parser = number)]
-    pub speed: f64,
-    /// Units/s² (default: the axis's home_acceleration).
-    #[arg(long, value_name = "A", value_parser = number)]
-    pub accel: Option<f64>,
-    /// Units/s² (default: the axis's home_deceleration).
-    #[arg(long, value_name = "D", value_parser = number)]
-    pub decel: Option<f64>,
+    /// The jog's parameters (the engine's `JogSpec`): --speed V [--accel
+    /// A] [--decel D].
+    #[command(flatten)]
+    pub jog: SpecArgs<JogSpec>,
     /// Stop after S seconds.
     #[arg(long = "for", value_name = "S", value_parser = seconds)]
     pub for_s: Option<f64>,
@@ -131,32 +128,17 @@ pub struct JogArgs {
 }
 
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("target").required(true).args(["to", "by"])))]
 pub struct MoveArgs {
     /// The axis or gantry to move.
     #[arg(value_name = "AXIS", value_parser = axis)]
     pub axis: String,
-    /// Target position, axis coordinates (units).
-    #[arg(long, value_name = "P", allow_negative_numbers = true, value_parser = number)]
-    pub to: Option<f64>,
-    /// Distance from where the move starts (units).
-    #[arg(long, value_name = "D", allow_negative_numbers = true, value_parser = number)]
-    pub by: Option<f64>,
-    /// Units/s (default: the axis's home_speed).
-    #[arg(long, value_name = "V", value_parser = number)]
-    pub speed: Option<f64>,
-    /// Units/s² (default: the axis's home_acceleration).
-    #[arg(long, value_name = "A", value_parser = number)]
-    pub accel: Option<f64>,
-    /// Units/s² (default: the axis's home_deceleration).
-    #[arg(long, value_name = "D", value_parser = number)]
-    pub decel: Option<f64>,
+    /// The move's parameters (the engine's `MoveSpec`): (--to P | --by D)
+    /// [--speed V] [--accel A] [--decel D] and its switches.
+    #[command(flatten)]
+    pub spec: SpecArgs<MoveSpec>,
     /// Return once the move is accepted, without following it.
     #[arg(long)]
     pub no_wait: bool,
-    /// Replace a running jog or move of the axis (else refused, ERR 3).
-    #[arg(long)]
-    pub supersede: bool,
     #[arg(long)]
     pub json: bool,
 }

@@ -3,3 +3,4 @@
 //! binary parses with (`crates/docgen`). Everything else lives in the binary.
 
 pub mod cli;
+pub mod spec_args;

@@ -211,6 +211,11 @@ impl Daemon {
         ctl(&self.prefix, args)
     }
 
+    /// Its process id.
+    pub fn pid(&self) -> u32 {
+        self.running.as_ref().map_or(0, Running::pid)
+    }
+
     /// Its stderr so far (and its spawned `motion-io`'s, which shares it).
     pub fn stderr(&self) -> String {
         self.running

@@ -10,7 +10,7 @@ use motion_frames::{axis_to_command, feedback_to_axis, CommandFrame, FeedbackFra
 use motion_homing::{Axis, Feedback, Phase, Request};
 use motion_plant::Plant;
 use motion_supervisor::core::Core;
-use motion_supervisor::shared::Control;
+use motion_supervisor::shared::{Ask, Control};
 
 /// Cycles of real homing (against the plants) before a cycle is measured.
 pub const CYCLE_WARMUP: u64 = 400;
@@ -131,15 +131,12 @@ pub fn homing_core(m: &MachineConfig) -> (Core, FeedbackFrame, CommandFrame, u64
     fb.header.origin = 1;
     for k in 0..CYCLE_WARMUP {
         if k == 10 {
-            core.control(
-                Control::Home {
-                    id: 1,
-                    mask: u64::MAX >> (64 - m.axes.len()),
-                    parallel: true,
-                    timeout_ns: 0,
-                },
-                k * dt_ns,
-            );
+            let home = Ask::Home {
+                mask: u64::MAX >> (64 - m.axes.len()),
+                parallel: true,
+                timeout_ns: 0,
+            };
+            core.control(Control::undated(1, home), k * dt_ns);
         }
         core.step(k * dt_ns, false, &[(k > 0).then_some(&fb)]);
         core.fill(0, &mut cmd);

@@ -5,7 +5,7 @@
 //! `motion_control`'s [`Stream`](motion_control::stream::Stream) — the
 //! Rust client a program uses, so what is measured is what a program sees.
 
-use motion_control::{Axes, Client, Request, RESULT_ACCEPTED};
+use motion_control::{Axes, Client, Operation, Request, RESULT_ACCEPTED};
 use motion_rt::{enter_realtime, now_ns, PeriodicTimer, RtConfig};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -23,7 +23,11 @@ pub fn home_and_enable(prefix: &str, n: usize) -> Result<(), String> {
         parallel: true,
         timeout_s: None,
     };
-    for r in [home, Request::Enable { axes: all }] {
+    let enable = Request::Operate {
+        axes: all,
+        op: Operation::Enable,
+    };
+    for r in [home, enable] {
         let resp = c
             .send(&r, Duration::from_secs(3))
             .map_err(|e| e.to_string())?;

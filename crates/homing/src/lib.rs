@@ -19,7 +19,8 @@
 //! * [`status`]: the instruction's and the axis's status after a cycle.
 //! * [`operation`]: the operations around homing (enable, disable, reset,
 //!   jog, move, stop, the supervised stream) as they cross the boundary;
-//!   [`op_limits`]: the bounds they run within.
+//!   [`op_limits`]: the bounds they run within; [`params`]: an operation's
+//!   parameters declared once with its spec, and carried by every layer.
 //! * [`names`]: every enum's spellings, written once next to the enum.
 //! * [`time`]: ns ↔ s conversions, exact and cheap.
 //! * [`equivalent`]: the CiA 402 homing method and PLCopen function blocks
@@ -33,6 +34,7 @@ pub mod io;
 pub mod names;
 pub mod op_limits;
 pub mod operation;
+pub mod params;
 pub mod plan;
 pub mod position;
 pub mod profile;
@@ -48,7 +50,9 @@ pub use op_limits::{
     effective_max_deceleration, effective_stream_acceleration, effective_stream_timeout_ns,
     effective_unhomed_speed, OpLimits,
 };
-pub use operation::{OpKind, OpStatus, Operation, Setpoint, StopCause};
+// Every operation, its verbs and its spec types, whatever the table adds.
+pub use operation::*;
+pub use params::{AxisRef, Carried, Param, Spec};
 pub use status::{Implausible, Phase, Status};
 pub use validate::{
     advisories, effective_max_speed, effective_search_limit, validate, ConfigError,

@@ -21,6 +21,19 @@ impl fmt::Display for UnknownName {
 
 impl std::error::Error for UnknownName {}
 
+/// An enum with a [`spellings!`](crate::spellings) table, as a generic
+/// caller sees it: an operation's parameter of one of these types (a
+/// choice, `params::Kind::Choice`) is carried as the index of its
+/// spelling and offered by its spellings.
+pub trait Spelled: Copy + 'static {
+    /// The spellings, in the table's order.
+    const SPELLINGS: &'static [&'static str];
+    /// The position of `self`'s spelling in [`Self::SPELLINGS`].
+    fn index(self) -> usize;
+    /// The variant of the spelling at `i`.
+    fn from_index(i: usize) -> Option<Self>;
+}
+
 /// Gives a fieldless enum its spellings from one table:
 ///
 /// * `NAMES`: every variant with its spelling, in the order a configuration
@@ -30,7 +43,8 @@ impl std::error::Error for UnknownName {}
 /// * `from_number(n)`: the variant whose discriminant is `n` (the CIP
 ///   attribute value where CIP defines one, as the frames carry it);
 /// * `FromStr` (error [`UnknownName`](crate::names::UnknownName)) and
-///   `Display` (the spelling).
+///   `Display` (the spelling);
+/// * [`Spelled`](crate::names::Spelled): the same for generic callers.
 ///
 /// ```
 /// #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,6 +76,18 @@ macro_rules! spellings {
                     .iter()
                     .map(|&(_, v)| v)
                     .find(|&v| v as u8 == n)
+            }
+        }
+
+        impl $crate::names::Spelled for $ty {
+            const SPELLINGS: &'static [&'static str] = &[$($name),+];
+
+            fn index(self) -> usize {
+                Self::NAMES.iter().position(|&(_, v)| v as u8 == self as u8).unwrap_or(0)
+            }
+
+            fn from_index(i: usize) -> Option<Self> {
+                Self::NAMES.get(i).map(|&(_, v)| v)
             }
         }
 

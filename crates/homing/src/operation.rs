@@ -10,81 +10,511 @@
 //! behaviour lives in `axis::ops`; the ERR / EXERR of a refusal are in
 //! [`codes`](crate::codes).
 //!
+//! An operation with parameters carries its spec (`JogSpec`, `MoveSpec`,
+//! written with [`op_spec!`](crate::op_spec)): declared here once, with
+//! how every layer outside the engine carries and offers each parameter
+//! ([`params`](crate::params)); the control request, the core, OPC UA,
+//! Python and motionctl carry it unchanged, and the engine fills what was
+//! left out from the axis's configuration as it arrives
+//! ([`Operation::resolve`]).
+//!
 //! Positions here are in **axis** coordinates (the reference HomedStatus
 //! stands for; before the first homing, the raw position), speeds in
 //! units/s, accelerations in units/s², times in ns.
 
-/// One operation, applied in the step it arrives and answered in
-/// `Status::op` of that step (accepted with a new id, or refused with an
-/// ERR / EXERR and no effect at all).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Operation {
+use crate::config::AxisConfig;
+use crate::params::{Carried, Fallback, Form, Param, Refused, Spec, Unit, Why};
+
+/// Declares [`Operation`], its verbs [`OpKind`] (one row each: the
+/// number a status frame carries, the spelling, the OPC UA method's name,
+/// and what the layers around the engine need to know of it), their
+/// spellings, and the dispatch from a kind to its spec. A new operation is
+/// a row here and its spec type; everything else derives from both.
+macro_rules! operations {
+    ($(
+        $(#[doc = $doc:literal])*
+        $variant:ident $( ( $spec:ident ) )? = $num:literal {
+            name: $name:literal,
+            title: $title:literal,
+            client: $client:literal,
+            moves: $moves:literal,
+            held: $held:literal,
+            all: $all:literal,
+            summary: $summary:literal $(,)?
+        }
+    )*) => {
+        /// One operation, applied in the step it arrives and answered in
+        /// `Status::op` of that step (accepted with a new id, or refused
+        /// with an ERR / EXERR and no effect at all). One with parameters
+        /// carries its spec, unchanged from the client that asked.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum Operation {
+            $( $(#[doc = $doc])* $variant $( ($spec) )?, )*
+        }
+
+        /// Which operation: the verbs. The numbers are what a status frame
+        /// and a control request carry; the spellings are JSON's.
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        #[repr(u8)]
+        pub enum OpKind {
+            /// No operation was asked for since the engine started.
+            #[default]
+            None = 0,
+            $( $variant = $num, )*
+        }
+
+        crate::spellings!(OpKind {
+            None => "none",
+            $( $variant => $name, )*
+        });
+
+        impl OpKind {
+            /// Every operation, in the table's order.
+            pub const ALL: &'static [OpKind] = &[$( OpKind::$variant ),*];
+
+            /// Its row of the table.
+            pub const fn traits(self) -> OpTraits {
+                match self {
+                    OpKind::None => OpTraits::NONE,
+                    $( OpKind::$variant => OpTraits {
+                        title: $title,
+                        client: $client,
+                        moves: $moves,
+                        held: $held,
+                        all_by_default: $all,
+                        summary: $summary,
+                    }, )*
+                }
+            }
+
+            /// Its parameters (none for most).
+            pub fn params(self) -> &'static [Param] {
+                match self {
+                    OpKind::None => &[],
+                    $( OpKind::$variant => spec_params!($($spec)?), )*
+                }
+            }
+        }
+
+        impl Operation {
+            /// The kind, as `Status::op` shows it.
+            pub fn kind(&self) -> OpKind {
+                match self {
+                    $( Operation::$variant $( (wild!($spec)) )? => OpKind::$variant, )*
+                }
+            }
+
+            /// The operation of `kind` with the carried parameters `c`
+            /// (what a client sent).
+            pub fn take(kind: OpKind, c: &Carried) -> Result<Operation, Refused> {
+                match kind {
+                    OpKind::None => Err(Refused { param: "kind", why: Why::NotAnOperation }),
+                    $( OpKind::$variant => take_op!(c, $variant $(, $spec)?), )*
+                }
+            }
+
+            fn spec(&self) -> Option<&dyn Carrier> {
+                match self {
+                    $( Operation::$variant $( (bind!(s, $spec)) )? => some_spec!(s $(, $spec)?), )*
+                }
+            }
+
+            fn spec_mut(&mut self) -> Option<&mut dyn Carrier> {
+                match self {
+                    $( Operation::$variant $( (bind!(s, $spec)) )? => some_spec!(s $(, $spec)?), )*
+                }
+            }
+        }
+    };
+}
+
+/// What the layers around the engine need to know of an operation: its
+/// row of the [`operations!`] table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OpTraits {
+    /// Its OPC UA method's name.
+    pub title: &'static str,
+    /// A client may ask for it (the control service, OPC UA, Python,
+    /// motionctl): the others are the daemon's own (the stream's start and
+    /// end go with its acquire and release; a client stops with the
+    /// control service's stop).
+    pub client: bool,
+    /// It moves the axis (or takes it over to be moved): the cycle refuses
+    /// it on an axis a program owns, that a home sequence will start or
+    /// whose I/O process is not attached, and a gantry takes it on every
+    /// side or on none.
+    pub moves: bool,
+    /// Hold to run: it runs while its client renews it (a token names it),
+    /// on one axis or one gantry.
+    pub held: bool,
+    /// Asked for without naming an axis, it applies to every axis (else it
+    /// needs one).
+    pub all_by_default: bool,
+    /// What it does, in a line (OPC UA's method description).
+    pub summary: &'static str,
+}
+
+impl OpTraits {
+    /// [`OpKind::None`]'s: nothing.
+    const NONE: OpTraits = OpTraits {
+        title: "",
+        client: false,
+        moves: false,
+        held: false,
+        all_by_default: false,
+        summary: "",
+    };
+}
+
+impl OpKind {
+    /// See [`OpTraits::title`].
+    pub const fn title(self) -> &'static str {
+        self.traits().title
+    }
+    /// See [`OpTraits::client`].
+    pub const fn client(self) -> bool {
+        self.traits().client
+    }
+    /// See [`OpTraits::moves`].
+    pub const fn moves(self) -> bool {
+        self.traits().moves
+    }
+    /// See [`OpTraits::held`].
+    pub const fn held(self) -> bool {
+        self.traits().held
+    }
+    /// See [`OpTraits::all_by_default`].
+    pub const fn all_by_default(self) -> bool {
+        self.traits().all_by_default
+    }
+    /// See [`OpTraits::summary`].
+    pub const fn summary(self) -> &'static str {
+        self.traits().summary
+    }
+}
+
+/// `_` for a variant's spec in a pattern.
+macro_rules! wild {
+    ($spec:ident) => {
+        _
+    };
+}
+
+/// The binding `$s` for a variant's spec in a pattern.
+macro_rules! bind {
+    ($s:ident, $spec:ident) => {
+        $s
+    };
+}
+
+/// The spec bound as `$s`, if the variant has one.
+macro_rules! some_spec {
+    ($s:ident) => {
+        None
+    };
+    ($s:ident, $spec:ident) => {
+        Some($s)
+    };
+}
+
+macro_rules! spec_params {
+    () => {
+        &[]
+    };
+    ($spec:ident) => {
+        <$spec as Spec>::PARAMS
+    };
+}
+
+macro_rules! take_op {
+    ($c:ident, $variant:ident) => {
+        Ok(Operation::$variant)
+    };
+    ($c:ident, $variant:ident, $spec:ident) => {
+        <$spec as Spec>::take($c).map(Operation::$variant)
+    };
+}
+
+/// What [`Operation`] needs of a spec without knowing its type.
+trait Carrier {
+    fn carry_dyn(&self, c: &mut Carried);
+    fn resolve_dyn(&mut self, cfg: &AxisConfig);
+    fn resolve_axes_dyn(
+        &mut self,
+        lookup: &mut dyn FnMut(&str) -> Option<u16>,
+    ) -> Result<(), Refused>;
+}
+
+impl<T: Spec> Carrier for T {
+    fn carry_dyn(&self, c: &mut Carried) {
+        self.carry(c);
+    }
+    fn resolve_dyn(&mut self, cfg: &AxisConfig) {
+        self.resolve(cfg);
+    }
+    fn resolve_axes_dyn(
+        &mut self,
+        lookup: &mut dyn FnMut(&str) -> Option<u16>,
+    ) -> Result<(), Refused> {
+        self.resolve_axes(lookup)
+    }
+}
+
+impl Operation {
+    /// Its parameters as a client carries them ([`Carried::EMPTY`] for
+    /// none).
+    pub fn carried(&self) -> Carried {
+        let mut c = Carried::EMPTY;
+        if let Some(s) = self.spec() {
+            s.carry_dyn(&mut c);
+        }
+        c
+    }
+
+    /// Its parameters left out, from the axis's configuration: the one
+    /// place defaults are resolved (the engine does it as the operation
+    /// arrives, `Axis::operation`).
+    pub fn resolve(&mut self, cfg: &AxisConfig) {
+        if let Some(s) = self.spec_mut() {
+            s.resolve_dyn(cfg);
+        }
+    }
+
+    /// Its axis parameters named by a client: their indices by `lookup`
+    /// (the control thread, which has the machine's names).
+    pub fn resolve_axes(
+        &mut self,
+        lookup: &mut dyn FnMut(&str) -> Option<u16>,
+    ) -> Result<(), Refused> {
+        match self.spec_mut() {
+            Some(s) => s.resolve_axes_dyn(lookup),
+            None => Ok(()),
+        }
+    }
+}
+
+operations! {
     /// MSO / MC_Power on: request the power stage on, holding the actual
     /// position (the command follows the actual position while disabled,
     /// so enabling never jumps). IP until the drive reports enabled; an
     /// enable timeout is an axis fault (ER 12 / 42).
-    Enable,
+    Enable = 1 {
+        name: "enable",
+        title: "Enable",
+        client: true,
+        moves: false,
+        held: false,
+        all: true,
+        summary: "MSO: enable the drive, holding position",
+    }
     /// MSF / MC_Power off: a moving axis is stopped first (with the
     /// deceleration of the running motion), then the power stage is
     /// switched off; homing in process aborts with ERR 12 / EXERR 1. Always
     /// accepted.
-    Disable,
+    Disable = 2 {
+        name: "disable",
+        title: "Disable",
+        client: true,
+        moves: false,
+        held: false,
+        all: true,
+        summary: "MSF: disable the drive (a moving axis is stopped first)",
+    }
     /// MAFR / MC_Reset: clears the axis's ER / ERR / EXERR and `faulted`,
     /// and asks the drive for a fault reset (`Command::fault_reset`). Never
     /// enables, never moves.
-    Reset,
-    /// MAJ / MC_Jog, hold to run: runs in the sign of `speed` until stopped
-    /// (a stop, a limit, a fault, or the lease running out). `lease_ns`: the
-    /// jog stops normally unless `Request::jog_renew` renews it within this
-    /// time (an HMI or program that dies never leaves an axis running).
-    Jog {
-        speed: f64,
-        accel: f64,
-        decel: f64,
-        lease_ns: u64,
-    },
-    /// MAM / MC_MoveAbsolute (`relative = false`: `target` is an axis
-    /// position) or MC_MoveRelative (`relative`: `target` is a distance from
-    /// the current command position): a trapezoid ending at rest on the
-    /// target (PC). `supersede`: replaces a jog or move in progress (without
-    /// it, such an axis refuses with ERR 3). On a cyclic axis an absolute
-    /// target is reached the shortest way.
-    Move {
-        target: f64,
-        relative: bool,
-        speed: f64,
-        accel: f64,
-        decel: f64,
-        supersede: bool,
-    },
+    Reset = 3 {
+        name: "reset",
+        title: "Reset",
+        client: true,
+        moves: false,
+        held: false,
+        all: true,
+        summary: "MAFR: clear the axis's error and ask the drive for a fault reset",
+    }
+    /// MAJ / MC_Jog, hold to run ([`JogSpec`]).
+    Jog(JogSpec) = 4 {
+        name: "jog",
+        title: "Jog",
+        client: true,
+        moves: true,
+        held: true,
+        all: false,
+        summary: "MAJ, hold to run: jog this axis while called again within Duration",
+    }
+    /// MAM / MC_MoveAbsolute, MC_MoveRelative ([`MoveSpec`]).
+    Move(MoveSpec) = 5 {
+        name: "move",
+        title: "Move",
+        client: true,
+        moves: true,
+        held: false,
+        all: false,
+        summary: "MAM: a trapezoidal move to Target (or by it); done when MoveStatus drops",
+    }
     /// The supervised stream starts: from now on the axis follows the
     /// setpoints of `Request::setpoint`, interpolated to the cycle, each one
     /// checked (ERR 1019 when refused).
-    StreamStart,
+    StreamStart = 6 {
+        name: "stream_start",
+        title: "StreamStart",
+        client: false,
+        moves: true,
+        held: false,
+        all: false,
+        summary: "the supervised setpoint stream starts",
+    }
     /// The stream ends (released by its owner, or the owner is gone): the
     /// axis comes to rest, landing on the last setpoint when the
     /// deceleration allows. Always accepted.
-    StreamEnd,
+    StreamEnd = 7 {
+        name: "stream_end",
+        title: "StreamEnd",
+        client: false,
+        moves: false,
+        held: false,
+        all: false,
+        summary: "the supervised setpoint stream ends",
+    }
     /// MAS / MC_Stop: ends a jog, move or stream normally (no error,
     /// HomedStatus kept, the drive stays enabled) with the deceleration of
     /// the running motion; homing in process ends with ERR 12 / EXERR 1 as a
     /// `Request::stop` does. Always accepted.
-    Stop,
+    Stop = 8 {
+        name: "stop",
+        title: "Stop",
+        client: false,
+        moves: false,
+        held: false,
+        all: true,
+        summary: "MAS: stop the axis",
+    }
 }
 
-impl Operation {
-    /// The kind, as `Status::op` shows it.
-    pub fn kind(&self) -> OpKind {
-        match self {
-            Operation::Enable => OpKind::Enable,
-            Operation::Disable => OpKind::Disable,
-            Operation::Reset => OpKind::Reset,
-            Operation::Jog { .. } => OpKind::Jog,
-            Operation::Move { .. } => OpKind::Move,
-            Operation::StreamStart => OpKind::StreamStart,
-            Operation::StreamEnd => OpKind::StreamEnd,
-            Operation::Stop => OpKind::Stop,
+/// A motion's acceleration (a jog's, a move's): one parameter, whichever
+/// operation carries it.
+const ACCEL: Param = Param::new("Accel", Unit::Acceleration)
+    .or(Fallback::HomeAcceleration)
+    .flag("accel", "A");
+/// A motion's deceleration.
+const DECEL: Param = Param::new("Decel", Unit::Acceleration)
+    .or(Fallback::HomeDeceleration)
+    .flag("decel", "D");
+
+crate::op_spec! {
+    /// MAJ / MC_Jog, hold to run: runs in the sign of `speed` until stopped
+    /// (a stop, a limit, a fault, or the lease running out): the jog stops
+    /// normally unless `Request::jog_renew` renews it within its lease (an
+    /// HMI or program that dies never leaves an axis running).
+    pub struct JogSpec {
+        /// Signed speed, units/s: the sign is the direction.
+        speed: f64 = Param::new("Speed", Unit::Speed).flag("speed", "V"),
+        /// The lease, s (0.05 ..= 5): the jog stops when no renewal came for
+        /// this long. Left out: 0.5 s.
+        lease: Option<f64> = Param::new("Duration", Unit::Seconds)
+            .or(Fallback::JogLease)
+            .form(Form::Lease),
+        /// Acceleration, units/s²; left out: the axis's `home_acceleration`.
+        accel: Option<f64> = ACCEL,
+        /// Deceleration, units/s²; left out: the axis's `home_deceleration`.
+        decel: Option<f64> = DECEL,
+    }
+}
+
+crate::op_spec! {
+    /// MAM / MC_MoveAbsolute (`relative` off: `target` is an axis position)
+    /// or MC_MoveRelative (`relative`: `target` is a distance from the
+    /// current command position): a trapezoid ending at rest on the target
+    /// (PC). On a cyclic axis an absolute target is reached the shortest
+    /// way.
+    pub struct MoveSpec {
+        /// The target position, axis coordinates (units); with `relative`
+        /// the distance from where the move starts.
+        target: f64 = Param::new("Target", Unit::Position).form(Form::Either {
+            off: ("to", "P"),
+            on: ("by", "D"),
+            switch: "relative",
+        }),
+        /// `target` is a distance from where the move starts.
+        relative: bool = Param::new("Relative", Unit::None),
+        /// Speed (magnitude), units/s; left out: the axis's `home_speed`.
+        speed: Option<f64> = Param::new("Speed", Unit::Speed)
+            .or(Fallback::HomeSpeed)
+            .flag("speed", "V"),
+        /// Acceleration, units/s²; left out: the axis's `home_acceleration`.
+        accel: Option<f64> = ACCEL,
+        /// Deceleration, units/s²; left out: the axis's `home_deceleration`.
+        decel: Option<f64> = DECEL,
+        /// Replace a jog or move in progress (without it such an axis
+        /// refuses with ERR 3).
+        supersede: bool = Param::new("Supersede", Unit::None).flag("supersede", ""),
+    }
+}
+
+/// A jog's or move's speed, acceleration and deceleration as the engine
+/// plans with them, after [`Operation::resolve`]: a number still left out
+/// (no default configured) is NaN, which the operand checks refuse (13).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dynamics {
+    pub speed: f64,
+    pub accel: f64,
+    pub decel: f64,
+}
+
+impl Dynamics {
+    fn of(speed: Option<f64>, accel: Option<f64>, decel: Option<f64>) -> Self {
+        let n = |x: Option<f64>| x.unwrap_or(f64::NAN);
+        Dynamics {
+            speed: n(speed),
+            accel: n(accel),
+            decel: n(decel),
         }
+    }
+}
+
+impl JogSpec {
+    /// A jog at `speed` with every other parameter left out.
+    pub fn at(speed: f64) -> Self {
+        JogSpec {
+            speed,
+            lease: None,
+            accel: None,
+            decel: None,
+        }
+    }
+
+    /// The signed speed and the acceleration, deceleration.
+    pub fn dynamics(&self) -> Dynamics {
+        Dynamics::of(Some(self.speed), self.accel, self.decel)
+    }
+
+    /// The lease to the nearest ns (0 when left out or not a positive
+    /// number of seconds: refused 13 / 6).
+    pub fn lease_ns(&self) -> u64 {
+        match self.lease {
+            Some(s) if s.is_finite() && s > 0.0 => (s * 1e9).round().min(u64::MAX as f64) as u64,
+            _ => 0,
+        }
+    }
+}
+
+impl MoveSpec {
+    /// A move to axis position `target` with every other parameter left
+    /// out.
+    pub fn to(target: f64) -> Self {
+        MoveSpec {
+            target,
+            relative: false,
+            speed: None,
+            accel: None,
+            decel: None,
+            supersede: false,
+        }
+    }
+
+    /// The speed, acceleration and deceleration.
+    pub fn dynamics(&self) -> Dynamics {
+        Dynamics::of(self.speed, self.accel, self.decel)
     }
 }
 
@@ -101,36 +531,6 @@ pub struct Setpoint {
     /// velocity is commanded.
     pub velocity: Option<f64>,
 }
-
-/// Which operation `Status::op` describes. The numbers are what a status
-/// frame carries; the spellings are JSON's.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[repr(u8)]
-pub enum OpKind {
-    /// No operation was asked for since the engine started.
-    #[default]
-    None = 0,
-    Enable = 1,
-    Disable = 2,
-    Reset = 3,
-    Jog = 4,
-    Move = 5,
-    StreamStart = 6,
-    StreamEnd = 7,
-    Stop = 8,
-}
-
-crate::spellings!(OpKind {
-    None => "none",
-    Enable => "enable",
-    Disable => "disable",
-    Reset => "reset",
-    Jog => "jog",
-    Move => "move",
-    StreamStart => "stream_start",
-    StreamEnd => "stream_end",
-    Stop => "stop",
-});
 
 /// The answer to the operations: the last accepted one and its progress,
 /// and the refusal of the last one asked for if it was refused.

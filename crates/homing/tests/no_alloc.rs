@@ -310,19 +310,23 @@ fn operations_make_no_allocation() {
         ..PlantConfig::default()
     });
     let mut fb = plant.feedback();
-    let jog = |speed: f64| Operation::Jog {
-        speed,
-        accel: 500.0,
-        decel: 500.0,
-        lease_ns: 300 * T,
+    let jog = |speed: f64| {
+        Operation::Jog(JogSpec {
+            speed,
+            accel: Some(500.0),
+            decel: Some(500.0),
+            lease: Some(time::ns_to_s(300 * T)),
+        })
     };
-    let mv = |target: f64, supersede: bool| Operation::Move {
-        target,
-        relative: false,
-        speed: 20.0,
-        accel: 500.0,
-        decel: 500.0,
-        supersede,
+    let mv = |target: f64, supersede: bool| {
+        Operation::Move(MoveSpec {
+            target,
+            relative: false,
+            speed: Some(20.0),
+            accel: Some(500.0),
+            decel: Some(500.0),
+            supersede,
+        })
     };
     // (step, request) of the script; every other step is empty.
     let sp = |t_ms: u64, p: f64| Request {
@@ -423,12 +427,12 @@ fn operations_make_no_allocation() {
     for k in 0..2000u64 {
         let req = match k {
             1 => op(Operation::Enable),
-            10 => op(Operation::Jog {
+            10 => op(Operation::Jog(JogSpec {
                 speed: 20.0,
-                accel: 500.0,
-                decel: 500.0,
-                lease_ns: 5_000 * T,
-            }),
+                accel: Some(500.0),
+                decel: Some(500.0),
+                lease: Some(time::ns_to_s(5_000 * T)),
+            })),
             1500 => op(Operation::Reset),
             1510 => op(jog(-5.0)),
             _ => Request::default(),
@@ -447,14 +451,14 @@ fn operations_make_no_allocation() {
 
 /// A move the travel limits refuse.
 fn move_outside() -> Operation {
-    Operation::Move {
+    Operation::Move(MoveSpec {
         target: 50.0,
         relative: false,
-        speed: 20.0,
-        accel: 500.0,
-        decel: 500.0,
+        speed: Some(20.0),
+        accel: Some(500.0),
+        decel: Some(500.0),
         supersede: false,
-    }
+    })
 }
 
 #[test]

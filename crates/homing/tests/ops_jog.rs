@@ -121,12 +121,12 @@ fn the_lease_keeps_a_renewed_jog_and_stops_one_that_is_not() {
     // 10² / (2·500) = 0.1 of where it was then.
     let mut r = Rig::at(0.0);
     r.enable();
-    let lease = Operation::Jog {
+    let lease = Operation::Jog(JogSpec {
         speed: 10.0,
-        accel: 500.0,
-        decel: 500.0,
-        lease_ns: 100 * MS,
-    };
+        accel: Some(500.0),
+        decel: Some(500.0),
+        lease: Some(secs(100 * MS)),
+    });
     let id = r.op(lease).unwrap();
     for k in 1..=1000 {
         r.step(Request {
@@ -179,12 +179,12 @@ fn unhome_during_a_jog_drops_the_limit_and_slows_to_the_cap() {
     };
     let mut r = Rig::new(cfg, op_plant(0.0));
     r.enable_and_home();
-    let fast = Operation::Jog {
+    let fast = Operation::Jog(JogSpec {
         speed: 40.0,
-        accel: 500.0,
-        decel: 500.0,
-        lease_ns: 5_000 * MS,
-    };
+        accel: Some(500.0),
+        decel: Some(500.0),
+        lease: Some(secs(5_000 * MS)),
+    });
     r.op(fast).unwrap();
     r.run(100);
     assert!(r.axis.clear_homed());
@@ -223,11 +223,13 @@ fn a_jog_replaces_a_jog_and_may_not_replace_a_move() {
 fn a_jog_checks_every_operand() {
     let mut r = Rig::at(0.0);
     r.enable_and_home();
-    let j = |speed: f64, accel: f64, decel: f64, lease_ns: u64| Operation::Jog {
-        speed,
-        accel,
-        decel,
-        lease_ns,
+    let j = |speed: f64, accel: f64, decel: f64, lease_ns: u64| {
+        Operation::Jog(JogSpec {
+            speed,
+            accel: Some(accel),
+            decel: Some(decel),
+            lease: Some(secs(lease_ns)),
+        })
     };
     let p = ERR_PARAMETER_OUT_OF_RANGE;
     for (op, code) in [

@@ -25,12 +25,12 @@ fn switched() -> (AxisConfig, PlantConfig) {
 
 /// A jog that runs for seconds.
 fn long_jog(speed: f64) -> Operation {
-    Operation::Jog {
+    Operation::Jog(JogSpec {
         speed,
-        accel: 500.0,
-        decel: 500.0,
-        lease_ns: 5_000 * MS,
-    }
+        accel: Some(500.0),
+        decel: Some(500.0),
+        lease: Some(secs(5_000 * MS)),
+    })
 }
 
 #[test]

@@ -33,14 +33,14 @@ fn a_move_lands_exactly_on_its_target_with_pc() {
     assert!(max_accel(cmds, CYCLE_S) <= 500.0 + 1e-3);
     assert!(cmds.windows(2).all(|w| w[1].position >= w[0].position));
     // Relative: +2 from the command position.
-    r.op(Operation::Move {
+    r.op(Operation::Move(MoveSpec {
         target: 2.0,
         relative: true,
-        speed: 20.0,
-        accel: 500.0,
-        decel: 500.0,
+        speed: Some(20.0),
+        accel: Some(500.0),
+        decel: Some(500.0),
         supersede: false,
-    })
+    }))
     .unwrap();
     assert!(r.run_until(1000, |s| s.op.pc));
     assert!((r.cmd_axis() - 7.0).abs() < 1e-12);
@@ -55,13 +55,15 @@ fn targets_outside_the_travel_limits_are_refused_while_homed() {
     r.enable_and_home();
     assert_eq!(r.op(move_to(10.001)), target);
     assert_eq!(r.op(move_to(-11.0)), target);
-    let by = |d: f64| Operation::Move {
-        target: d,
-        relative: true,
-        speed: 20.0,
-        accel: 500.0,
-        decel: 500.0,
-        supersede: false,
+    let by = |d: f64| {
+        Operation::Move(MoveSpec {
+            target: d,
+            relative: true,
+            speed: Some(20.0),
+            accel: Some(500.0),
+            decel: Some(500.0),
+            supersede: false,
+        })
     };
     assert_eq!(r.op(by(10.5)), target);
     assert_eq!(r.op(by(1e308)), target);
@@ -93,14 +95,14 @@ fn a_move_on_a_jogging_or_moving_axis_needs_supersede() {
     r.run(50);
     assert_eq!(r.op(move_to(-5.0)), Err((ERR_EXECUTION_COLLISION, 0)));
     assert!(r.axis.status().jogging);
-    let sup = Operation::Move {
+    let sup = Operation::Move(MoveSpec {
         target: -5.0,
         relative: false,
-        speed: 20.0,
-        accel: 500.0,
-        decel: 500.0,
+        speed: Some(20.0),
+        accel: Some(500.0),
+        decel: Some(500.0),
         supersede: true,
-    };
+    });
     let id = r.op(sup).unwrap();
     assert!(r.axis.status().moving && !r.axis.status().jogging);
     // It reverses with its deceleration: no jump.
@@ -112,24 +114,11 @@ fn a_move_on_a_jogging_or_moving_axis_needs_supersede() {
     r.op(move_to(5.0)).unwrap();
     r.run(100);
     assert_eq!(r.op(move_to(0.0)), Err((ERR_EXECUTION_COLLISION, 0)));
-    let Operation::Move {
-        speed,
-        accel,
-        decel,
-        ..
-    } = sup
-    else {
+    let Operation::Move(sup) = sup else {
         unreachable!()
     };
-    r.op(Operation::Move {
-        target: 0.0,
-        relative: false,
-        speed,
-        accel,
-        decel,
-        supersede: true,
-    })
-    .unwrap();
+    r.op(Operation::Move(MoveSpec { target: 0.0, ..sup }))
+        .unwrap();
     assert!(r.run_until(2000, |s| s.op.pc));
     assert_eq!(r.cmd_axis(), 0.0);
 }
@@ -147,24 +136,24 @@ fn a_supersede_that_could_not_stop_inside_the_limits_is_refused() {
     };
     let mut r = Rig::new(cfg, op_plant(0.0));
     r.enable_and_home();
-    r.op(Operation::Jog {
+    r.op(Operation::Jog(JogSpec {
         speed: 40.0,
-        accel: 2000.0,
-        decel: 2000.0,
-        lease_ns: 5_000 * MS,
-    })
+        accel: Some(2000.0),
+        decel: Some(2000.0),
+        lease: Some(secs(5_000 * MS)),
+    }))
     .unwrap();
     while r.cmd_axis() < 9.4 {
         r.run(1);
     }
-    let back = Operation::Move {
+    let back = Operation::Move(MoveSpec {
         target: 0.0,
         relative: false,
-        speed: 20.0,
-        accel: 500.0,
-        decel: 500.0,
+        speed: Some(20.0),
+        accel: Some(500.0),
+        decel: Some(500.0),
         supersede: true,
-    };
+    });
     assert_eq!(
         r.op(back),
         Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET))
@@ -223,37 +212,37 @@ fn cyclic_axes_move_the_shortest_way_and_have_no_travel_limits() {
     r.enable_and_home();
     assert_eq!(r.axis.axis_position(), Some(10.0));
     // 10 → 350: backwards through 0 (20 degrees), not forwards (340).
-    let m = Operation::Move {
+    let m = Operation::Move(MoveSpec {
         target: 350.0,
         relative: false,
-        speed: 100.0,
-        accel: 5000.0,
-        decel: 5000.0,
+        speed: Some(100.0),
+        accel: Some(5000.0),
+        decel: Some(5000.0),
         supersede: false,
-    };
+    });
     r.op(m).unwrap();
     assert!(r.run_until(1000, |s| s.op.pc));
     assert_eq!(r.cmds.last().unwrap().position, -20.0);
     assert_eq!(r.cmd_axis(), 350.0);
     // Relative: whole revolutions.
-    r.op(Operation::Move {
+    r.op(Operation::Move(MoveSpec {
         target: 720.0,
         relative: true,
-        speed: 100.0,
-        accel: 5000.0,
-        decel: 5000.0,
+        speed: Some(100.0),
+        accel: Some(5000.0),
+        decel: Some(5000.0),
         supersede: false,
-    })
+    }))
     .unwrap();
     assert!(r.run_until(20_000, |s| s.op.pc));
     assert_eq!(r.cmds.last().unwrap().position, 700.0);
     // Jogs run on, homed, without any limit.
-    r.op(Operation::Jog {
+    r.op(Operation::Jog(JogSpec {
         speed: 100.0,
-        accel: 5000.0,
-        decel: 5000.0,
-        lease_ns: 5_000 * MS,
-    })
+        accel: Some(5000.0),
+        decel: Some(5000.0),
+        lease: Some(secs(5_000 * MS)),
+    }))
     .unwrap();
     r.run(4000);
     assert!(r.axis.status().jogging && r.axis.status().homed);

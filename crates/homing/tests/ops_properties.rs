@@ -46,22 +46,22 @@ fn sane_op() -> impl Strategy<Value = Operation> {
     let dynamics = (1.0..60.0f64, 50.0..5000.0f64, 50.0..6000.0f64);
     prop_oneof![
         2 => (dynamics.clone(), any::<bool>(), 50u64..600).prop_map(|((s, a, d), neg, lease)| {
-            Operation::Jog {
+            Operation::Jog(JogSpec {
                 speed: if neg { -s } else { s },
-                accel: a,
-                decel: d,
-                lease_ns: lease * MS,
-            }
+                accel: Some(a),
+                decel: Some(d),
+                lease: Some(secs(lease * MS)),
+            })
         }),
         2 => (dynamics, -15.0..15.0f64, any::<bool>(), any::<bool>()).prop_map(
-            |((speed, accel, decel), target, relative, supersede)| Operation::Move {
+            |((speed, accel, decel), target, relative, supersede)| Operation::Move(MoveSpec {
                 target,
                 relative,
-                speed,
-                accel,
-                decel,
+                speed: Some(speed),
+                accel: Some(accel),
+                decel: Some(decel),
                 supersede,
-            }
+            })
         ),
         1 => Just(Operation::StreamStart),
         1 => Just(Operation::StreamEnd),
@@ -284,21 +284,32 @@ fn wild() -> impl Strategy<Value = f64> {
     ]
 }
 
+/// A wild number, or left out (the axis's default then applies).
+fn maybe_wild() -> impl Strategy<Value = Option<f64>> {
+    proptest::option::of(wild())
+}
+
 fn wild_op() -> impl Strategy<Value = Operation> {
     prop_oneof![
-        2 => (wild(), wild(), wild(), any::<u64>()).prop_map(|(speed, accel, decel, lease_ns)| {
-            Operation::Jog { speed, accel, decel, lease_ns }
-        }),
-        2 => (wild(), any::<bool>(), wild(), wild(), wild(), any::<bool>()).prop_map(
-            |(target, relative, speed, accel, decel, supersede)| Operation::Move {
-                target,
-                relative,
+        2 => (wild(), maybe_wild(), maybe_wild(), maybe_wild()).prop_map(
+            |(speed, accel, decel, lease)| Operation::Jog(JogSpec {
                 speed,
+                lease,
                 accel,
                 decel,
-                supersede,
-            }
+            })
         ),
+        2 => (wild(), any::<bool>(), maybe_wild(), maybe_wild(), maybe_wild(), any::<bool>())
+            .prop_map(|(target, relative, speed, accel, decel, supersede)| {
+                Operation::Move(MoveSpec {
+                    target,
+                    relative,
+                    speed,
+                    accel,
+                    decel,
+                    supersede,
+                })
+            }),
         1 => Just(Operation::StreamStart),
         1 => Just(Operation::StreamEnd),
         1 => Just(Operation::Stop),

@@ -8,7 +8,12 @@
 //! * Users log in with a name and password checked against the argon2
 //!   hash of `[[opcua.user]]`; role "operator" may call methods, "viewer"
 //!   may not ([`Roles::may_call`], applied in `manager.rs`, which logs
-//!   every refused call with the session's identity).
+//!   every refused call with the session's identity, and checked again for
+//!   every running hold-to-run jog by the bridge).
+//! * The users and their roles are read again on SIGHUP
+//!   ([`Roles::reload`]): a user removed or made a viewer calls nothing
+//!   more, and a jog it holds stops at once. (The rest of `[opcua]` takes
+//!   a restart.)
 //!
 //! Every refused login is logged here with the name the client gave and
 //! the endpoint it used.
@@ -24,13 +29,14 @@ use opcua::server::ServerEndpoint;
 use opcua::types::{
     Error, MessageSecurityMode, NodeId, StatusCode, UAString, UserTokenPolicy, UserTokenType,
 };
+use std::sync::RwLock;
 
 /// The anonymous token's policy id (the stack's spelling).
 const ANONYMOUS_POLICY: &str = "anonymous";
 
 /// The users and the anonymous rule of `[opcua]`.
 pub struct Roles {
-    users: Vec<User>,
+    users: RwLock<Vec<User>>,
     anonymous: bool,
     verifying: tokio::sync::Semaphore,
 }
@@ -41,17 +47,30 @@ pub const VERIFYING: usize = 2;
 impl Roles {
     pub fn new(cfg: &OpcuaConfig) -> Self {
         Self {
-            users: cfg.users.clone(),
+            users: RwLock::new(cfg.users.clone()),
             anonymous: cfg.anonymous,
             verifying: tokio::sync::Semaphore::new(VERIFYING),
         }
+    }
+
+    /// The users now (a poisoned lock still holds the last list set).
+    fn users(&self) -> std::sync::RwLockReadGuard<'_, Vec<User>> {
+        self.users.read().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The users of `cfg` from now on (its password hashes already
+    /// checked); how many there are.
+    pub fn reload(&self, cfg: &OpcuaConfig) -> usize {
+        let mut users = self.users.write().unwrap_or_else(|p| p.into_inner());
+        *users = cfg.users.clone();
+        users.len()
     }
 
     /// May the session of `token` call methods?
     pub fn may_call(&self, token: &UserToken) -> bool {
         !token.is_anonymous()
             && self
-                .users
+                .users()
                 .iter()
                 .any(|u| u.name == token.0 && u.role == Role::Operator)
     }
@@ -61,12 +80,12 @@ impl Roles {
         if token.is_anonymous() {
             return "anonymous (read-only)";
         }
-        match self
-            .users
+        let role = self
+            .users()
             .iter()
             .find(|u| u.name == token.0)
-            .map(|u| u.role)
-        {
+            .map(|u| u.role);
+        match role {
             Some(Role::Operator) => "operator",
             Some(Role::Viewer) => "viewer (read-only)",
             None => "unknown",
@@ -113,10 +132,10 @@ impl AuthManager for Roles {
                 format!("user {shown} on the None endpoint (anonymous only there)"),
             ));
         }
-        let user = self.users.iter().find(|u| u.name == username);
+        let user = self.users().iter().find(|u| u.name == username).cloned();
         // Verified even for an unknown name (against a fixed hash), so the
         // time taken does not tell which names exist.
-        let hash = user.map(|u| u.password_hash.clone());
+        let hash = user.as_ref().map(|u| u.password_hash.clone());
         let given = password.get().to_string();
         // At most VERIFYING checks at once (each takes argon2's memory and
         // tens of ms of CPU): a flood of logins waits here instead of
@@ -166,7 +185,7 @@ impl AuthManager for Roles {
                 security_policy_uri: UAString::null(),
             });
         }
-        if !is_none(endpoint) && !self.users.is_empty() {
+        if !is_none(endpoint) && !self.users().is_empty() {
             out.push(UserTokenPolicy {
                 policy_id: user_pass_security_policy_id(endpoint),
                 token_type: UserTokenType::UserName,

@@ -3,8 +3,9 @@
 //! status services). iceoryx2's ports stay on this thread; the OPC UA side
 //! reaches it through a channel.
 //!
-//! Loop (every 2 ms): run the method calls that arrived, renew or end the
-//! hold-to-run jogs ([`crate::jogs`]), take the newest status frame, every
+//! Loop (every 2 ms): run the method calls that arrived (a Jog call on a
+//! jog of its own renews it), end the hold-to-run jogs whose caller may no
+//! longer run them ([`crate::jogs`]), take the newest status frame, every
 //! second the statistics. No frame for a second, or a
 //! frame of another session: the daemon is gone or restarted — values go
 //! Bad, and it joins again (every 500 ms) when the daemon is back. Nothing
@@ -12,10 +13,11 @@
 //! thread, off the cycle.
 
 use crate::jogs::{Jogs, Watch};
-use crate::methods::{Operation, JOG_RENEW_MS};
+use crate::methods::Call;
 use crate::values::Publisher;
+use motion_control::params::JOG_LEASE_S;
 use motion_control::{
-    put_str, Axes, Client, ClientError, ControlResponse, Request, REQ_STATS, RESULT_ACCEPTED,
+    Axes, Client, ClientError, ControlResponse, Operation, Request, REQ_STATS, RESULT_ACCEPTED,
 };
 use motion_report::StatsReport;
 use opcua::server::node_manager::memory::InMemoryNodeManagerImpl;
@@ -37,8 +39,9 @@ pub enum BridgeError {
 
 /// A method call for the daemon.
 pub struct Job {
-    pub op: Operation,
-    /// For a Jog: the session that asks (renewals only while it lives).
+    pub call: Call,
+    /// For a hold-to-run call: the session that asks, and whether it may
+    /// still run the jog.
     pub watch: Option<Watch>,
     pub reply: oneshot::Sender<Result<Box<ControlResponse>, BridgeError>>,
 }
@@ -68,7 +71,7 @@ pub fn run<T: InMemoryNodeManagerImpl>(
     let mut last_frame = Instant::now();
     let mut last_stats = Instant::now() - STATS_EVERY;
     let mut told_missing = false;
-    let mut jogs = Jogs::new(Duration::from_millis(JOG_RENEW_MS));
+    let mut jogs = Jogs::new();
     while !stop.load(Ordering::Acquire) {
         if client.is_none() && last_try.elapsed() >= RETRY {
             last_try = Instant::now();
@@ -92,7 +95,7 @@ pub fn run<T: InMemoryNodeManagerImpl>(
         }
         while let Ok(job) = jobs.try_recv() {
             let r = match client.as_mut() {
-                Some(c) => run_job(c, &mut jogs, job.op, job.watch),
+                Some(c) => run_job(c, &mut jogs, job.call, job.watch),
                 None => Err(BridgeError::NoDaemon(
                     "motion-supervisor is not running (or not joined yet)".into(),
                 )),
@@ -104,7 +107,7 @@ pub fn run<T: InMemoryNodeManagerImpl>(
             let _ = job.reply.send(r);
         }
         if let Some(c) = client.as_mut() {
-            renew_jogs(c, &mut jogs);
+            end_jogs(c, &mut jogs);
         } else {
             jogs.forget();
         }
@@ -139,67 +142,67 @@ pub fn run<T: InMemoryNodeManagerImpl>(
     }
 }
 
-/// A method call: a Jog is started (or extended) and then renewed here.
+/// A method call. A Jog of a session on a jog of its own (same axis and
+/// speed) renews it, answered with the supervisor's answer to the
+/// renewal; any other starts a jog (replacing the axis's), kept for its
+/// renewals.
 fn run_job(
     c: &mut Client,
     jogs: &mut Jogs,
-    op: Operation,
+    call: Call,
     watch: Option<Watch>,
 ) -> Result<Box<ControlResponse>, BridgeError> {
     let (
-        Operation::Jog {
+        Call::Operate {
             axis,
-            speed,
-            duration_s,
+            op: Operation::Jog(jog),
         },
         Some(watch),
-    ) = (&op, watch)
+    ) = (&call, watch)
     else {
-        return call(c, &op);
+        return send(c, &call.typed());
     };
-    let duration = Duration::from_secs_f64(*duration_s);
     let now = Instant::now();
-    if let Some(token) = jogs.extend(axis, *speed, duration, watch.session, now) {
-        let mut r = ControlResponse::zeroed();
-        r.result = RESULT_ACCEPTED;
-        r.axis_count = 1;
-        put_str(&mut r.axes[0].name, axis);
-        r.axes[0].accepted = 1;
-        r.token = token;
+    if let Some(token) = jogs.running(axis, jog.speed, watch.session) {
+        let r = send(c, &renewal(token, false))?;
+        if r.result == RESULT_ACCEPTED {
+            jogs.renewed(token, now);
+        } else {
+            jogs.gone(token);
+        }
         return Ok(r);
     }
-    let r = call(c, &op)?;
+    let r = send(c, &call.typed())?;
     if r.result == RESULT_ACCEPTED {
-        jogs.started(axis, *speed, duration, r.token, watch, now);
+        let lease = Duration::from_secs_f64(jog.lease.unwrap_or(JOG_LEASE_S));
+        jogs.started(axis, jog.speed, lease, r.token, watch, now);
     }
     Ok(r)
 }
 
-/// Renews the jogs that may run on, ends the others.
-fn renew_jogs(c: &mut Client, jogs: &mut Jogs) {
+/// Ends the jogs whose caller may no longer run them.
+fn end_jogs(c: &mut Client, jogs: &mut Jogs) {
     if jogs.is_empty() {
         return;
     }
     for r in jogs.due(Instant::now()) {
-        let ok = jog_renewal(c, r.token, r.end);
-        if r.end {
-            log::info!("jog on axis {} ended: {}", r.axis, r.why);
-        } else if !ok {
-            log::info!("jog on axis {} ended by the supervisor", r.axis);
-            jogs.gone(r.token);
-        }
+        let _ = jog_renewal(c, r.token, true);
+        log::info!("jog on axis {} ended: {}", r.axis, r.why);
+    }
+}
+
+/// A renewal (or, with `end`, the end) of jog `token`.
+fn renewal(token: u64, end: bool) -> Request {
+    Request::JogRenew {
+        axes: Axes::All,
+        token,
+        end,
     }
 }
 
 /// One renewal (or the end) of jog `token`: did the supervisor accept it?
 fn jog_renewal(c: &mut Client, token: u64, end: bool) -> bool {
-    let req = Request::JogRenew {
-        axes: Axes::All,
-        token,
-        end,
-    };
-    c.send(&req, CALL_TIMEOUT)
-        .is_ok_and(|r| r.result == RESULT_ACCEPTED)
+    send(c, &renewal(token, end)).is_ok_and(|r| r.result == RESULT_ACCEPTED)
 }
 
 fn drop_client<T: InMemoryNodeManagerImpl>(
@@ -212,8 +215,9 @@ fn drop_client<T: InMemoryNodeManagerImpl>(
     publisher.lost();
 }
 
-fn call(c: &mut Client, op: &Operation) -> Result<Box<ControlResponse>, BridgeError> {
-    c.call(&op.request(), CALL_TIMEOUT).map_err(|e| match e {
+/// Sends `req`; a daemon that does not answer is [`BridgeError::NoDaemon`].
+fn send(c: &mut Client, req: &Request) -> Result<Box<ControlResponse>, BridgeError> {
+    c.send(req, CALL_TIMEOUT).map_err(|e| match e {
         ClientError::NoSupervisor(_) | ClientError::Timeout { .. } | ClientError::WrongSession => {
             BridgeError::NoDaemon(e.to_string())
         }
@@ -237,21 +241,21 @@ pub struct Handle {
 }
 
 impl Handle {
-    pub async fn run(&self, op: Operation) -> Result<Box<ControlResponse>, BridgeError> {
-        self.run_watched(op, None).await
+    pub async fn run(&self, call: Call) -> Result<Box<ControlResponse>, BridgeError> {
+        self.run_watched(call, None).await
     }
 
-    /// [`Handle::run`] for a Jog, renewed while `watch` says its session
-    /// lives.
+    /// [`Handle::run`] for a hold-to-run call, ended as soon as `watch`
+    /// says its caller may no longer run it.
     pub async fn run_watched(
         &self,
-        op: Operation,
+        call: Call,
         watch: Option<Watch>,
     ) -> Result<Box<ControlResponse>, BridgeError> {
         let (tx, rx) = oneshot::channel();
         self.jobs
             .send(Job {
-                op,
+                call,
                 watch,
                 reply: tx,
             })

@@ -1,29 +1,36 @@
 //! The hold-to-run jogs started by Jog calls, kept by the bridge thread.
 //!
-//! The control service runs a jog only while its lease is renewed
-//! ([`crate::methods::JOG_LEASE_MS`]). The bridge renews it every
-//! [`crate::methods::JOG_RENEW_MS`] — but only while the calling session
-//! lives and the call's Duration has not run out; then it ends the jog
-//! (a renewal with the end flag: a stop of this jog only). If
-//! `motion-opcua` itself dies, the renewals stop and the supervisor's
-//! lease runs out: the jog stops within [`crate::methods::JOG_LEASE_MS`].
+//! An OPC UA jog is hold to run like motionctl's: its lease is the call's
+//! Duration (at most [`crate::methods::MAX_JOG_S`]), and the control
+//! service stops the axis when the lease runs out unless the jog is
+//! renewed — and only a new Jog call renews it. A call is authorised like
+//! any other (`manager.rs`: the client certificate still trusted, the
+//! session over Sign & Encrypt, its user an operator), so every renewal is
+//! checked again; a client that hangs, whose link is cut or whose HMI
+//! froze with its session open stops the axis within its lease, whatever
+//! the session's timeout. If `motion-opcua` itself dies, nothing renews
+//! either.
 //!
 //! A Jog call by the same session on the same axis at the same speed while
-//! its jog runs extends the Duration instead of starting a new jog: that is
-//! the keep-alive an HMI sends while its button is held.
+//! its jog runs renews that jog (for the lease of the call that started
+//! it) instead of starting a new one: the call an HMI repeats while its
+//! button is held. Between calls the bridge ends a jog at once when its
+//! session is gone or its caller may no longer call (a certificate no
+//! longer trusted, a role taken away): [`Watch::may_run`], checked on
+//! every pass of the bridge's loop.
 //!
 //! No I/O here: the bridge sends what [`Jogs::due`] says.
 
 use std::time::{Duration, Instant};
 
-/// Is the session that started a jog still there?
-pub type Alive = Box<dyn Fn() -> bool + Send>;
+/// May the jog of a session go on? `Err(why)` when not.
+pub type MayRun = Box<dyn Fn() -> Result<(), &'static str> + Send>;
 
-/// Who asked for a jog: the session (its numeric id) and how to tell that
-/// it still lives.
+/// Who asked for a jog: the session (its numeric id) and whether it may
+/// still run a jog.
 pub struct Watch {
     pub session: u32,
-    pub alive: Alive,
+    pub may_run: MayRun,
 }
 
 struct Running {
@@ -31,62 +38,55 @@ struct Running {
     speed: f64,
     token: u64,
     session: u32,
-    alive: Alive,
+    may_run: MayRun,
+    /// The supervisor stops it by itself after this (the lease).
     until: Instant,
-    next: Instant,
+    lease: Duration,
 }
 
-/// What the bridge sends for a jog now.
+/// A jog the bridge ends now, and why (for the log).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Renewal {
+pub struct End {
     pub axis: String,
     pub token: u64,
-    /// End the jog (else: renew its lease).
-    pub end: bool,
-    /// Why it ends, for the log.
     pub why: &'static str,
 }
 
 /// The running jogs (at most one per axis).
+#[derive(Default)]
 pub struct Jogs {
     running: Vec<Running>,
-    every: Duration,
 }
 
 impl Jogs {
-    pub fn new(every: Duration) -> Self {
-        Self {
-            running: Vec::new(),
-            every,
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The token of the jog of `session` at `speed` on `axis`, if one runs
+    /// (a Jog call for it is a renewal).
+    pub fn running(&self, axis: &str, speed: f64, session: u32) -> Option<u64> {
+        self.running
+            .iter()
+            .find(|r| r.axis == axis && r.session == session && r.speed == speed)
+            .map(|r| r.token)
+    }
+
+    /// The supervisor renewed jog `token` at `now`.
+    pub fn renewed(&mut self, token: u64, now: Instant) {
+        if let Some(r) = self.running.iter_mut().find(|r| r.token == token) {
+            r.until = now + r.lease;
         }
     }
 
-    /// A Jog call of `session`: if its jog at `speed` runs on `axis`,
-    /// extends it to `duration` from `now` and returns its token.
-    pub fn extend(
-        &mut self,
-        axis: &str,
-        speed: f64,
-        duration: Duration,
-        session: u32,
-        now: Instant,
-    ) -> Option<u64> {
-        let r = self
-            .running
-            .iter_mut()
-            .find(|r| r.axis == axis && r.session == session && r.speed == speed)?;
-        r.until = now + duration;
-        Some(r.token)
-    }
-
-    /// The control service accepted a jog (`token`): renew it from now on.
-    /// A jog this one replaced on the axis is forgotten (the supervisor
-    /// replaced it too).
+    /// The control service accepted a jog (`token`) with `lease`. A jog
+    /// this one replaced on the axis is forgotten (the supervisor replaced
+    /// it too).
     pub fn started(
         &mut self,
         axis: &str,
         speed: f64,
-        duration: Duration,
+        lease: Duration,
         token: u64,
         watch: Watch,
         now: Instant,
@@ -97,61 +97,53 @@ impl Jogs {
             speed,
             token,
             session: watch.session,
-            alive: watch.alive,
-            until: now + duration,
-            next: now + self.every,
+            may_run: watch.may_run,
+            until: now + lease,
+            lease,
         });
     }
 
-    /// The renewals and ends due at `now`; ended jogs are forgotten.
-    pub fn due(&mut self, now: Instant) -> Vec<Renewal> {
+    /// The jogs to end now (their session is gone or may no longer call);
+    /// those whose lease ran out are forgotten (the supervisor stopped
+    /// them).
+    pub fn due(&mut self, now: Instant) -> Vec<End> {
         let mut out = Vec::new();
-        let every = self.every;
-        self.running.retain_mut(|r| {
-            let why = if now >= r.until {
-                Some("its duration ran out")
-            } else if !(r.alive)() {
-                Some("the session that started it is gone")
-            } else {
-                None
-            };
-            if let Some(why) = why {
-                out.push(Renewal {
-                    axis: r.axis.clone(),
-                    token: r.token,
-                    end: true,
-                    why,
-                });
+        self.running.retain(|r| {
+            if now >= r.until {
+                log::info!(
+                    "jog on axis {} ended: its lease ran out (not called again within its Duration)",
+                    r.axis
+                );
                 return false;
             }
-            if now >= r.next {
-                r.next = now + every;
-                out.push(Renewal {
-                    axis: r.axis.clone(),
-                    token: r.token,
-                    end: false,
-                    why: "",
-                });
+            match (r.may_run)() {
+                Ok(()) => true,
+                Err(why) => {
+                    out.push(End {
+                        axis: r.axis.clone(),
+                        token: r.token,
+                        why,
+                    });
+                    false
+                }
             }
-            true
         });
         out
     }
 
     /// A renewal of `token` was refused: the jog ended otherwise (a stop,
-    /// a limit, a fault, a lease the supervisor let run out).
+    /// a limit, a fault, its lease).
     pub fn gone(&mut self, token: u64) {
         self.running.retain(|r| r.token != token);
     }
 
     /// Every jog ended (shutting down): what to send.
-    pub fn end_all(&mut self, why: &'static str) -> Vec<Renewal> {
+    pub fn end_all(&mut self, why: &'static str) -> Vec<End> {
         self.running
             .drain(..)
-            .map(|r| Renewal {
+            .map(|r| End {
                 axis: r.axis,
                 token: r.token,
-                end: true,
                 why,
             })
             .collect()
@@ -174,65 +166,72 @@ impl Jogs {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::atomic::{AtomicU8, Ordering};
     use std::sync::Arc;
 
     const MS: Duration = Duration::from_millis(1);
 
-    fn watch(session: u32, alive: &Arc<AtomicBool>) -> Watch {
-        let a = alive.clone();
+    /// 0: may run; 1: session gone; 2: no longer an operator.
+    fn watch(session: u32, state: &Arc<AtomicU8>) -> Watch {
+        let s = state.clone();
         Watch {
             session,
-            alive: Box::new(move || a.load(Ordering::Acquire)),
+            may_run: Box::new(move || match s.load(Ordering::Acquire) {
+                0 => Ok(()),
+                1 => Err("the session that started it is gone"),
+                _ => Err("its caller may no longer call"),
+            }),
         }
     }
 
     #[test]
-    fn renewed_until_the_duration_runs_out_or_the_session_goes() {
+    fn a_jog_lasts_its_lease_from_the_last_call_and_no_longer() {
         let t0 = Instant::now();
-        let alive = Arc::new(AtomicBool::new(true));
-        let mut j = Jogs::new(100 * MS);
-        j.started("X", 5.0, 1000 * MS, 7, watch(1, &alive), t0);
-        assert!(j.due(t0 + 50 * MS).is_empty());
-        let s = j.due(t0 + 100 * MS);
-        assert_eq!((s.len(), s[0].token, s[0].end), (1, 7, false));
-        assert!(j.due(t0 + 150 * MS).is_empty(), "once per period");
-        // The same session, same speed: extended, no new jog.
-        assert_eq!(j.extend("X", 5.0, 1000 * MS, 1, t0 + 900 * MS), Some(7));
-        assert_eq!(j.extend("X", 5.0, 1000 * MS, 2, t0 + 900 * MS), None);
-        assert_eq!(j.extend("X", -5.0, 1000 * MS, 1, t0 + 900 * MS), None);
-        assert!(j.due(t0 + 1500 * MS).iter().all(|s| !s.end));
-        let s = j.due(t0 + 1900 * MS);
-        assert_eq!(
-            (s[0].end, s[0].why),
-            (true, "its duration ran out"),
-            "ends at the extended time"
-        );
+        let ok = Arc::new(AtomicU8::new(0));
+        let mut j = Jogs::new();
+        j.started("X", 5.0, 1000 * MS, 7, watch(1, &ok), t0);
+        assert_eq!(j.running("X", 5.0, 1), Some(7));
+        assert_eq!(j.running("X", 5.0, 2), None, "another session's call");
+        assert_eq!(j.running("X", -5.0, 1), None, "another speed");
+        assert!(j.due(t0 + 900 * MS).is_empty());
+        j.renewed(7, t0 + 900 * MS);
+        assert!(j.due(t0 + 1800 * MS).is_empty(), "renewed for its lease");
+        assert_eq!(j.len(), 1);
+        assert!(j.due(t0 + 1900 * MS).is_empty(), "lease over: forgotten");
         assert!(j.is_empty());
+    }
 
-        j.started("X", 5.0, 5000 * MS, 8, watch(1, &alive), t0);
-        alive.store(false, Ordering::Release);
-        let s = j.due(t0 + MS);
-        assert_eq!(
-            (s[0].token, s[0].end, s[0].why),
-            (8, true, "the session that started it is gone")
-        );
-        assert!(j.is_empty());
+    #[test]
+    fn a_jog_ends_at_once_when_its_caller_may_no_longer_run_it() {
+        let t0 = Instant::now();
+        for (state, why) in [
+            (1, "the session that started it is gone"),
+            (2, "its caller may no longer call"),
+        ] {
+            let s = Arc::new(AtomicU8::new(0));
+            let mut j = Jogs::new();
+            j.started("X", 5.0, 1000 * MS, 8, watch(1, &s), t0);
+            assert!(j.due(t0 + MS).is_empty());
+            s.store(state, Ordering::Release);
+            let e = j.due(t0 + 2 * MS);
+            assert_eq!((e.len(), e[0].token, e[0].why), (1, 8, why));
+            assert!(j.is_empty());
+        }
     }
 
     #[test]
     fn a_new_jog_replaces_the_axis_s_and_refusals_forget() {
         let t0 = Instant::now();
-        let alive = Arc::new(AtomicBool::new(true));
-        let mut j = Jogs::new(100 * MS);
-        j.started("X", 5.0, 1000 * MS, 1, watch(1, &alive), t0);
-        j.started("Y", 5.0, 1000 * MS, 2, watch(1, &alive), t0);
-        j.started("X", -5.0, 1000 * MS, 3, watch(2, &alive), t0);
+        let ok = Arc::new(AtomicU8::new(0));
+        let mut j = Jogs::new();
+        j.started("X", 5.0, 1000 * MS, 1, watch(1, &ok), t0);
+        j.started("Y", 5.0, 1000 * MS, 2, watch(1, &ok), t0);
+        j.started("X", -5.0, 1000 * MS, 3, watch(2, &ok), t0);
         assert_eq!(j.len(), 2);
         j.gone(3);
         assert_eq!(j.len(), 1);
         let s = j.end_all("stopping");
-        assert_eq!((s.len(), s[0].token, s[0].end), (1, 2, true));
+        assert_eq!((s.len(), s[0].token), (1, 2));
         assert!(j.is_empty());
     }
 }

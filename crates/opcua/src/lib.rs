@@ -6,10 +6,12 @@
 //! * [`space`] — what the address space holds (tables), [`nodes`] builds it,
 //!   [`units`] the engineering units, [`values`] fills it from status frames,
 //!   [`events`] the event of an axis going ER.
-//! * [`methods`] — Home/Stop/Unhome and the operations Enable, Disable,
-//!   Reset, Jog (hold to run), Move per axis, HomeAll/StopAll: arguments
-//!   in, the control service's answer out; [`jogs`] — the jogs the bridge
-//!   renews while the calling session lives.
+//! * [`methods`] — Home/Stop/Unhome, HomeAll/StopAll, and every operation
+//!   of the engine a client may ask for (Enable, Disable, Reset, Jog, Move,
+//!   …: derived from the engine's specs) per axis: arguments in, the
+//!   control service's answer out; [`jogs`] — hold to run: a jog lives
+//!   for its lease (at most 1 s), renewed only by calling again, and ends
+//!   at once when its caller may no longer call.
 //! * [`manager`] — the node manager: roles checked, calls to the daemon.
 //! * [`bridge`] — the thread that talks to the daemon (and follows restarts).
 //! * [`auth`], [`password`], [`pki`] — users and roles, argon2 hashes, the

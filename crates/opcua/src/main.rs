@@ -47,7 +47,7 @@ fn main() {
     let r = match cli.command {
         Some(Command::HashPassword) => Ok(()),
         Some(Command::Trust { cert }) => trust(&cfg.pki_dir, &cert),
-        None => serve(machine, cfg),
+        None => serve(machine, cfg, cli.config.clone()),
     };
     if let Err(e) = r {
         log::error!("{e}");
@@ -90,6 +90,7 @@ fn hash_password() -> Result<(), String> {
 fn serve(
     machine: motion_config::MachineConfig,
     cfg: motion_config::opcua::OpcuaConfig,
+    config: std::path::PathBuf,
 ) -> Result<(), String> {
     // Like motionctl and HMIs: never on the cycle's CPU (threads made
     // from here on, tokio's included, inherit the mask).
@@ -106,7 +107,7 @@ fn serve(
         .enable_all()
         .build()
         .map_err(|e| format!("tokio runtime: {e}"))?;
-    rt.block_on(motion_opcua::server::serve(machine, cfg))
+    rt.block_on(motion_opcua::server::serve(machine, cfg, config))
 }
 
 /// Terminal echo switched off while it lives (stdin a terminal only).

@@ -88,6 +88,42 @@ impl MachineManager {
         methods::spec(m, Scope::Machine).map(|spec| (spec, None))
     }
 
+    /// How the bridge tells that the caller of a hold-to-run call may still
+    /// run it, checked between its calls: its session is still in the
+    /// server's session table (a closed or expired session is dropped from
+    /// it) and not past its timeout, its client certificate is still
+    /// trusted, and its user still has the operator role (the users are
+    /// read again on SIGHUP) — what a call is checked for.
+    fn watch(&self, ctx: &RequestContext) -> Watch {
+        let session = Arc::downgrade(&ctx.session);
+        let (roles, pki, token) = (
+            self.roles.clone(),
+            self.pki.clone(),
+            ctx.user_token().clone(),
+        );
+        Watch {
+            session: ctx.session_id(),
+            may_run: Box::new(move || {
+                let Some(s) = session.upgrade() else {
+                    return Err("the session that started it is gone");
+                };
+                let s = s.read();
+                if !s.is_activated() || s.deadline() <= Instant::now() {
+                    return Err("the session that started it is gone");
+                }
+                if s.client_certificate()
+                    .is_some_and(|c| !crate::pki::still_trusted(&pki, c))
+                {
+                    return Err("its client certificate is no longer trusted");
+                }
+                if !roles.may_call(&token) {
+                    return Err("its user is no longer an operator");
+                }
+                Ok(())
+            }),
+        }
+    }
+
     /// The caller, in words, for the log.
     fn who(&self, ctx: &RequestContext) -> String {
         let s = ctx.session().read();
@@ -160,7 +196,8 @@ impl MachineManager {
                 return;
             }
         };
-        let watch = matches!(op, methods::Operation::Jog { .. }).then(|| watch(ctx));
+        let held = matches!(spec.verb, methods::Verb::Op(k) if k.held());
+        let watch = held.then(|| self.watch(ctx));
         match self.bridge.run_watched(op, watch).await {
             Ok(resp) => {
                 let status = methods::status_of(&resp);
@@ -185,21 +222,6 @@ impl MachineManager {
                 call.set_status(status);
             }
         }
-    }
-}
-
-/// How the bridge tells that the session calling Jog still lives: it is
-/// still in the server's session table (a closed or expired session is
-/// dropped from it) and not past its timeout.
-fn watch(ctx: &RequestContext) -> Watch {
-    let session = Arc::downgrade(&ctx.session);
-    Watch {
-        session: ctx.session_id(),
-        alive: Box::new(move || {
-            session
-                .upgrade()
-                .is_some_and(|s| s.read().deadline() > Instant::now())
-        }),
     }
 }
 

@@ -1,22 +1,33 @@
 //! The methods: what each takes and answers, the decoding of a call's
-//! arguments into an [`Operation`] for the control service, and the
-//! control service's answer as output arguments and a status code.
+//! arguments into a request for the control service, and the control
+//! service's answer as output arguments and a status code.
 //!
 //! Pure functions (no server, no daemon), so they are fuzzed directly
 //! (`tests` below, proptest).
 //!
-//! A new operation is a row of [`METHODS`], a variant of [`Operation`]
-//! with its control request in [`Operation::typed`], and an arm in
-//! [`decode`]. Enable, Disable and Reset take no input (like Stop); Move
-//! takes Target (Double), Relative (Boolean) and Speed (Double, 0: the
-//! axis's default); Jog is hold to run: Speed and a Duration (at most
-//! [`MAX_JOG_S`]) that the client extends by calling Jog again with the
-//! same speed (the keep-alive), and the jog stops when the duration runs
-//! out or the calling session is gone (the bridge renews the control
-//! service's lease only while both hold: `bridge.rs`, `jogs.rs`).
+//! Home, Stop, Unhome (per axis) and HomeAll, StopAll (on `Machine`) are
+//! the control service's own requests, declared here. The operations of
+//! the engine are not: every operation a client may ask for
+//! (`motion_homing::OpKind::client`) is a method on every axis, named by
+//! its kind's title, with one input argument per parameter of its spec in
+//! the spec's order — named by the parameter's title, typed by its kind
+//! (a number: Double; a switch: Boolean; a choice or an axis: String; a
+//! pair: Double[2]) and described by its doc — decoded into the spec the
+//! engine declared ([`Call::Operate`]). A new operation is a method here
+//! without a line of this file changing.
+//!
+//! Arguments after the last one that must be given may be left out, and an
+//! optional number, a switch or a pair may be given as null: left out, the
+//! engine applies the axis's default (Move's Speed: the axis's
+//! `home_speed`). Jog is hold to run: its Duration is its lease, which the
+//! caller must state, at most [`MAX_JOG_S`], renewed by calling Jog again
+//! (`jogs.rs`, `bridge.rs`).
 
+use motion_control::params::{Carried, Form, Kind, Param, Place};
 use motion_control::*;
 use opcua::types::{DataTypeId, StatusCode, Variant};
+use std::borrow::Cow;
+use std::sync::OnceLock;
 
 /// Where a method sits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,151 +43,167 @@ pub struct ArgSpec {
     pub name: &'static str,
     pub data_type: DataTypeId,
     pub array: bool,
-    pub doc: &'static str,
+    pub doc: Cow<'static, str>,
+}
+
+/// What a method asks of the control service.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verb {
+    Home,
+    Stop,
+    Unhome,
+    /// An operation of the engine.
+    Op(OpKind),
 }
 
 /// One method.
 pub struct MethodSpec {
     pub name: &'static str,
     pub scope: Scope,
-    pub inputs: &'static [ArgSpec],
+    pub verb: Verb,
+    pub inputs: Vec<ArgSpec>,
     pub doc: &'static str,
 }
 
-const TIMEOUT: ArgSpec = ArgSpec {
-    name: "Timeout",
-    data_type: DataTypeId::Double,
-    array: false,
-    doc: "seconds after which the supervisor stops what still homes (0: the axes' own home_timeout only)",
-};
+const fn arg(name: &'static str, data_type: DataTypeId, array: bool, doc: &'static str) -> ArgSpec {
+    ArgSpec {
+        name,
+        data_type,
+        array,
+        doc: Cow::Borrowed(doc),
+    }
+}
 
-/// Every method we offer.
-pub const METHODS: &[MethodSpec] = &[
-    MethodSpec {
-        name: "Home",
-        scope: Scope::Axis,
-        inputs: &[TIMEOUT],
-        doc: "MAH: home this axis (a gantry side: home the gantry with HomeAll)",
-    },
-    MethodSpec {
-        name: "Stop",
-        scope: Scope::Axis,
-        inputs: &[],
-        doc: "MAS: stop this axis (a homing ends with ERR 12 / EXERR 1)",
-    },
-    MethodSpec {
-        name: "Unhome",
-        scope: Scope::Axis,
-        inputs: &[],
-        doc: "clear HomedStatus (and invalidate a stored absolute reference)",
-    },
-    MethodSpec {
-        name: "Enable",
-        scope: Scope::Axis,
-        inputs: &[],
-        doc: "MSO: enable the drive, holding position",
-    },
-    MethodSpec {
-        name: "Disable",
-        scope: Scope::Axis,
-        inputs: &[],
-        doc: "MSF: disable the drive (a moving axis is stopped first)",
-    },
-    MethodSpec {
-        name: "Reset",
-        scope: Scope::Axis,
-        inputs: &[],
-        doc: "MAFR: clear the axis's error and ask the drive for a fault reset",
-    },
-    MethodSpec {
-        name: "Jog",
-        scope: Scope::Axis,
-        inputs: &[
-            ArgSpec {
-                name: "Speed",
-                data_type: DataTypeId::Double,
-                array: false,
-                doc: "signed speed (units/s): the sign is the direction",
-            },
-            ArgSpec {
-                name: "Duration",
-                data_type: DataTypeId::Double,
-                array: false,
-                doc: "seconds the jog runs (0 < Duration <= 10) unless called again with the same speed, which extends it (hold to run); it stops at once when the session closes",
-            },
-        ],
-        doc: "MAJ, hold to run: jog this axis for Duration seconds, or while called again",
-    },
-    MethodSpec {
-        name: "Move",
-        scope: Scope::Axis,
-        inputs: &[
-            ArgSpec {
-                name: "Target",
-                data_type: DataTypeId::Double,
-                array: false,
-                doc: "the target position (units), or the distance with Relative",
-            },
-            ArgSpec {
-                name: "Relative",
-                data_type: DataTypeId::Boolean,
-                array: false,
-                doc: "Target is a distance from where the axis is",
-            },
-            ArgSpec {
-                name: "Speed",
-                data_type: DataTypeId::Double,
-                array: false,
-                doc: "units/s (> 0), or 0: the axis's home_speed",
-            },
-        ],
-        doc: "MAM: a trapezoidal move to Target (or by it); done when MoveStatus drops",
-    },
-    MethodSpec {
-        name: "HomeAll",
-        scope: Scope::Machine,
-        inputs: &[
-            ArgSpec {
-                name: "Axes",
-                data_type: DataTypeId::String,
-                array: true,
-                doc: "axis or gantry names; empty: every axis, in home order",
-            },
-            ArgSpec {
-                name: "Parallel",
-                data_type: DataTypeId::Boolean,
-                array: false,
-                doc: "start every named axis at once, ignoring the home order",
-            },
-            TIMEOUT,
-        ],
-        doc: "home the named axes (all by default), like `motionctl home`",
-    },
-    MethodSpec {
-        name: "StopAll",
-        scope: Scope::Machine,
-        inputs: &[],
-        doc: "MAS on every axis",
-    },
-];
+const TIMEOUT: ArgSpec = arg(
+    "Timeout",
+    DataTypeId::Double,
+    false,
+    "seconds after which the supervisor stops what still homes (0: the axes' own home_timeout only)",
+);
+
+/// The argument of an operation's parameter.
+fn param_arg(p: &Param) -> ArgSpec {
+    let (data_type, array) = match p.kind {
+        Kind::Number | Kind::Optional => (DataTypeId::Double, false),
+        Kind::Switch => (DataTypeId::Boolean, false),
+        Kind::Choice(_) | Kind::Axis => (DataTypeId::String, false),
+        Kind::Pair => (DataTypeId::Double, true),
+    };
+    let doc: Vec<&str> = p.doc.lines().map(str::trim).collect();
+    let mut doc = doc.join(" ").replace('`', "");
+    if let Kind::Choice(c) = p.kind {
+        doc += &format!(" One of: {}.", c.join(", "));
+    }
+    if p.form == Form::Lease {
+        doc +=
+            &format!(" At most {MAX_JOG_S} s here: call again within it to go on (hold to run).");
+    }
+    if !given(p) {
+        doc += " Null or left out: not given.";
+    }
+    ArgSpec {
+        name: p.title,
+        data_type,
+        array,
+        doc: Cow::Owned(doc),
+    }
+}
+
+/// Every method we offer: the control service's own, then one per
+/// operation a client may ask for.
+pub fn methods() -> &'static [MethodSpec] {
+    static ALL: OnceLock<Vec<MethodSpec>> = OnceLock::new();
+    ALL.get_or_init(|| {
+        let own = |name, scope, verb, inputs, doc| MethodSpec {
+            name,
+            scope,
+            verb,
+            inputs,
+            doc,
+        };
+        let mut all = vec![
+            own(
+                "Home",
+                Scope::Axis,
+                Verb::Home,
+                vec![TIMEOUT],
+                "MAH: home this axis (a gantry side: home the gantry with HomeAll)",
+            ),
+            own(
+                "Stop",
+                Scope::Axis,
+                Verb::Stop,
+                vec![],
+                "MAS: stop this axis (a homing ends with ERR 12 / EXERR 1)",
+            ),
+            own(
+                "Unhome",
+                Scope::Axis,
+                Verb::Unhome,
+                vec![],
+                "clear HomedStatus (and invalidate a stored absolute reference)",
+            ),
+            own(
+                "HomeAll",
+                Scope::Machine,
+                Verb::Home,
+                vec![
+                    arg(
+                        "Axes",
+                        DataTypeId::String,
+                        true,
+                        "axis or gantry names; empty: every axis, in home order",
+                    ),
+                    arg(
+                        "Parallel",
+                        DataTypeId::Boolean,
+                        false,
+                        "start every named axis at once, ignoring the home order",
+                    ),
+                    TIMEOUT,
+                ],
+                "home the named axes (all by default), like `motionctl home`",
+            ),
+            own(
+                "StopAll",
+                Scope::Machine,
+                Verb::Stop,
+                vec![],
+                "MAS on every axis",
+            ),
+        ];
+        for k in OpKind::ALL.iter().copied().filter(|k| k.client()) {
+            all.push(MethodSpec {
+                name: k.title(),
+                scope: Scope::Axis,
+                verb: Verb::Op(k),
+                inputs: k.params().iter().map(param_arg).collect(),
+                doc: k.summary(),
+            });
+        }
+        all
+    })
+}
 
 pub fn spec(name: &str, scope: Scope) -> Option<&'static MethodSpec> {
-    METHODS.iter().find(|m| m.name == name && m.scope == scope)
+    methods()
+        .iter()
+        .find(|m| m.name == name && m.scope == scope)
 }
 
 /// Longest Timeout accepted (the range of `home_timeout`).
 pub const MAX_TIMEOUT_S: f64 = 86_400.0;
-/// Longest Duration of one Jog call: an HMI that holds longer calls Jog
-/// again; one that vanished without closing its session stops jogging
-/// within this bound.
-pub const MAX_JOG_S: f64 = 10.0;
-/// Largest |Speed| or |Target| taken (the daemon applies the axis's own
-/// limits; this only keeps absurd numbers off the wire).
+/// Longest lease of a hold-to-run call (Jog's Duration): an HMI that holds
+/// longer calls again within it; one that hangs, or whose link is cut,
+/// stops the axis within this bound — whatever its session's timeout.
+pub const MAX_JOG_S: f64 = 1.0;
+/// Largest |number| taken (the daemon applies the axis's own limits; this
+/// only keeps absurd numbers off the wire).
 pub const MAX_ABS: f64 = 1e12;
 
 /// What the control service is asked.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Operation {
+pub enum Call {
     /// `axes` empty: every axis in home order.
     Home {
         axes: Vec<String>,
@@ -189,42 +216,19 @@ pub enum Operation {
     Unhome {
         axes: Vec<String>,
     },
-    Enable {
-        axes: Vec<String>,
-    },
-    Disable {
-        axes: Vec<String>,
-    },
-    Reset {
-        axes: Vec<String>,
-    },
-    /// Hold to run on one axis: the bridge starts it and renews it while
-    /// `duration_s` lasts and the session lives.
-    Jog {
+    /// An operation of the engine on one axis, as its spec declares it.
+    Operate {
         axis: String,
-        speed: f64,
-        duration_s: f64,
-    },
-    Move {
-        axis: String,
-        position: f64,
-        relative: bool,
-        /// `None`: the axis's default.
-        speed: Option<f64>,
+        op: Operation,
     },
 }
 
-/// The control service's lease of a jog started here, renewed by the
-/// bridge every [`JOG_RENEW_MS`] while the jog may run.
-pub const JOG_LEASE_MS: u32 = 500;
-pub const JOG_RENEW_MS: u64 = 100;
-
-impl Operation {
+impl Call {
     /// The typed control request.
     pub fn typed(&self) -> Request {
         let named = |a: &Vec<String>| Axes::from_names(a);
         match self {
-            Operation::Home {
+            Call::Home {
                 axes,
                 parallel,
                 timeout_s,
@@ -233,31 +237,11 @@ impl Operation {
                 parallel: *parallel,
                 timeout_s: (*timeout_s > 0.0).then_some(*timeout_s),
             },
-            Operation::Stop { axes } => Request::Stop { axes: named(axes) },
-            Operation::Unhome { axes } => Request::Unhome { axes: named(axes) },
-            Operation::Enable { axes } => Request::Enable { axes: named(axes) },
-            Operation::Disable { axes } => Request::Disable { axes: named(axes) },
-            Operation::Reset { axes } => Request::Reset { axes: named(axes) },
-            Operation::Jog { axis, speed, .. } => Request::Jog {
+            Call::Stop { axes } => Request::Stop { axes: named(axes) },
+            Call::Unhome { axes } => Request::Unhome { axes: named(axes) },
+            Call::Operate { axis, op } => Request::Operate {
                 axes: Axes::Named(vec![axis.clone()]),
-                speed: *speed,
-                accel: None,
-                decel: None,
-                lease_ms: JOG_LEASE_MS,
-            },
-            Operation::Move {
-                axis,
-                position,
-                relative,
-                speed,
-            } => Request::Move {
-                axes: Axes::Named(vec![axis.clone()]),
-                position: *position,
-                relative: *relative,
-                speed: *speed,
-                accel: None,
-                decel: None,
-                supersede: false,
+                op: *op,
             },
         }
     }
@@ -281,44 +265,38 @@ pub enum CallError {
 
 /// Decodes the input arguments of `spec` called on `axis` (the axis object,
 /// for [`Scope::Axis`]).
-pub fn decode(
-    spec: &MethodSpec,
-    axis: Option<&str>,
-    args: &[Variant],
-) -> Result<Operation, CallError> {
-    if args.len() < spec.inputs.len() {
-        return Err(CallError::Status(StatusCode::BadArgumentsMissing));
-    }
+pub fn decode(spec: &MethodSpec, axis: Option<&str>, args: &[Variant]) -> Result<Call, CallError> {
     if args.len() > spec.inputs.len() {
         return Err(CallError::Status(StatusCode::BadTooManyArguments));
     }
+    let axes = match (spec.scope, axis) {
+        (Scope::Axis, Some(a)) => vec![a.to_string()],
+        (Scope::Axis, None) => return Err(CallError::Status(StatusCode::BadMethodInvalid)),
+        (Scope::Machine, _) => Vec::new(),
+    };
+    match spec.verb {
+        Verb::Op(kind) => decode_op(kind, axes.concat(), args),
+        verb => decode_own(spec, verb, axes, args),
+    }
+}
+
+/// Home, Stop, Unhome and their machine-wide forms: every argument given.
+fn decode_own(
+    spec: &MethodSpec,
+    verb: Verb,
+    mut axes: Vec<String>,
+    args: &[Variant],
+) -> Result<Call, CallError> {
+    if args.len() < spec.inputs.len() {
+        return Err(CallError::Status(StatusCode::BadArgumentsMissing));
+    }
     let mut results = vec![StatusCode::Good; args.len()];
-    let mut timeout_s = 0.0;
-    let mut parallel = false;
-    let mut named = Vec::new();
-    let (mut speed, mut duration_s, mut target, mut relative) = (0.0, 0.0, 0.0, false);
-    for (i, (a, s)) in args.iter().zip(spec.inputs).enumerate() {
-        let r = match (spec.name, s.name) {
-            (_, "Timeout") => timeout(a).map(|t| timeout_s = t),
-            ("Jog", "Speed") => bounded(a, |x| x.abs() <= MAX_ABS).map(|x| speed = x),
-            ("Move", "Speed") => bounded(a, |x| (0.0..=MAX_ABS).contains(&x)).map(|x| speed = x),
-            (_, "Duration") => bounded(a, |x| x > 0.0 && x <= MAX_JOG_S).map(|x| duration_s = x),
-            (_, "Target") => bounded(a, |x| x.abs() <= MAX_ABS).map(|x| target = x),
-            (_, "Relative") => match a {
-                Variant::Boolean(b) => {
-                    relative = *b;
-                    Ok(())
-                }
-                _ => Err(StatusCode::BadTypeMismatch),
-            },
-            (_, "Parallel") => match a {
-                Variant::Boolean(b) => {
-                    parallel = *b;
-                    Ok(())
-                }
-                _ => Err(StatusCode::BadTypeMismatch),
-            },
-            (_, "Axes") => names(a).map(|n| named = n),
+    let (mut timeout_s, mut parallel) = (0.0, false);
+    for (i, (a, s)) in args.iter().zip(&spec.inputs).enumerate() {
+        let r = match s.name {
+            "Timeout" => timeout(a).map(|t| timeout_s = t),
+            "Parallel" => boolean(a).map(|b| parallel = b),
+            "Axes" => names(a).map(|n| axes = n),
             _ => Err(StatusCode::BadInvalidArgument),
         };
         if let Err(e) = r {
@@ -328,35 +306,108 @@ pub fn decode(
     if results.iter().any(|r| r.is_bad()) {
         return Err(CallError::Args(results));
     }
-    let axes = match (spec.scope, axis) {
-        (Scope::Axis, Some(a)) => vec![a.to_string()],
-        (Scope::Axis, None) => return Err(CallError::Status(StatusCode::BadMethodInvalid)),
-        (Scope::Machine, _) => named,
-    };
-    Ok(match spec.name {
-        "Home" | "HomeAll" => Operation::Home {
+    Ok(match verb {
+        Verb::Home => Call::Home {
             axes,
             parallel,
             timeout_s,
         },
-        "Stop" | "StopAll" => Operation::Stop { axes },
-        "Unhome" => Operation::Unhome { axes },
-        "Enable" => Operation::Enable { axes },
-        "Disable" => Operation::Disable { axes },
-        "Reset" => Operation::Reset { axes },
-        "Jog" => Operation::Jog {
-            axis: axes.concat(),
-            speed,
-            duration_s,
-        },
-        "Move" => Operation::Move {
-            axis: axes.concat(),
-            position: target,
-            relative,
-            speed: (speed > 0.0).then_some(speed),
-        },
-        _ => return Err(CallError::Status(StatusCode::BadMethodInvalid)),
+        Verb::Stop => Call::Stop { axes },
+        Verb::Unhome | Verb::Op(_) => Call::Unhome { axes },
     })
+}
+
+/// An operation of the engine: each argument by its parameter.
+fn decode_op(kind: OpKind, axis: String, args: &[Variant]) -> Result<Call, CallError> {
+    let params = kind.params();
+    let needed = params.iter().rposition(given).map_or(0, |i| i + 1);
+    if args.len() < needed {
+        return Err(CallError::Status(StatusCode::BadArgumentsMissing));
+    }
+    let mut c = Carried::EMPTY;
+    let results: Vec<StatusCode> = (args.iter().zip(params))
+        .map(|(a, p)| param(p, a, &mut c).err().unwrap_or(StatusCode::Good))
+        .collect();
+    if results.iter().any(|r| r.is_bad()) {
+        return Err(CallError::Args(results));
+    }
+    // Every argument was checked against its parameter: what remains is
+    // a parameter the call left out that must be given.
+    let op = Operation::take(kind, &c)
+        .map_err(|_| CallError::Status(StatusCode::BadArgumentsMissing))?;
+    Ok(Call::Operate { axis, op })
+}
+
+/// A parameter a call must give: a number, choice or axis that has no
+/// default — and the lease of a hold-to-run call, which its caller states
+/// (it is the one that renews it).
+fn given(p: &Param) -> bool {
+    matches!(p.kind, Kind::Number | Kind::Choice(_) | Kind::Axis) || p.form == Form::Lease
+}
+
+/// One argument of an operation into `c`, where its parameter is carried.
+fn param(p: &Param, v: &Variant, c: &mut Carried) -> Result<(), StatusCode> {
+    let slot = match p.place {
+        Place::Slot(s) => s,
+        _ => 0,
+    };
+    let empty = matches!(v, Variant::Empty);
+    match p.kind {
+        _ if empty && given(p) => Err(StatusCode::BadTypeMismatch),
+        Kind::Optional | Kind::Switch | Kind::Pair if empty => Ok(()),
+        Kind::Number | Kind::Optional => {
+            let lease = p.form == Form::Lease;
+            let x = bounded(v, |x| {
+                x.abs() <= MAX_ABS && (!lease || (x > 0.0 && x <= MAX_JOG_S))
+            })?;
+            c.values[slot] = x;
+            Ok(())
+        }
+        Kind::Switch => {
+            if let (true, Place::Bit(b)) = (boolean(v)?, p.place) {
+                c.switches |= 1 << b;
+            }
+            Ok(())
+        }
+        Kind::Choice(choices) => {
+            let Variant::String(s) = v else {
+                return Err(StatusCode::BadTypeMismatch);
+            };
+            let i = choices.iter().position(|x| *x == s.as_ref());
+            c.values[slot] = i.ok_or(StatusCode::BadOutOfRange)? as f64;
+            Ok(())
+        }
+        Kind::Axis => {
+            let Variant::String(s) = v else {
+                return Err(StatusCode::BadTypeMismatch);
+            };
+            match params::AxisRef::named(s.as_ref()) {
+                Some(params::AxisRef::Name(n)) => {
+                    c.name = n;
+                    Ok(())
+                }
+                _ => Err(StatusCode::BadOutOfRange),
+            }
+        }
+        Kind::Pair => {
+            let Variant::Array(a) = v else {
+                return Err(StatusCode::BadTypeMismatch);
+            };
+            let [lo, hi] = a.values.as_slice() else {
+                return Err(StatusCode::BadOutOfRange);
+            };
+            c.values[slot] = bounded(lo, |x| x.abs() <= MAX_ABS)?;
+            c.values[slot + 1] = bounded(hi, |x| x.abs() <= MAX_ABS)?;
+            Ok(())
+        }
+    }
+}
+
+fn boolean(v: &Variant) -> Result<bool, StatusCode> {
+    match v {
+        Variant::Boolean(b) => Ok(*b),
+        _ => Err(StatusCode::BadTypeMismatch),
+    }
 }
 
 fn timeout(v: &Variant) -> Result<f64, StatusCode> {
@@ -491,25 +542,25 @@ pub fn output_args(scope: Scope) -> &'static [ArgSpec] {
             name: "Accepted",
             data_type: DataTypeId::Boolean,
             array: false,
-            doc: "the control service accepted the request",
+            doc: Cow::Borrowed("the control service accepted the request"),
         },
         ArgSpec {
             name: "Reason",
             data_type: DataTypeId::String,
             array: false,
-            doc: "\"accepted\", or why it was refused (the control service's words)",
+            doc: Cow::Borrowed("\"accepted\", or why it was refused (the control service's words)"),
         },
         ArgSpec {
             name: "ERR",
             data_type: DataTypeId::UInt16,
             array: false,
-            doc: "the instruction's ERR where it has one, else 0",
+            doc: Cow::Borrowed("the instruction's ERR where it has one, else 0"),
         },
         ArgSpec {
             name: "EXERR",
             data_type: DataTypeId::UInt16,
             array: false,
-            doc: "the instruction's EXERR where it has one, else 0",
+            doc: Cow::Borrowed("the instruction's EXERR where it has one, else 0"),
         },
     ];
     const MACHINE: &[ArgSpec] = &[
@@ -517,37 +568,37 @@ pub fn output_args(scope: Scope) -> &'static [ArgSpec] {
             name: "Axes",
             data_type: DataTypeId::String,
             array: true,
-            doc: "the axes the request addressed",
+            doc: Cow::Borrowed("the axes the request addressed"),
         },
         ArgSpec {
             name: "Accepted",
             data_type: DataTypeId::Boolean,
             array: true,
-            doc: "per axis",
+            doc: Cow::Borrowed("per axis"),
         },
         ArgSpec {
             name: "Reasons",
             data_type: DataTypeId::String,
             array: true,
-            doc: "per axis: \"accepted\" or why refused",
+            doc: Cow::Borrowed("per axis: \"accepted\" or why refused"),
         },
         ArgSpec {
             name: "ERR",
             data_type: DataTypeId::UInt16,
             array: true,
-            doc: "per axis",
+            doc: Cow::Borrowed("per axis"),
         },
         ArgSpec {
             name: "EXERR",
             data_type: DataTypeId::UInt16,
             array: true,
-            doc: "per axis",
+            doc: Cow::Borrowed("per axis"),
         },
         ArgSpec {
             name: "Message",
             data_type: DataTypeId::String,
             array: false,
-            doc: "the control service's message (empty when accepted)",
+            doc: Cow::Borrowed("the control service's message (empty when accepted)"),
         },
     ];
     match scope {

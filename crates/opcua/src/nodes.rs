@@ -11,7 +11,7 @@
 //! ```
 
 use crate::events::AxisErrorEventType;
-use crate::methods::{output_args, ArgSpec, Scope, METHODS};
+use crate::methods::{methods as all_methods, output_args, ArgSpec, Scope};
 use crate::space::*;
 use crate::units;
 use motion_config::opcua::OpcuaConfig;
@@ -233,14 +233,14 @@ fn argument(a: &ArgSpec) -> Argument {
         data_type: a.data_type.into(),
         value_rank: if a.array { 1 } else { -1 },
         array_dimensions: a.array.then(|| vec![0]),
-        description: LocalizedText::new("", a.doc),
+        description: LocalizedText::new("", a.doc.as_ref()),
     }
 }
 
 /// The methods of `scope` on `object` (node ids `<path>.<Method>`).
 fn methods(space: &mut AddressSpace, ns: u16, object: &NodeId, path: &str, scope: Scope) {
     let outputs: Vec<Argument> = output_args(scope).iter().map(argument).collect();
-    for m in METHODS.iter().filter(|m| m.scope == scope) {
+    for m in all_methods().iter().filter(|m| m.scope == scope) {
         let mid = id(ns, &format!("{path}.{}", m.name));
         let mut b = MethodBuilder::new(&mid, QualifiedName::new(ns, m.name), m.name)
             .description(m.doc)

@@ -112,8 +112,13 @@ fn builder(
     b
 }
 
-/// Serves until SIGINT/SIGTERM. Returns the exit code.
-pub async fn serve(machine: MachineConfig, cfg: OpcuaConfig) -> Result<(), String> {
+/// Serves until SIGINT/SIGTERM; on SIGHUP reads the users of `config` again
+/// ([`reload_users`]). Returns the exit code.
+pub async fn serve(
+    machine: MachineConfig,
+    cfg: OpcuaConfig,
+    config: std::path::PathBuf,
+) -> Result<(), String> {
     for u in &cfg.users {
         crate::password::parses(&u.password_hash)
             .map_err(|e| format!("[[opcua.user]] {}: password_hash: {e}", u.name))?;
@@ -129,7 +134,7 @@ pub async fn serve(machine: MachineConfig, cfg: OpcuaConfig) -> Result<(), Strin
     }
     let roles = Arc::new(Roles::new(&cfg));
     let (tx, rx) = std::sync::mpsc::channel();
-    let (server, handle) = builder(&machine, &cfg, roles, Handle { jobs: tx })
+    let (server, handle) = builder(&machine, &cfg, roles.clone(), Handle { jobs: tx })
         .build()
         .map_err(|e| format!("OPC UA server: {e}"))?;
     let manager = handle
@@ -164,6 +169,15 @@ pub async fn serve(machine: MachineConfig, cfg: OpcuaConfig) -> Result<(), Strin
             }
         }
     });
+    tokio::spawn(async move {
+        use tokio::signal::unix::{signal, SignalKind};
+        let Ok(mut hup) = signal(SignalKind::hangup()) else {
+            return;
+        };
+        while hup.recv().await.is_some() {
+            reload_users(&config, &roles);
+        }
+    });
     let h = handle.clone();
     tokio::spawn(async move {
         use tokio::signal::unix::{signal, SignalKind};
@@ -194,6 +208,38 @@ pub async fn serve(machine: MachineConfig, cfg: OpcuaConfig) -> Result<(), Strin
     stop.store(true, Ordering::Release);
     let _ = thread.join();
     r.map_err(|e| format!("OPC UA server: {e}"))
+}
+
+/// SIGHUP: the users of `[[opcua.user]]` (names, hashes, roles) read again
+/// from `config`. A configuration that does not load, or a hash that does
+/// not parse, changes nothing (said in the log).
+pub fn reload_users(config: &std::path::Path, roles: &Roles) {
+    let cfg = match motion_config::opcua::load(config) {
+        Ok((_, cfg)) => cfg,
+        Err(problems) => {
+            let p: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+            log::warn!(
+                "SIGHUP: {} does not load, the users stay as they were: {}",
+                config.display(),
+                p.join("; ")
+            );
+            return;
+        }
+    };
+    for u in &cfg.users {
+        if let Err(e) = crate::password::parses(&u.password_hash) {
+            log::warn!(
+                "SIGHUP: [[opcua.user]] {}: password_hash: {e}; the users stay as they were",
+                u.name
+            );
+            return;
+        }
+    }
+    let n = roles.reload(&cfg);
+    log::info!(
+        "SIGHUP: the users were read again from {} ({n})",
+        config.display()
+    );
 }
 
 #[cfg(test)]

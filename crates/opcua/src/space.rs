@@ -301,7 +301,7 @@ mod tests {
             for v in AXIS_LIVE.iter().map(|v| v.name) {
                 ids.push(axis_var_id(ns, axis, v));
             }
-            for m in crate::methods::METHODS {
+            for m in crate::methods::methods() {
                 ids.push(id(ns, &format!("{}.{}", axis_path(axis), m.name)));
             }
         }

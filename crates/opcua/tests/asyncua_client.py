@@ -12,6 +12,7 @@ import asyncio
 import json
 import math
 import os
+import signal
 import time
 from pathlib import Path
 
@@ -211,8 +212,9 @@ async def enable_move(a):
         enable = await ax.call_method(f"{ns}:Enable")
         _, servo = await poll(ax, ns, "ServoActionStatus", bool, 10)
         D = ua.VariantType.Double
+        # Speed and the rest left out: the axis's defaults.
         out = await ax.call_method(f"{ns}:Move", ua.Variant(a.target, D),
-                                   ua.Variant(False, ua.VariantType.Boolean), ua.Variant(0.0, D))
+                                   ua.Variant(False, ua.VariantType.Boolean))
         _, moving = await poll(ax, ns, "MoveStatus", bool, 5)
         pos, reached = await poll(ax, ns, "ActualPosition",
                                   lambda p: p is not None and abs(p - a.target) < 0.01, a.timeout)
@@ -226,9 +228,10 @@ async def enable_move(a):
 
 
 async def jog(a):
-    """Operator: Jog at `--speed` for `--duration` s: it runs, then stops by
-    itself while the session stays open. With `--close`: the session
-    closes mid-jog instead (duration 10 s) and a second session sees it stop."""
+    """Operator: Jog at `--speed` with the lease `--duration` s, called once:
+    it runs, then stops by itself while the session stays open (a frozen
+    HMI). With `--close`: the session closes mid-jog instead and a second
+    session sees it stop."""
     async with await client(a) as watcher:
         wns, wax = await axis_node(watcher, a.axis)
         start = await read(wax, wns, "ActualPosition")
@@ -243,11 +246,49 @@ async def jog(a):
             await c.disconnect()
         _, stopped = await poll(wax, wns, "JogStatus", lambda j: not j, a.timeout)
         took = time.time() - t0
+        # The frozen caller's session is still there: the jog stopped anyway.
+        session_open = None
         if not a.close:
+            session_open = (await read(ax, ns, "JogStatus")) is not None
             await c.disconnect()
         end = await read(wax, wns, "ActualPosition")
         return {"outputs": [jsonable(x) for x in out], "jogging_seen": seen, "stopped": stopped,
-                "took": took, "moved": jsonable(end - start if end is not None and start is not None else None)}
+                "took": took, "session_open": session_open,
+                "moved": jsonable(end - start if end is not None and start is not None else None)}
+
+
+async def jog_hold(a):
+    """Operator: Jog at `--speed` with the lease `--duration`, called again
+    every 0.2 s for `--hold` s (a button held): every call is accepted and
+    the axis jogs throughout; then the calls stop and so does the axis.
+
+    With `--config FILE --pid PID`: after a few calls the operator's role is
+    taken away (FILE rewritten, SIGHUP to PID); the calls go on until one is
+    refused, and the jog must stop."""
+    async with await client(a) as watcher:
+        wns, wax = await axis_node(watcher, a.axis)
+        async with await client(a, user=a.user, password=a.password) as c:
+            ns, ax = await axis_node(c, a.axis)
+            D = ua.VariantType.Double
+            call = lambda: ax.call_method(f"{ns}:Jog", ua.Variant(a.speed, D), ua.Variant(a.duration, D))
+            outputs = [[jsonable(x) for x in await call()]]
+            _, seen = await poll(wax, wns, "JogStatus", bool, 5)
+            jogging, refused, calls = [], None, 1
+            until = time.time() + a.hold
+            while time.time() < until:
+                await asyncio.sleep(0.2)
+                if a.config and calls == 3:
+                    text = Path(a.config).read_text()
+                    Path(a.config).write_text(text.replace('role = "operator"', 'role = "viewer"'))
+                    os.kill(a.pid, signal.SIGHUP)
+                refused = await expect_error(call())
+                calls += 1
+                if refused is not None:
+                    break
+                jogging.append(bool(await read(wax, wns, "JogStatus")))
+            _, stopped = await poll(wax, wns, "JogStatus", lambda j: not j, a.timeout)
+        return {"first": outputs[0], "jogging_seen": seen, "calls": calls, "refused": refused,
+                "jogging_throughout": all(jogging), "polls": len(jogging), "stopped": stopped}
 
 
 async def none_call(a):
@@ -297,14 +338,18 @@ async def fuzz(a):
             "jog_huge_speed": (ax, "Jog", [ua.Variant(1e308, D), ua.Variant(1.0, D)]),
             "jog_inf_duration": (ax, "Jog", [ua.Variant(1.0, D), ua.Variant(float("inf"), D)]),
             "jog_long_duration": (ax, "Jog", [ua.Variant(1.0, D), ua.Variant(1e9, D)]),
+            # Hold to run: a lease over a second is not one.
+            "jog_ten_seconds": (ax, "Jog", [ua.Variant(1.0, D), ua.Variant(10.0, D)]),
             "jog_zero_duration": (ax, "Jog", [ua.Variant(1.0, D), ua.Variant(0.0, D)]),
             "jog_missing": (ax, "Jog", [ua.Variant(1.0, D)]),
             "move_nan": (ax, "Move", [ua.Variant(float("nan"), D), ua.Variant(False, B),
                                       ua.Variant(0.0, D)]),
             "move_huge": (ax, "Move", [ua.Variant(1e308, D), ua.Variant(False, B),
                                        ua.Variant(0.0, D)]),
-            "move_negative_speed": (ax, "Move", [ua.Variant(1.0, D), ua.Variant(False, B),
-                                                 ua.Variant(-3.0, D)]),
+            "move_nan_speed": (ax, "Move", [ua.Variant(1.0, D), ua.Variant(False, B),
+                                            ua.Variant(float("nan"), D)]),
+            "move_too_many": (ax, "Move", [ua.Variant(1.0, D), ua.Variant(False, B)]
+                              + [ua.Variant(1.0, D)] * 5),
             "move_string": (ax, "Move", [ua.Variant("1", S), ua.Variant(False, B),
                                          ua.Variant(0.0, D)]),
             "enable_too_many": (ax, "Enable", [ua.Variant(1.0, D)]),
@@ -354,7 +399,7 @@ async def latency(a):
 
 SCENARIOS = {f.__name__.replace("_", "-"): f for f in
              (gen_cert, endpoints, browse, home, er_event, anon_call, none_call, wrong_password,
-              untrusted, fuzz, connected, latency, enable_move, jog)}
+              untrusted, fuzz, connected, latency, enable_move, jog, jog_hold)}
 
 
 def main():
@@ -374,6 +419,9 @@ def main():
     p.add_argument("--speed", type=float, default=5.0)
     p.add_argument("--duration", type=float, default=1.0)
     p.add_argument("--close", action="store_true")
+    p.add_argument("--hold", type=float, default=2.0)
+    p.add_argument("--config", default=None)
+    p.add_argument("--pid", type=int, default=0)
     a = p.parse_args()
     out = asyncio.run(SCENARIOS[a.scenario](a))
     print(json.dumps(out))

@@ -435,7 +435,8 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         "{m}"
     );
     assert_eq!(m["reached"], true, "{m}");
-    // A Jog with a Duration stops by itself, the session still open ...
+    // Jog is hold to run: called once and then never again by a client
+    // that froze with its session open, it stops within its lease ...
     let j = rig.ua("jog", &["--password", "op-secret", "--duration", "1"]);
     assert_eq!(
         j["outputs"],
@@ -443,12 +444,13 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         "{j}"
     );
     assert_eq!(
-        (&j["jogging_seen"], &j["stopped"]),
-        (&Value::Bool(true), &Value::Bool(true)),
+        (&j["jogging_seen"], &j["stopped"], &j["session_open"]),
+        (&Value::Bool(true), &Value::Bool(true), &Value::Bool(true)),
         "{j}"
     );
     assert!(j["moved"].as_f64().unwrap() > 0.5, "{j}");
-    // ... and one whose session closes stops long before its Duration.
+    rig.wait_log("opcua.err", "jog on axis X ended: its lease ran out", 1);
+    // ... one whose session closes stops at once ...
     let j = rig.ua(
         "jog",
         &[
@@ -457,7 +459,7 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
             "--speed",
             "-5",
             "--duration",
-            "10",
+            "1",
             "--close",
             "--timeout",
             "5",
@@ -469,9 +471,57 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         "{j}"
     );
     rig.wait_log("opcua.err", "the session that started it is gone", 1);
-    assert!(rig
-        .text("opcua.err")
-        .contains("jog on axis X ended: its duration ran out"));
+    // ... one called again and again runs as long as the calls come, each
+    // accepted (a lease of a second, renewed five times a second) ...
+    let j = rig.ua(
+        "jog-hold",
+        &["--password", "op-secret", "--duration", "1", "--hold", "3"],
+    );
+    assert_eq!(
+        j["first"],
+        serde_json::json!([true, "accepted", 0, 0]),
+        "{j}"
+    );
+    assert_eq!(j["refused"], Value::Null, "{j}");
+    assert!(j["polls"].as_u64().unwrap() >= 5, "{j}");
+    assert_eq!(
+        (&j["jogging_throughout"], &j["stopped"]),
+        (&Value::Bool(true), &Value::Bool(true)),
+        "{j}"
+    );
+    // ... and one whose caller loses the operator role (the users read
+    // again on SIGHUP) is refused its next call and stops, every renewal
+    // being checked like a first call.
+    let original = std::fs::read_to_string(&rig.config).unwrap();
+    let pid = rig.opcua.as_ref().unwrap().id().to_string();
+    let config = rig.config.to_string_lossy().into_owned();
+    let j = rig.ua(
+        "jog-hold",
+        &[
+            "--password",
+            "op-secret",
+            "--duration",
+            "1",
+            "--hold",
+            "10",
+            "--config",
+            &config,
+            "--pid",
+            &pid,
+        ],
+    );
+    std::fs::write(&rig.config, &original).unwrap();
+    rig.wait_log("opcua.err", "the users were read again", 1);
+    assert_eq!(j["refused"], "BadUserAccessDenied", "{j}");
+    assert!(j["calls"].as_u64().unwrap() >= 4, "{j}");
+    assert_eq!(j["stopped"], true, "{j}");
+    rig.wait_log("opcua.err", "its user is no longer an operator", 1);
+    nix::sys::signal::kill(
+        nix::unistd::Pid::from_raw(rig.opcua.as_ref().unwrap().id() as i32),
+        nix::sys::signal::Signal::SIGHUP,
+    )
+    .unwrap();
+    rig.wait_log("opcua.err", "the users were read again", 2);
 
     // Hostile arguments: each refused with a Bad status, the server still serves.
     let f = rig.ua("fuzz", &["--password", "op-secret"]);

@@ -12,7 +12,7 @@ use crate::control_thread::{self, ControlSettings, Ready};
 use crate::hub::SharedHub;
 use crate::io_child::{Backoff, IoChild, Seen, SpawnNote};
 use crate::rt_thread::{self, RtOutcome, RtSettings};
-use crate::shared::{Control, Phase, Shared, Snapshot};
+use crate::shared::{Ask, Control, Phase, Shared, Snapshot};
 use motion_config::{IoMode, MachineConfig};
 use motion_ipc::Domain;
 use motion_report::{IoReport, Latency};
@@ -428,7 +428,7 @@ impl Session {
     fn shutdown_rt(&mut self) -> Option<RtOutcome> {
         let h = self.rt.take()?;
         if !matches!(self.shared.phase(), Phase::Exited | Phase::Failed) {
-            let _ = self.send(Control::Exit);
+            let _ = self.send(Control::undated(0, Ask::Exit));
         }
         // Stopping axes at home deceleration takes well under this.
         let until = Instant::now() + Duration::from_secs(30);

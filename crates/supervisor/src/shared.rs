@@ -19,55 +19,139 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 /// Most I/O processes (the config's limit).
 pub const MAX_IOS: usize = 16;
 
-/// Requests to the real-time thread. `mask` bit `i` = axis `i`.
+/// A request to the real-time thread: what is asked, the id its answer
+/// carries, and the deadline after which it is never applied.
+///
+/// The control thread waits for the answer until the deadline and then
+/// tells its client that nothing was applied — which must stay true, or a
+/// client retrying `move --by` after "the cycle did not answer" would move
+/// twice. So the cycle refuses a request past its deadline without any
+/// effect ([`Ack::expired`], `Core::control`), and, because the cycle's
+/// clock may lag (a wake-up late, a thread stopped between reading the
+/// clock and acting), the one request the control thread waits for also
+/// passes a [`Gate`]: whichever of the cycle (taking it) and the control
+/// thread (giving up on it) comes first decides, atomically.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Control {
+pub struct Control {
+    /// Echoed in the answer ([`Ack::id`]); 0 for [`Ask::Exit`], which is
+    /// not answered.
+    pub id: u32,
+    /// `CLOCK_MONOTONIC` ns after which the cycle refuses it without
+    /// effect; [`NO_DEADLINE`] for what nobody waits for with a timeout
+    /// (the keeper's restore, leaving).
+    pub deadline_ns: u64,
+    pub ask: Ask,
+}
+
+/// [`Control::deadline_ns`] of a request that never expires (never gated).
+pub const NO_DEADLINE: u64 = u64::MAX;
+
+impl Control {
+    /// `ask` with no deadline (and not gated): for requests whose sender
+    /// takes the answer whenever it comes.
+    pub fn undated(id: u32, ask: Ask) -> Self {
+        Control {
+            id,
+            deadline_ns: NO_DEADLINE,
+            ask,
+        }
+    }
+
+    /// Passes through the [`Gate`]: a request someone waits for until its
+    /// deadline.
+    pub fn gated(&self) -> bool {
+        self.deadline_ns != NO_DEADLINE
+    }
+}
+
+/// What a request asks of the cycle. `mask` bit `i` = axis `i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Ask {
     /// Home the axes of `mask`: in home order (config order one at a time
     /// when no axis has one), or all at once with `parallel`. `timeout_ns`
     /// (0 = none) stops what is still homing after that long.
     Home {
-        id: u32,
         mask: u64,
         parallel: bool,
         timeout_ns: u64,
     },
     /// Stop (MAS) the axes of `mask`.
-    Stop { id: u32, mask: u64 },
+    Stop { mask: u64 },
     /// Clear HomedStatus of the axes of `mask`.
-    Unhome { id: u32, mask: u64 },
+    Unhome { mask: u64 },
     /// Record every cycle of the next homing of axis `axis`.
-    Trace { id: u32, axis: usize },
+    Trace { axis: usize },
     /// Apply the stored raw → axis `offset` of absolute axis `axis` without
     /// motion ([`motion_homing::Axis::restore_reference`]).
-    Restore { id: u32, axis: usize, offset: f64 },
+    Restore { axis: usize, offset: f64 },
     /// Stop every axis, disable the drives once at rest, then leave the loop.
     Exit,
     /// An operation for every axis of `mask` (a gantry: all its sides),
     /// delivered to their engines in the same cycle and answered after that
-    /// cycle's step with each engine's answer. `f64` parameters that are
-    /// NaN are the axis's default (a gantry side: its gantry's first
-    /// side's): accel `home_acceleration`, decel `home_deceleration`, a
-    /// move's speed `home_speed`. `token` names a jog (for its renewals).
+    /// cycle's step with each engine's answer; carried as the client gave
+    /// it (each engine fills what was left out from its configuration).
+    /// `token` names a hold-to-run operation (a jog) for its renewals.
     Op {
-        id: u32,
         mask: u64,
         op: motion_homing::Operation,
         token: u64,
     },
     /// Renew (or with `end`, end) the jog `token` on the axes of `mask`
     /// (0: wherever it runs).
-    JogRenew {
-        id: u32,
-        token: u64,
-        mask: u64,
-        end: bool,
-    },
+    JogRenew { token: u64, mask: u64, end: bool },
     /// `token` takes the axes of `mask` over for the setpoint stream (all
     /// of them or none).
-    StreamAcquire { id: u32, mask: u64, token: u64 },
+    StreamAcquire { mask: u64, token: u64 },
     /// The stream of `token` ends (released, or its owner is gone): its
     /// axes stop.
-    StreamRelease { id: u32, token: u64 },
+    StreamRelease { token: u64 },
+}
+
+/// Who decided the fate of the request the control thread waits for: the
+/// cycle taking it ([`Gate::take`]) or the control thread giving up on it
+/// ([`Gate::abandon`]) — one atomic word (the id and its state), so the
+/// two can never both win, whatever either thread's clock says or however
+/// long either is stopped between its decision and its effect. The
+/// control thread waits for one request at a time.
+#[derive(Debug, Default)]
+pub struct Gate(AtomicU64);
+
+impl Gate {
+    const PENDING: u64 = 1;
+    const TAKEN: u64 = 2;
+    const ABANDONED: u64 = 3;
+
+    fn word(id: u32, state: u64) -> u64 {
+        u64::from(id) << 8 | state
+    }
+
+    /// Control thread, before sending request `id`: it is pending.
+    pub fn offer(&self, id: u32) {
+        self.0
+            .store(Self::word(id, Self::PENDING), Ordering::Release);
+    }
+
+    /// Request `id`, still pending, is now `state`; false when it was not
+    /// pending (the other side decided first, or it is not the one).
+    fn decide(&self, id: u32, state: u64) -> bool {
+        let (pending, decided) = (Self::word(id, Self::PENDING), Self::word(id, state));
+        (self.0)
+            .compare_exchange(pending, decided, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+    }
+
+    /// Cycle: takes request `id` to apply it; false when the control thread
+    /// gave up on it first (or has moved on to another): drop it unapplied.
+    pub fn take(&self, id: u32) -> bool {
+        self.decide(id, Self::TAKEN)
+    }
+
+    /// Control thread, at the deadline: gives up on request `id`; true when
+    /// the cycle had not taken it (it never will), false when it had (its
+    /// answer will come).
+    pub fn abandon(&self, id: u32) -> bool {
+        self.decide(id, Self::ABANDONED)
+    }
 }
 
 /// Why the cycle refused a request for one axis: the domain's words. The
@@ -123,6 +207,8 @@ pub struct Ack {
     pub axes: [AxisAck; MAX_AXES],
     /// The engine's operation id of each accepted operation (0 otherwise).
     pub op_ids: [u32; MAX_AXES],
+    /// It reached the cycle after its deadline and was not applied at all.
+    pub expired: bool,
 }
 
 impl Ack {
@@ -132,6 +218,7 @@ impl Ack {
             cycle: 0,
             axes: [AxisAck::default(); MAX_AXES],
             op_ids: [0; MAX_AXES],
+            expired: false,
         }
     }
 }
@@ -223,6 +310,8 @@ pub enum Phase {
 /// Everything the threads share.
 pub struct Shared {
     pub control: ArrayQueue<Control>,
+    /// The request the control thread waits for ([`Gate`]).
+    pub gate: Gate,
     pub acks: ArrayQueue<Ack>,
     pub trace: ArrayQueue<TraceRecord>,
     pub stats_full: ArrayQueue<Box<HistSet>>,
@@ -245,6 +334,7 @@ impl Shared {
     pub fn new(spare_stats: usize, spare_snaps: usize) -> Self {
         let s = Self {
             control: ArrayQueue::new(256),
+            gate: Gate::default(),
             acks: ArrayQueue::new(64),
             trace: ArrayQueue::new(16_384),
             stats_full: ArrayQueue::new(spare_stats + 1),
@@ -284,6 +374,13 @@ impl Shared {
         self.control.push(c).is_ok()
     }
 
+    /// Real-time side: may request `c` be applied? An undated one always;
+    /// one someone waits for only if the cycle takes it before they give
+    /// up ([`Gate`]).
+    pub fn admit(&self, c: &Control) -> bool {
+        !c.gated() || self.gate.take(c.id)
+    }
+
     /// Reporting side: the newest snapshot, recycling older ones.
     pub fn latest_snapshot(&self, keep: &mut Option<Box<Snapshot>>) {
         while let Some(s) = self.snap_full.pop() {
@@ -301,5 +398,40 @@ impl Shared {
             h.reset();
             let _ = self.stats_free.push(h);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whoever comes first decides: the cycle takes a pending request
+    /// (then the control thread cannot give up on it), or the control
+    /// thread gives up (then the cycle never takes it, nor any request
+    /// before the one the control thread now waits for).
+    #[test]
+    fn the_gate_lets_exactly_one_side_decide() {
+        let g = Gate::default();
+        g.offer(7);
+        assert!(g.take(7));
+        assert!(!g.abandon(7), "taken: its answer will come");
+        assert!(!g.take(7), "taken once");
+        g.offer(8);
+        assert!(g.abandon(8));
+        assert!(!g.take(8), "given up on: never applied");
+        g.offer(9);
+        assert!(!g.take(8), "an old request the control thread gave up on");
+        assert!(g.take(9));
+        let s = Shared::new(0, 0);
+        let undated = Control::undated(3, Ask::Exit);
+        assert!(s.admit(&undated) && s.admit(&undated), "not gated");
+        let dated = Control {
+            id: 4,
+            deadline_ns: 1,
+            ask: Ask::Exit,
+        };
+        assert!(!s.admit(&dated), "not offered: not waited for");
+        s.gate.offer(4);
+        assert!(s.admit(&dated));
     }
 }

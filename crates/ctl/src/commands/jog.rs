@@ -1,6 +1,7 @@
-//! `jog AXIS --speed V [--accel A] [--decel D] [--for S]` (MAJ), hold to
-//! run: the jog runs while this command runs — its lease (500 ms) is
-//! renewed every 100 ms by the [`Jog`] handle's thread. Ctrl-C / SIGTERM
+//! `jog AXIS --speed V [--accel A] [--decel D] [--for S]` (MAJ; the flags
+//! are the engine's `JogSpec`, `spec_args.rs`), hold to run: the jog runs
+//! while this command runs — its lease (500 ms) is renewed every 100 ms by
+//! the [`Jog`] handle's thread. Ctrl-C / SIGTERM
 //! or `--for` elapsing end it here; `stop`, a soft or hard limit, a fault
 //! or lost feedback end it in the supervisor. Killed outright (SIGKILL),
 //! this command stops renewing and the jog stops within its lease.
@@ -19,12 +20,7 @@ use motion_report::MotionReport;
 use std::time::{Duration, Instant};
 
 pub fn jog(client: &mut Client, a: &JogArgs) -> i32 {
-    let spec = JogSpec {
-        accel: a.accel,
-        decel: a.decel,
-        ..JogSpec::new(&a.axis, a.speed)
-    };
-    let handle = match client.jog(&spec) {
+    let handle = match client.jog(&a.axis, a.jog.spec) {
         Ok(j) => j,
         Err(e) => return op_error(a.json, "jog", &e),
     };

@@ -11,8 +11,9 @@ mod stream;
 mod trace;
 
 use crate::cli::{Cli, Command, Target};
-use motion_control::{Client, ClientError};
+use motion_control::{Client, ClientError, Operation, REQ_STOP, REQ_UNHOME};
 use motion_report::ErrorEntry;
+use simple::Simple;
 use std::path::PathBuf;
 
 /// How a command fails: a refused command line, and every other failure.
@@ -39,13 +40,11 @@ pub fn run(cli: Cli) -> i32 {
     match cli.command {
         Command::Status(a) => status::status(&mut client, &a),
         Command::Home(a) => home::home(&mut client, &a),
-        Command::Stop(a) => simple::axes(&mut client, motion_control::REQ_STOP, "stop", &a),
-        Command::Unhome(a) => simple::axes(&mut client, motion_control::REQ_UNHOME, "unhome", &a),
-        Command::Enable(a) => simple::axes(&mut client, motion_control::REQ_ENABLE, "enable", &a),
-        Command::Disable(a) => {
-            simple::axes(&mut client, motion_control::REQ_DISABLE, "disable", &a)
-        }
-        Command::Reset(a) => simple::axes(&mut client, motion_control::REQ_RESET, "reset", &a),
+        Command::Stop(a) => simple::axes(&mut client, Simple::Kind(REQ_STOP), &a),
+        Command::Unhome(a) => simple::axes(&mut client, Simple::Kind(REQ_UNHOME), &a),
+        Command::Enable(a) => simple::axes(&mut client, Simple::Op(Operation::Enable), &a),
+        Command::Disable(a) => simple::axes(&mut client, Simple::Op(Operation::Disable), &a),
+        Command::Reset(a) => simple::axes(&mut client, Simple::Op(Operation::Reset), &a),
         Command::Jog(a) => jog::jog(&mut client, &a),
         Command::Move(a) => moves::move_axis(&mut client, &a),
         Command::Stream(a) => stream::stream(&mut client, &a),

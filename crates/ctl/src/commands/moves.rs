@@ -1,6 +1,7 @@
 //! `move AXIS (--to P | --by D) [--speed V] [--accel A] [--decel D]
-//! [--no-wait] [--json] [--supersede]` (MAM): waits like `home`; exit 0
-//! only when every axis ended at its target.
+//! [--no-wait] [--json]` (MAM; the flags are the engine's
+//! `MoveSpec`, `spec_args.rs`): waits like `home`; exit 0 only when every
+//! axis ended at its target.
 
 use super::{client_error, fail, signal_code, EXIT_FAILED, EXIT_OK};
 use crate::cli::MoveArgs;
@@ -15,16 +16,7 @@ use std::time::Duration;
 const FOLLOW_WALL: Duration = Duration::from_secs(86_400);
 
 pub fn move_axis(client: &mut Client, a: &MoveArgs) -> i32 {
-    let spec = MoveSpec {
-        axes: vec![a.axis.clone()],
-        position: a.to.or(a.by).unwrap_or(f64::NAN),
-        relative: a.to.is_none(),
-        speed: a.speed,
-        accel: a.accel,
-        decel: a.decel,
-        supersede: a.supersede,
-    };
-    let resp = match client.move_axes(&spec) {
+    let resp = match client.operate(std::slice::from_ref(&a.axis), Operation::Move(a.spec.spec)) {
         Ok(r) => r,
         Err(e) => return op_error(a.json, "move", &e),
     };

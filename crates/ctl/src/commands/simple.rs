@@ -4,10 +4,33 @@ use motion_control::*;
 use motion_report::print_json;
 use std::time::Duration;
 
+/// What `stop` / `unhome` / `enable` / `disable` / `reset` send.
+pub enum Simple {
+    /// A control-plane request (`REQ_STOP`, `REQ_UNHOME`).
+    Kind(u32),
+    /// An operation of the engine without parameters.
+    Op(Operation),
+}
+
 /// `stop` / `unhome` / `enable` / `disable` / `reset`: one request, every
 /// axis's answer.
-pub fn axes(client: &mut Client, kind: u32, what: &str, a: &AxesArgs) -> i32 {
-    let resp = match client.simple(kind, 0, &a.axes, Duration::from_secs(3)) {
+pub fn axes(client: &mut Client, what: Simple, a: &AxesArgs) -> i32 {
+    let sent = match what {
+        Simple::Kind(kind) => client.simple(kind, 0, &a.axes, Duration::from_secs(3)),
+        Simple::Op(op) => client.send(
+            &Request::Operate {
+                axes: Axes::from_names(&a.axes),
+                op,
+            },
+            Duration::from_secs(3),
+        ),
+    };
+    let what = match what {
+        Simple::Kind(REQ_STOP) => "stop",
+        Simple::Kind(_) => "unhome",
+        Simple::Op(op) => op.kind().name(),
+    };
+    let resp = match sent {
         Ok(r) => r,
         Err(e) => return client_error(a.json, &e),
     };

@@ -338,26 +338,31 @@ impl Rig {
     }
 }
 
+/// `ns` in seconds (a lease as an operation's spec carries it).
+pub fn secs(ns: u64) -> f64 {
+    ns as f64 * 1e-9
+}
+
 /// A jog at `speed` with acceleration and deceleration 500 and a 500 ms lease.
 pub fn jog(speed: f64) -> Operation {
-    Operation::Jog {
+    Operation::Jog(JogSpec {
         speed,
-        accel: 500.0,
-        decel: 500.0,
-        lease_ns: 500 * MS,
-    }
+        accel: Some(500.0),
+        decel: Some(500.0),
+        lease: Some(secs(500 * MS)),
+    })
 }
 
 /// A move to `target` (axis position) at 20, acceleration and deceleration 500.
 pub fn move_to(target: f64) -> Operation {
-    Operation::Move {
+    Operation::Move(MoveSpec {
         target,
         relative: false,
-        speed: 20.0,
-        accel: 500.0,
-        decel: 500.0,
+        speed: Some(20.0),
+        accel: Some(500.0),
+        decel: Some(500.0),
         supersede: false,
-    }
+    })
 }
 
 /// Largest |second difference| / cycle² of the commanded positions: the

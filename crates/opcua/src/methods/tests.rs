@@ -39,49 +39,35 @@ fn any_variant() -> impl Strategy<Value = Variant> {
     ]
 }
 
-fn check_request(op: &Operation) {
-    let r = op.request();
+fn check_request(call: &Call) {
+    let r = call.request();
     assert!((r.axis_count as usize) <= MAX_AXES);
     assert!(r.timeout_s.is_finite() && (0.0..=MAX_TIMEOUT_S).contains(&r.timeout_s));
     let names = r.axis_names();
-    match op {
-        Operation::Home { axes, .. }
-        | Operation::Stop { axes }
-        | Operation::Unhome { axes }
-        | Operation::Enable { axes }
-        | Operation::Disable { axes }
-        | Operation::Reset { axes } => {
-            assert!(matches!(
-                r.kind,
-                REQ_HOME | REQ_STOP | REQ_UNHOME | REQ_ENABLE | REQ_DISABLE | REQ_RESET
-            ));
+    match call {
+        Call::Home { axes, .. } | Call::Stop { axes } | Call::Unhome { axes } => {
+            assert!(matches!(r.kind, REQ_HOME | REQ_STOP | REQ_UNHOME));
             assert_eq!(&names, axes, "every name carried as given");
         }
-        Operation::Jog {
-            axis,
-            speed,
-            duration_s,
-        } => {
-            assert_eq!(r.kind, REQ_JOG);
+        Call::Operate { axis, op } => {
+            assert_eq!(r.kind, REQ_OPERATE);
             assert_eq!(names, vec![axis.clone()]);
-            assert!(speed.is_finite() && speed.abs() <= MAX_ABS && r.speed == *speed);
-            assert!(*duration_s > 0.0 && *duration_s <= MAX_JOG_S);
-            assert_eq!(r.lease_ms, JOG_LEASE_MS);
-        }
-        Operation::Move {
-            axis,
-            position,
-            speed,
-            ..
-        } => {
-            assert_eq!(r.kind, REQ_MOVE);
-            assert_eq!(names, vec![axis.clone()]);
-            assert!(position.is_finite() && r.position == *position);
-            match speed {
-                Some(v) => assert!(*v > 0.0 && v.is_finite() && r.speed == *v),
-                None => assert!(r.speed.is_nan(), "NaN on the wire: the default"),
+            // What the daemon decodes is the operation decoded here.
+            let Ok(Request::Operate { op: got, .. }) = Request::decode(&r) else {
+                panic!("{op:?} does not decode");
+            };
+            assert_eq!(got, *op);
+            let c = op.carried();
+            for (p, x) in op.kind().params().iter().zip(0..) {
+                if let params::Place::Slot(s) = p.place {
+                    let v = c.values[s];
+                    assert!(v.is_nan() || v.abs() <= MAX_ABS, "{p:?} {x}");
+                }
             }
-            assert!(r.accel.is_nan() && r.decel.is_nan());
+            if let Operation::Jog(j) = op {
+                assert!(j.speed.is_finite() && j.speed.abs() <= MAX_ABS);
+                assert!(j.lease.is_none_or(|l| l > 0.0 && l <= MAX_JOG_S));
+            }
         }
     }
 }
@@ -91,14 +77,14 @@ proptest! {
 
     #[test]
     fn any_arguments_are_decoded_or_refused(
-        m in 0..METHODS.len(),
+        m in 0..methods().len(),
         axis in prop_oneof![Just(None), Just(Some("X")), "[A-Z]{1,3}".prop_map(|s| Some(Box::leak(s.into_boxed_str()) as &str))],
         args in proptest::collection::vec(any_variant(), 0..5),
     ) {
-        let spec = &METHODS[m];
+        let spec = &methods()[m];
         match decode(spec, axis, &args) {
             Ok(op) => {
-                prop_assert_eq!(args.len(), spec.inputs.len());
+                prop_assert!(args.len() <= spec.inputs.len());
                 check_request(&op);
                 if spec.scope == Scope::Axis {
                     let r = op.request();
@@ -146,7 +132,7 @@ fn a_home_call_carries_its_timeout_and_refusals_say_why() {
     let home = spec("Home", Scope::Axis).unwrap();
     assert_eq!(
         decode(home, Some("X"), &[Variant::from(5.0)]),
-        Ok(Operation::Home {
+        Ok(Call::Home {
             axes: vec!["X".into()],
             parallel: false,
             timeout_s: 5.0
@@ -199,80 +185,144 @@ fn a_home_call_carries_its_timeout_and_refusals_say_why() {
 #[test]
 fn operations_decode_with_their_bounds() {
     let jog = spec("Jog", Scope::Axis).unwrap();
+    let names: Vec<&str> = jog.inputs.iter().map(|a| a.name).collect();
+    assert_eq!(names, ["Speed", "Duration", "Accel", "Decel"]);
     assert_eq!(
-        decode(jog, Some("X"), &[Variant::from(-5.0), Variant::from(2.0)]),
-        Ok(Operation::Jog {
+        decode(jog, Some("X"), &[Variant::from(-5.0), Variant::from(0.5)]),
+        Ok(Call::Operate {
             axis: "X".into(),
-            speed: -5.0,
-            duration_s: 2.0
+            op: Operation::Jog(JogSpec {
+                lease: Some(0.5),
+                ..JogSpec::at(-5.0)
+            })
         })
     );
+    // The lease is the caller's to state: hold to run.
+    assert_eq!(
+        decode(jog, Some("X"), &[Variant::from(2.0)]),
+        Err(CallError::Status(StatusCode::BadArgumentsMissing))
+    );
+    assert_eq!(
+        decode(jog, Some("X"), &[Variant::from(2.0), Variant::Empty]),
+        Err(CallError::Args(vec![
+            StatusCode::Good,
+            StatusCode::BadTypeMismatch
+        ]))
+    );
     for (speed, dur, bad) in [
-        (
-            f64::NAN,
-            1.0,
-            vec![StatusCode::BadOutOfRange, StatusCode::Good],
-        ),
-        (
-            1e300,
-            1.0,
-            vec![StatusCode::BadOutOfRange, StatusCode::Good],
-        ),
-        (1.0, 0.0, vec![StatusCode::Good, StatusCode::BadOutOfRange]),
+        (f64::NAN, 1.0, [StatusCode::BadOutOfRange, StatusCode::Good]),
+        (1e300, 1.0, [StatusCode::BadOutOfRange, StatusCode::Good]),
+        (1.0, 0.0, [StatusCode::Good, StatusCode::BadOutOfRange]),
+        // Hold to run: a lease longer than a second is refused.
+        (1.0, 10.0, [StatusCode::Good, StatusCode::BadOutOfRange]),
         (
             1.0,
             MAX_JOG_S + 0.1,
-            vec![StatusCode::Good, StatusCode::BadOutOfRange],
+            [StatusCode::Good, StatusCode::BadOutOfRange],
         ),
         (
             1.0,
             f64::INFINITY,
-            vec![StatusCode::Good, StatusCode::BadOutOfRange],
+            [StatusCode::Good, StatusCode::BadOutOfRange],
         ),
     ] {
         assert_eq!(
             decode(jog, Some("X"), &[Variant::from(speed), Variant::from(dur)]),
-            Err(CallError::Args(bad)),
+            Err(CallError::Args(bad.to_vec())),
             "{speed} {dur}"
         );
     }
+    assert_eq!(
+        decode(jog, Some("X"), &[]),
+        Err(CallError::Status(StatusCode::BadArgumentsMissing))
+    );
     let mv = spec("Move", Scope::Axis).unwrap();
-    let op = decode(
+    let names: Vec<&str> = mv.inputs.iter().map(|a| a.name).collect();
+    assert_eq!(
+        names,
+        ["Target", "Relative", "Speed", "Accel", "Decel", "Supersede"]
+    );
+    let call = decode(
         mv,
         Some("X"),
-        &[Variant::from(12.5), Variant::from(true), Variant::from(0.0)],
+        &[Variant::from(12.5), Variant::from(true), Variant::Empty],
     )
     .unwrap();
     assert_eq!(
-        op,
-        Operation::Move {
+        call,
+        Call::Operate {
             axis: "X".into(),
-            position: 12.5,
-            relative: true,
-            speed: None
+            op: Operation::Move(MoveSpec {
+                relative: true,
+                ..MoveSpec::to(12.5)
+            })
         }
     );
-    let r = op.request();
-    assert_eq!((r.kind, r.flags & FLAG_RELATIVE), (REQ_MOVE, FLAG_RELATIVE));
+    let r = call.request();
+    assert_eq!((r.kind, r.op), (REQ_OPERATE, OpKind::Move as u32));
+    assert!(r.values[1].is_nan(), "Speed null: the default");
     assert_eq!(
         decode(
             mv,
             Some("X"),
-            &[Variant::from(1.0), Variant::from(1i32), Variant::from(-1.0)]
+            &[
+                Variant::from(1.0),
+                Variant::from(false),
+                Variant::from(3.0),
+                Variant::Empty,
+                Variant::from(40.0),
+                Variant::from(true)
+            ]
+        ),
+        Ok(Call::Operate {
+            axis: "X".into(),
+            op: Operation::Move(MoveSpec {
+                speed: Some(3.0),
+                decel: Some(40.0),
+                supersede: true,
+                ..MoveSpec::to(1.0)
+            })
+        })
+    );
+    assert_eq!(
+        decode(
+            mv,
+            Some("X"),
+            &[Variant::from(1.0), Variant::from(1i32), Variant::from("3")]
         ),
         Err(CallError::Args(vec![
             StatusCode::Good,
             StatusCode::BadTypeMismatch,
-            StatusCode::BadOutOfRange
+            StatusCode::BadTypeMismatch
         ]))
     );
-    for (name, kind) in [
-        ("Enable", REQ_ENABLE),
-        ("Disable", REQ_DISABLE),
-        ("Reset", REQ_RESET),
+    for (name, op) in [
+        ("Enable", Operation::Enable),
+        ("Disable", Operation::Disable),
+        ("Reset", Operation::Reset),
     ] {
-        let op = decode(spec(name, Scope::Axis).unwrap(), Some("X"), &[]).unwrap();
-        assert_eq!(op.request().kind, kind, "{name}");
-        assert_eq!(op.request().axis_names(), vec!["X".to_string()]);
+        let call = decode(spec(name, Scope::Axis).unwrap(), Some("X"), &[]).unwrap();
+        assert_eq!(
+            call,
+            Call::Operate {
+                axis: "X".into(),
+                op
+            }
+        );
+        assert_eq!(call.request().axis_names(), vec!["X".to_string()]);
     }
+}
+
+/// Every operation a client may ask for is a method on every axis, with
+/// its spec's parameters as arguments — none written here.
+#[test]
+fn every_client_operation_is_a_method_with_its_spec_s_arguments() {
+    for k in OpKind::ALL.iter().filter(|k| k.client()) {
+        let m = spec(k.title(), Scope::Axis).expect("a method per operation");
+        assert_eq!(m.verb, Verb::Op(*k));
+        let args: Vec<&str> = m.inputs.iter().map(|a| a.name).collect();
+        let titles: Vec<&str> = k.params().iter().map(|p| p.title).collect();
+        assert_eq!(args, titles, "{k:?}");
+    }
+    assert!(spec("StreamStart", Scope::Axis).is_none());
 }

@@ -6,8 +6,9 @@
 
 use super::answer::{outcome, reason};
 use super::ControlThread;
+use super::Unanswered;
 use crate::hub::TraceBuf;
-use crate::shared::{Ack, AxisAck, Control};
+use crate::shared::{Ack, Ask, AxisAck};
 use motion_control::{Axes, AxisOutcome, ControlResponse, Reason, MAX_AXES, RESULT_ACCEPTED};
 
 impl ControlThread {
@@ -26,14 +27,14 @@ impl ControlThread {
             return;
         }
         let timeout_ns = timeout_s.map_or(0, |t| (t * 1e9) as u64);
-        let ack = self.ask(|id| Control::Home {
-            id,
+        let ack = self.ask(Ask::Home {
             mask,
             parallel,
             timeout_ns,
         });
-        let Some(ack) = ack else {
-            return no_answer(r);
+        let ack = match ack {
+            Ok(a) => a,
+            Err(u) => return no_answer(r, u),
         };
         let (all, why) = self.answers(mask, &ack, r);
         self.verdict("home", mask, all, why, r);
@@ -44,8 +45,9 @@ impl ControlThread {
         let Some(mask) = self.axes_of(axes, self.every_axis(), r) else {
             return;
         };
-        let Some(ack) = self.ask(|id| Control::Stop { id, mask }) else {
-            return no_answer(r);
+        let ack = match self.ask(Ask::Stop { mask }) {
+            Ok(a) => a,
+            Err(u) => return no_answer(r, u),
         };
         let (all, why) = self.answers(mask, &ack, r);
         self.verdict("stop", mask, all, why, r);
@@ -57,8 +59,9 @@ impl ControlThread {
         let Some(mask) = self.axes_of(axes, self.every_axis(), r) else {
             return;
         };
-        let Some(ack) = self.ask(|id| Control::Unhome { id, mask }) else {
-            return no_answer(r);
+        let ack = match self.ask(Ask::Unhome { mask }) {
+            Ok(a) => a,
+            Err(u) => return no_answer(r, u),
         };
         let (all, why) = self.answers(mask, &ack, r);
         for i in 0..self.s.machine.axes.len() {
@@ -79,8 +82,9 @@ impl ControlThread {
             return r.bad_request("trace needs exactly one axis");
         }
         let axis = mask.trailing_zeros() as usize;
-        let Some(ack) = self.ask(|id| Control::Trace { id, axis }) else {
-            return no_answer(r);
+        let ack = match self.ask(Ask::Trace { axis }) {
+            Ok(a) => a,
+            Err(u) => return no_answer(r, u),
         };
         self.hub.lock().trace = TraceBuf {
             axis: Some(axis),
@@ -282,8 +286,8 @@ impl ControlThread {
 }
 
 /// The cycle did not answer in time.
-pub(super) fn no_answer(r: &mut ControlResponse) {
-    r.refuse("the real-time cycle did not answer (shutting down or stalled)");
+pub(super) fn no_answer(r: &mut ControlResponse, why: Unanswered) {
+    r.refuse(why.text());
 }
 
 impl ControlThread {

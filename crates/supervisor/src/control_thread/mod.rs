@@ -35,11 +35,10 @@ pub use pages::io_reports;
 use crate::hlog::HlogFile;
 use crate::hub::SharedHub;
 use crate::keeper::Keeper;
-use crate::shared::{Ack, Control, Phase, Shared};
+use crate::shared::{Ack, Ask, Control, Phase, Shared};
 use crate::status_fill;
 use motion_config::MachineConfig;
 use motion_control::{ControlRequest, ControlResponse, Request, Server};
-use motion_homing::Operation;
 use motion_ipc::Domain;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -49,8 +48,39 @@ use std::time::{Duration, Instant};
 
 /// Status frames per second.
 pub const STATUS_HZ: u64 = 100;
-/// How long a request waits for the cycle's answer.
+/// How long a request waits for the cycle to take it: its deadline.
 const ACK_TIMEOUT: Duration = Duration::from_secs(1);
+/// How long an answer is awaited once the cycle has taken the request (it
+/// comes within a cycle of the real-time thread running on; this bounds a
+/// thread that stopped for good).
+const TAKEN_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Why a request has no answer from the cycle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Unanswered {
+    /// The cycle did not take it by its deadline: it never will, nothing
+    /// was applied.
+    NotApplied,
+    /// The cycle took it but has not answered (stopped since): its effect
+    /// is unknown.
+    Unknown,
+}
+
+impl Unanswered {
+    /// What the client is told: true either way.
+    pub(crate) fn text(self) -> &'static str {
+        match self {
+            Unanswered::NotApplied => {
+                "the real-time cycle did not take the request within 1 s (stalled or shutting \
+                 down): nothing was applied"
+            }
+            Unanswered::Unknown => {
+                "the real-time cycle took the request but stopped before answering: see the \
+                 status for its effect"
+            }
+        }
+    }
+}
 
 pub struct ControlSettings {
     pub machine: MachineConfig,
@@ -200,30 +230,68 @@ impl ControlThread {
         }
     }
 
-    /// Sends `c` to the cycle and waits for its answer.
-    fn ask(&mut self, make: impl FnOnce(u32) -> Control) -> Option<Ack> {
+    /// Sends `ask` to the cycle with a deadline [`ACK_TIMEOUT`] from now
+    /// and waits for its answer. Past the deadline the request is given up
+    /// on through the gate: the cycle never applies it after that, and the
+    /// client is told nothing was applied — unless the cycle took it first,
+    /// whose answer is then awaited.
+    fn ask(&mut self, ask: Ask) -> Result<Ack, Unanswered> {
         let id = self.next_id;
         self.next_id = self.next_id.wrapping_add(1).max(1);
-        let c = make(id);
-        let until = Instant::now() + ACK_TIMEOUT;
-        while !self.shared.send(c) {
-            if Instant::now() > until {
-                return None;
-            }
-            std::thread::sleep(Duration::from_millis(1));
-        }
+        let deadline_ns = motion_rt::now_ns().saturating_add(ACK_TIMEOUT.as_nanos() as u64);
+        let c = Control {
+            id,
+            deadline_ns,
+            ask,
+        };
+        self.shared.gate.offer(id);
+        let mut sent = false;
         loop {
-            while let Some(a) = self.shared.acks.pop() {
-                self.acks.push(a);
+            sent = sent || self.shared.send(c);
+            if sent {
+                if let Some(a) = self.ack_of(id) {
+                    return if a.expired {
+                        Err(Unanswered::NotApplied)
+                    } else {
+                        Ok(a)
+                    };
+                }
             }
-            if let Some(p) = self.acks.iter().position(|a| a.id == id) {
-                return Some(self.acks.swap_remove(p));
-            }
-            if Instant::now() > until || self.shared.phase() != Phase::Running {
-                return None;
+            let late = motion_rt::now_ns() > deadline_ns;
+            if late || self.shared.phase() != Phase::Running {
+                if !sent || self.shared.gate.abandon(id) {
+                    return Err(Unanswered::NotApplied);
+                }
+                return self.taken_answer(id);
             }
             std::thread::sleep(Duration::from_millis(1));
         }
+    }
+
+    /// The answer of request `id`, which the cycle has taken: awaited while
+    /// the real-time thread runs, at most [`TAKEN_TIMEOUT`].
+    fn taken_answer(&mut self, id: u32) -> Result<Ack, Unanswered> {
+        let until = Instant::now() + TAKEN_TIMEOUT;
+        while Instant::now() < until && self.shared.phase() == Phase::Running {
+            if let Some(a) = self.ack_of(id) {
+                return if a.expired {
+                    Err(Unanswered::NotApplied)
+                } else {
+                    Ok(a)
+                };
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        Err(Unanswered::Unknown)
+    }
+
+    /// The cycle's answer to request `id`, if it has come.
+    fn ack_of(&mut self, id: u32) -> Option<Ack> {
+        while let Some(a) = self.shared.acks.pop() {
+            self.acks.push(a);
+        }
+        let p = self.acks.iter().position(|a| a.id == id)?;
+        Some(self.acks.swap_remove(p))
     }
 
     /// One request from the control service: decoded here, once.
@@ -249,46 +317,8 @@ impl ControlThread {
             Ok(Request::TraceFetch { axis, offset }) => {
                 self.paged(pages::PageKey::Trace(axis), false, offset, r)
             }
-            Ok(Request::Enable { axes }) => self.operation("enable", &axes, Operation::Enable, r),
-            Ok(Request::Disable { axes }) => {
-                self.operation("disable", &axes, Operation::Disable, r)
-            }
-            Ok(Request::Reset { axes }) => self.operation("reset", &axes, Operation::Reset, r),
-            Ok(Request::Jog {
-                axes,
-                speed,
-                accel,
-                decel,
-                lease_ms,
-            }) => {
-                let op = Operation::Jog {
-                    speed,
-                    accel: accel.unwrap_or(f64::NAN),
-                    decel: decel.unwrap_or(f64::NAN),
-                    lease_ns: u64::from(lease_ms) * 1_000_000,
-                };
-                self.jog(&axes, op, r)
-            }
+            Ok(Request::Operate { axes, op }) => self.operation(&axes, op, r),
             Ok(Request::JogRenew { axes, token, end }) => self.jog_renew(&axes, token, end, r),
-            Ok(Request::Move {
-                axes,
-                position,
-                relative,
-                speed,
-                accel,
-                decel,
-                supersede,
-            }) => {
-                let op = Operation::Move {
-                    target: position,
-                    relative,
-                    speed: speed.unwrap_or(f64::NAN),
-                    accel: accel.unwrap_or(f64::NAN),
-                    decel: decel.unwrap_or(f64::NAN),
-                    supersede,
-                };
-                self.operation("move", &axes, op, r)
-            }
             Ok(Request::StreamAcquire {
                 axes,
                 owner,

@@ -1,15 +1,20 @@
-//! Enable, disable, reset, jog (and its renewals), move, and the setpoint
+//! The operations of the engine (enable, disable, reset, jog and its
+//! renewals, move, and whatever the engine declares next), and the setpoint
 //! stream's acquire and release: the rules the control thread applies to a
 //! typed request before the cycle sees it, one concern per function —
 //! which axes the names mean (a gantry's name for all its sides, a side
-//! named alone refused), one axis or gantry for a jog, a named program for
-//! a stream, the owner token — then the cycle's answer per axis (the
-//! engines' ERR / EXERR), the owners' table and the log line.
+//! named alone refused; none: every axis for an operation that says so),
+//! an operation's axis parameters by name, one axis or gantry for a
+//! hold-to-run one and its token, a named program for a stream, the owner
+//! token — then the cycle's answer per axis (the engines' ERR / EXERR), the
+//! owners' table and the log line. What these rules need of an operation
+//! its kind says (`OpKind::all_by_default`, `OpKind::held`): no operation
+//! is named here.
 
 use super::axes::no_answer;
 use super::owners::Owner;
 use super::ControlThread;
-use crate::shared::Control;
+use crate::shared::Ask;
 use motion_control::stream::{StreamAxis, StreamMap};
 use motion_control::{Axes, ControlResponse};
 use motion_homing::Operation;
@@ -20,18 +25,17 @@ fn token() -> u64 {
 }
 
 impl ControlThread {
-    /// Enable, disable, reset or move the named axes (enable, disable,
-    /// reset: none named is every axis); a gantry whole.
-    pub(super) fn operation(
-        &mut self,
-        what: &str,
-        axes: &Axes,
-        op: Operation,
-        r: &mut ControlResponse,
-    ) {
-        let default = match op {
-            Operation::Move { .. } => 0,
-            _ => self.every_axis(),
+    /// An operation of the named axes (none named: every axis, for the
+    /// operations that say so), a gantry whole; its axis parameters by
+    /// name; a hold-to-run one on one axis or gantry, its answer carrying
+    /// the token that names it.
+    pub(super) fn operation(&mut self, axes: &Axes, mut op: Operation, r: &mut ControlResponse) {
+        let kind = op.kind();
+        let what = kind.name();
+        let default = if kind.all_by_default() {
+            self.every_axis()
+        } else {
+            0
         };
         let Some(mask) = self.axes_of(axes, default, r) else {
             return;
@@ -42,23 +46,20 @@ impl ControlThread {
         if !self.whole_gantries(mask, r) {
             return;
         }
-        self.deliver(what, mask, op, 0, r);
-    }
-
-    /// A hold-to-run jog of one axis or one gantry; the answer carries its
-    /// token.
-    pub(super) fn jog(&mut self, axes: &Axes, op: Operation, r: &mut ControlResponse) {
-        let Some(mask) = self.axes_of(axes, 0, r) else {
-            return;
-        };
-        if !self.whole_gantries(mask, r) {
+        let machine = &self.s.machine;
+        let mut lookup = |n: &str| machine.axis_index(n).and_then(|i| u16::try_from(i).ok());
+        if let Err(e) = op.resolve_axes(&mut lookup) {
+            return r.bad_request(&format!("{what}: {e}"));
+        }
+        if !kind.held() {
+            self.deliver(what, mask, op, 0, r);
             return;
         }
         if !self.one_axis_or_gantry(mask) {
-            return r.bad_request("jog takes one axis or one gantry");
+            return r.bad_request(&format!("{what} takes one axis or one gantry"));
         }
         let t = token();
-        if self.deliver("jog", mask, op, t, r) {
+        if self.deliver(what, mask, op, t, r) {
             r.token = t;
         }
     }
@@ -74,13 +75,9 @@ impl ControlThread {
         let Some(mask) = self.axes_of(axes, 0, r) else {
             return;
         };
-        let Some(ack) = self.ask(|id| Control::JogRenew {
-            id,
-            token,
-            mask,
-            end,
-        }) else {
-            return no_answer(r);
+        let ack = match self.ask(Ask::JogRenew { token, mask, end }) {
+            Ok(a) => a,
+            Err(u) => return no_answer(r, u),
         };
         let running = (0..self.s.machine.axes.len())
             .filter(|&i| ack.axes[i].accepted())
@@ -113,8 +110,9 @@ impl ControlThread {
             return;
         }
         let t = token();
-        let Some(ack) = self.ask(|id| Control::StreamAcquire { id, mask, token: t }) else {
-            return no_answer(r);
+        let ack = match self.ask(Ask::StreamAcquire { mask, token: t }) {
+            Ok(a) => a,
+            Err(u) => return no_answer(r, u),
         };
         let (all, why) = self.answers(mask, &ack, r);
         self.verdict(&format!("stream of {owner}"), mask, all, why, r);
@@ -135,8 +133,9 @@ impl ControlThread {
 
     /// Ends the stream of `token`.
     pub(super) fn stream_release(&mut self, token: u64, r: &mut ControlResponse) {
-        let Some(ack) = self.ask(|id| Control::StreamRelease { id, token }) else {
-            return no_answer(r);
+        let ack = match self.ask(Ask::StreamRelease { token }) {
+            Ok(a) => a,
+            Err(u) => return no_answer(r, u),
         };
         let mask = (0..self.s.machine.axes.len())
             .filter(|&i| ack.axes[i].accepted())
@@ -154,16 +153,15 @@ impl ControlThread {
     pub(super) fn check_owners(&mut self) {
         for o in self.owners.dead() {
             let t = o.token;
-            let released = self.ask(|id| Control::StreamRelease { id, token: t });
+            let released = self.ask(Ask::StreamRelease { token: t });
             self.owners.remove(t);
             log::warn!(
                 "stream owner {} (iceoryx2 node {:x}) is gone: its axes are released and stop{}",
                 o.name,
                 o.node_id,
-                if released.is_some() {
-                    ""
-                } else {
-                    " (the cycle did not answer)"
+                match released {
+                    Ok(_) => "",
+                    Err(u) => u.text(),
                 }
             );
         }
@@ -185,14 +183,12 @@ impl ControlThread {
         token: u64,
         r: &mut ControlResponse,
     ) -> bool {
-        let Some(ack) = self.ask(|id| Control::Op {
-            id,
-            mask,
-            op,
-            token,
-        }) else {
-            no_answer(r);
-            return false;
+        let ack = match self.ask(Ask::Op { mask, op, token }) {
+            Ok(a) => a,
+            Err(u) => {
+                no_answer(r, u);
+                return false;
+            }
         };
         let (all, why) = self.answers(mask, &ack, r);
         self.verdict(what, mask, all, why, r);

@@ -4,7 +4,7 @@
 
 use super::ControlThread;
 use crate::hub::TRACE_MAX;
-use crate::shared::{Control, Snapshot};
+use crate::shared::{Ask, Control, Snapshot};
 use motion_config::MachineConfig;
 
 impl ControlThread {
@@ -46,7 +46,7 @@ impl ControlThread {
                 let id = *next_id;
                 *next_id = next_id.wrapping_add(1).max(1);
                 shared
-                    .send(Control::Restore { id, axis, offset })
+                    .send(Control::undated(id, Ask::Restore { axis, offset }))
                     .then_some(id)
             });
             self.ios.watch(&self.s.machine, snap);

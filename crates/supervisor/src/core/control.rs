@@ -6,62 +6,43 @@
 
 use motion_homing::codes::{ERR_AXIS_FAULTED, ERR_EXECUTION_COLLISION, ERR_ILLEGAL_HOMING_CONFIG};
 
-use super::ops::Then;
-use super::Core;
-use crate::shared::{Ack, AxisAck, Control, Refusal};
-
-/// The axes of `mask` among the first `n`, in index order.
-pub(super) fn named(mask: u64, n: usize) -> impl Iterator<Item = usize> {
-    (0..n.min(64)).filter(move |&i| mask & (1 << i) != 0)
-}
+use super::{named, Core};
+use crate::shared::{Ack, Ask, AxisAck, Control, Refusal};
 
 impl Core {
-    /// Applies one control request; requests with an id are answered (with
-    /// the cycle in which they take effect: the next step) — the operations
-    /// an engine must judge after that step ([`Core::answers`]).
+    /// Applies one control request at `now_ns` (the cycle's time, on the
+    /// clock of its deadline); requests with an id are answered (with the
+    /// cycle in which they take effect: the next step) — the operations an
+    /// engine must judge after that step ([`Core::answers`]). A request
+    /// past its deadline is answered [`Ack::expired`] and has no effect at
+    /// all: whoever asked has been told so.
     pub fn control(&mut self, c: Control, now_ns: u64) -> Option<Ack> {
-        let mut ack = match c {
-            Control::Home {
-                id,
+        let ack = Ack::new(c.id);
+        if now_ns > c.deadline_ns {
+            return Some(Ack {
+                expired: true,
+                cycle: self.cycle,
+                ..ack
+            });
+        }
+        let mut ack = match c.ask {
+            Ask::Home {
                 mask,
                 parallel,
                 timeout_ns,
-            } => self.home(Ack::new(id), mask, parallel, timeout_ns, now_ns),
-            Control::Stop { id, mask } => self.stop(Ack::new(id), mask),
-            Control::Unhome { id, mask } => self.unhome(Ack::new(id), mask),
-            Control::Trace { id, axis } => self.trace(Ack::new(id), axis),
-            Control::Restore { id, axis, offset } => {
-                self.restore(Ack::new(id), axis, offset, now_ns)
-            }
-            Control::Exit => {
+            } => self.home(ack, mask, parallel, timeout_ns, now_ns),
+            Ask::Stop { mask } => self.stop(ack, mask),
+            Ask::Unhome { mask } => self.unhome(ack, mask),
+            Ask::Trace { axis } => self.trace(ack, axis),
+            Ask::Restore { axis, offset } => self.restore(ack, axis, offset, now_ns),
+            Ask::Exit => {
                 self.exit();
                 return None;
             }
-            Control::Op {
-                id,
-                mask,
-                op,
-                token,
-            } => {
-                let then = match op {
-                    motion_homing::Operation::Jog { .. } => Then::Jog(token),
-                    _ => Then::Nothing,
-                };
-                self.op(Ack::new(id), mask, op, then)?
-            }
-            Control::JogRenew {
-                id,
-                token,
-                mask,
-                end,
-            } => self.jog_renew(Ack::new(id), token, mask, end),
-            Control::StreamAcquire { id, mask, token } => self.op(
-                Ack::new(id),
-                mask,
-                motion_homing::Operation::StreamStart,
-                Then::Own(token),
-            )?,
-            Control::StreamRelease { id, token } => self.stream_release(Ack::new(id), token)?,
+            Ask::Op { mask, op, token } => self.op(ack, mask, op, token)?,
+            Ask::JogRenew { token, mask, end } => self.jog_renew(ack, token, mask, end),
+            Ask::StreamAcquire { mask, token } => self.stream_acquire(ack, mask, token)?,
+            Ask::StreamRelease { token } => self.stream_release(ack, token)?,
         };
         ack.cycle = self.cycle + 1;
         Some(ack)

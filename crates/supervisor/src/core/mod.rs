@@ -44,6 +44,11 @@ pub use slot::AxisSlot;
 pub use stream::StreamIntake;
 use trace::Tracer;
 
+/// The axes of `mask` among the first `n`, in index order.
+pub(super) fn named(mask: u64, n: usize) -> impl Iterator<Item = usize> {
+    (0..n.min(64)).filter(move |&i| mask & (1 << i) != 0)
+}
+
 /// What one cycle measured, for the statistics.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct CycleInfo {
@@ -64,9 +69,6 @@ pub struct Core {
     exiting: bool,
     cycle: u64,
     all_mask: u64,
-    /// Per axis, the axis whose configuration and setpoints a request for
-    /// it uses: itself, or its gantry's first side.
-    lead: Vec<usize>,
     /// Per gantry, its sides.
     gantry_mask: Vec<u64>,
     /// Operations delivered this cycle, answered after the step.
@@ -98,6 +100,8 @@ impl Core {
             .iter()
             .map(|g| GantryCoord::new(g, &cfgs, sup.cycle_ns()))
             .collect();
+        // Per axis, the axis whose setpoints move it: itself, or its
+        // gantry's first side.
         let lead: Vec<usize> = (0..m.axes.len())
             .map(|i| {
                 m.gantry_of(i)
@@ -110,7 +114,6 @@ impl Core {
             .collect();
         Self {
             stream: StreamIntake::new(None, &lead),
-            lead,
             gantry_mask,
             pending: [None; MAX_PENDING],
             slots: (m.axes.iter().enumerate())

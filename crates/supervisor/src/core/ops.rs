@@ -15,10 +15,9 @@
 //! another side refused are stopped again in the next cycle (nothing has
 //! moved by more than one cycle's acceleration) and answered "not started".
 
-use motion_homing::{AxisConfig, Operation, Setpoint};
+use motion_homing::{Operation, Setpoint};
 
-use super::control::named;
-use super::Core;
+use super::{named, Core};
 use crate::shared::{Ack, AxisAck, Refusal};
 
 /// Requests waiting for their engines' answers (the control thread asks
@@ -27,7 +26,7 @@ pub(super) const MAX_PENDING: usize = 4;
 
 /// What a request answered after the step does when accepted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Then {
+enum Then {
     /// Nothing more.
     Nothing,
     /// A jog: its token goes with every axis (for the renewals).
@@ -46,46 +45,9 @@ pub(super) struct Pending {
     motion: bool,
 }
 
-/// `op` with the axis's defaults where it carries NaN.
-fn resolve(op: Operation, cfg: &AxisConfig) -> Operation {
-    let or = |x: f64, d: f64| if x.is_nan() { d } else { x };
-    match op {
-        Operation::Jog {
-            speed,
-            accel,
-            decel,
-            lease_ns,
-        } => Operation::Jog {
-            speed,
-            accel: or(accel, cfg.home_acceleration),
-            decel: or(decel, cfg.home_deceleration),
-            lease_ns,
-        },
-        Operation::Move {
-            target,
-            relative,
-            speed,
-            accel,
-            decel,
-            supersede,
-        } => Operation::Move {
-            target,
-            relative,
-            speed: or(speed, cfg.home_speed),
-            accel: or(accel, cfg.home_acceleration),
-            decel: or(decel, cfg.home_deceleration),
-            supersede,
-        },
-        op => op,
-    }
-}
-
 /// Operations that move the axis (or take it over to be moved).
 fn is_motion(op: &Operation) -> bool {
-    matches!(
-        op,
-        Operation::Jog { .. } | Operation::Move { .. } | Operation::StreamStart
-    )
+    op.kind().moves()
 }
 
 impl Core {
@@ -115,9 +77,27 @@ impl Core {
         None
     }
 
+    /// Delivers `op` (as the client gave it: each engine fills what was
+    /// left out from its own configuration) to every engine of `mask` in
+    /// this step; a hold-to-run one is named by `token` for its renewals.
+    pub(super) fn op(&mut self, ack: Ack, mask: u64, op: Operation, token: u64) -> Option<Ack> {
+        let then = if op.kind().held() {
+            Then::Jog(token)
+        } else {
+            Then::Nothing
+        };
+        self.deliver(ack, mask, op, then)
+    }
+
+    /// `token` takes the axes of `mask` over for its setpoint stream: they
+    /// start streaming in this step (all of them, or none).
+    pub(super) fn stream_acquire(&mut self, ack: Ack, mask: u64, token: u64) -> Option<Ack> {
+        self.deliver(ack, mask, Operation::StreamStart, Then::Own(token))
+    }
+
     /// Delivers `op` to every engine of `mask` in this step (all of them, or
     /// none when the cycle refuses one); answered after the step.
-    pub(super) fn op(&mut self, mut ack: Ack, mask: u64, op: Operation, then: Then) -> Option<Ack> {
+    fn deliver(&mut self, mut ack: Ack, mask: u64, op: Operation, then: Then) -> Option<Ack> {
         let n = self.slots.len();
         for i in named(mask, n) {
             if let Some(r) = self.op_refusal(i, &op) {
@@ -145,11 +125,9 @@ impl Core {
             motion: is_motion(&op),
         });
         for i in named(mask, n) {
-            let lead = self.lead[i];
-            let resolved = resolve(op, self.slots[lead].engine.config());
             let slot = &mut self.slots[i];
             slot.op_before = slot.status().op.id;
-            slot.rung.request.op = Some(resolved);
+            slot.rung.request.op = Some(op);
         }
         None
     }
@@ -191,7 +169,7 @@ impl Core {
             return Some(ack);
         }
         self.stream.drop_axes(mask);
-        self.op(ack, mask, Operation::StreamEnd, Then::Nothing)
+        self.deliver(ack, mask, Operation::StreamEnd, Then::Nothing)
     }
 
     /// After the step: every pending request's answer per axis (the

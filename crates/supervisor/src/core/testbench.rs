@@ -3,7 +3,7 @@
 //! IPC (for the core's and the keeper's tests).
 
 use super::*;
-use crate::shared::{Ack, Control};
+use crate::shared::{Ack, Ask, Control};
 use motion_frames::feedback_to_axis;
 use motion_plant::Plant;
 
@@ -48,6 +48,11 @@ impl Bench {
         }
     }
 
+    /// `ask` as request `id`, with no deadline.
+    pub fn ask(&mut self, id: u32, ask: Ask) {
+        self.control(Control::undated(id, ask));
+    }
+
     /// One cycle: the core steps on last cycle's answers, publishes, and
     /// every live I/O process answers (its plants advance one cycle).
     pub fn cycle(&mut self) {
@@ -56,6 +61,8 @@ impl Bench {
             .map(|k| (self.alive[k] && self.seq[k] > 0).then_some(&self.fb[k]))
             .collect();
         self.core.step(now, false, &frames);
+        let acks = &mut self.acks;
+        self.core.answers(|a| acks.push(a));
         let dt = self.m.supervisor.cycle_us as f64 * 1e-6;
         for k in 0..self.cmd.len() {
             self.core.fill(k, &mut self.cmd[k]);
@@ -94,12 +101,14 @@ impl Bench {
     }
 
     pub fn home(&mut self, mask: u64, parallel: bool) -> Ack {
-        self.control(Control::Home {
-            id: 7,
-            mask,
-            parallel,
-            timeout_ns: 0,
-        });
+        self.ask(
+            7,
+            Ask::Home {
+                mask,
+                parallel,
+                timeout_ns: 0,
+            },
+        );
         self.acks.pop().unwrap()
     }
 }

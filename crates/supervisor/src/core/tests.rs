@@ -3,7 +3,8 @@
 //! place (and made to fall silent or restart at will).
 
 use super::*;
-use crate::shared::{AxisAck, Control, Refusal};
+use crate::shared::{Ask, AxisAck, Control, Refusal};
+use motion_homing::{MoveSpec, Operation};
 
 use super::testbench::{Bench, MS};
 
@@ -45,7 +46,7 @@ fn demo_homes_through_frames_in_config_order() {
         );
     }
     // Exit: stop, then disable every drive.
-    b.control(Control::Exit);
+    b.ask(0, Ask::Exit);
     b.run(10);
     assert!(b.core.exit_done());
 }
@@ -140,14 +141,14 @@ fn stop_and_unhome() {
     b.run(5);
     b.home(0b01, false);
     b.run(100);
-    b.control(Control::Stop { id: 1, mask: 0b01 });
+    b.ask(1, Ask::Stop { mask: 0b01 });
     b.run(200);
     let s = b.snap().axes[0].status;
     assert!(s.er && (s.err, s.exerr) == (ERR_SERVO_MESSAGE, EX_TERMINATED_ON_REQUEST));
     b.home(0b10, false);
     b.run(4000);
     assert!(b.snap().axes[1].status.homed);
-    b.control(Control::Unhome { id: 2, mask: 0b10 });
+    b.ask(2, Ask::Unhome { mask: 0b10 });
     assert!(b.acks.pop().unwrap().axes[1].accepted());
     b.run(1);
     assert!(!b.snap().axes[1].status.homed);
@@ -171,7 +172,7 @@ fn a_second_home_request_on_a_homing_axis_is_refused() {
 fn trace_records_one_homing() {
     let mut b = Bench::new(&two_io());
     b.run(5);
-    b.control(Control::Trace { id: 3, axis: 1 });
+    b.ask(3, Ask::Trace { axis: 1 });
     b.home(0b10, false);
     let mut recs = Vec::new();
     for _ in 0..5000 {
@@ -343,4 +344,66 @@ fn a_side_faulting_mid_phase_stops_every_side() {
         "Y1 names the side that failed"
     );
     assert!(!y1.homed && !y2.homed);
+}
+
+/// A move by 2 of axis 0, asked as request `id` with deadline `deadline_ns`.
+fn move_by_2(id: u32, deadline_ns: u64) -> Control {
+    Control {
+        id,
+        deadline_ns,
+        ask: Ask::Op {
+            mask: 0b1,
+            op: Operation::Move(MoveSpec {
+                relative: true,
+                ..MoveSpec::to(2.0)
+            }),
+            token: 0,
+        },
+    }
+}
+
+/// The cycle stalled with a move queued: the control thread gave up on it
+/// at its deadline and told its client nothing was applied. When the
+/// cycle catches up, the move is refused without any effect (a client
+/// retrying `move --by` moves once) — and a move in time is made.
+#[test]
+fn a_request_the_cycle_reaches_after_its_deadline_is_never_applied() {
+    let mut b = Bench::new(&two_io());
+    b.run(5);
+    b.ask(
+        1,
+        Ask::Op {
+            mask: 0b1,
+            op: Operation::Enable,
+            token: 0,
+        },
+    );
+    b.run(1500);
+    let before = b.snap().axes[0];
+    assert!(before.status.servo_action, "{:?}", before.status);
+    b.acks.clear();
+    // Queued 1.3 s ago with a 1 s deadline: the core steps only now.
+    let now = b.k * MS;
+    b.control(move_by_2(2, now - 300 * MS));
+    let ack = b.acks.pop().expect("answered at once");
+    assert!(ack.expired && ack.id == 2, "{ack:?}");
+    assert!(ack.axes.iter().all(|a| *a == AxisAck::NotNamed));
+    b.run(1000);
+    let after = b.snap().axes[0];
+    assert_eq!(
+        after.status.op, before.status.op,
+        "never reached the engine"
+    );
+    assert!(!after.status.moving);
+    assert_eq!(after.cmd_position, before.cmd_position);
+    // The same request within its deadline moves the axis by 2.
+    b.control(move_by_2(3, b.k * MS + 1000 * MS));
+    assert!(b.acks.is_empty(), "an operation is answered after the step");
+    b.cycle();
+    let ack = b.acks.pop().unwrap();
+    assert!(!ack.expired && ack.axes[0].accepted(), "{ack:?}");
+    b.run(1500);
+    let moved = b.snap().axes[0];
+    assert!(moved.status.op.pc, "{:?}", moved.status);
+    assert!((moved.cmd_position - before.cmd_position - 2.0).abs() < 1e-9);
 }

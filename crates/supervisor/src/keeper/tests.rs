@@ -5,7 +5,7 @@
 
 use super::*;
 use crate::core::testbench::Bench;
-use crate::shared::{AxisAck, Control, Refusal};
+use crate::shared::{Ask, AxisAck, Control, Refusal};
 use motion_plant::Plant;
 use motion_state::reference::References;
 use motion_state::{Loaded, RecordKind};
@@ -37,11 +37,7 @@ impl Kb {
         let next = &mut self.next_id;
         self.keeper.observe(&self.b.m, &snap, |axis, offset| {
             *next += 1;
-            sends.push(Control::Restore {
-                id: *next,
-                axis,
-                offset,
-            });
+            sends.push(Control::undated(*next, Ask::Restore { axis, offset }));
             Some(*next)
         });
         for c in sends {

@@ -231,10 +231,15 @@ fn run(
 }
 
 /// Takes every request of the control queue and answers each one (an
-/// operation only after the step its engines judge it in: `answers`).
-/// Bounded: the queue holds at most 256 requests.
+/// operation only after the step its engines judge it in: `answers`); a
+/// request the control thread has given up on is dropped unapplied (it
+/// told its client so: `Shared::admit`). Bounded: the queue holds at most
+/// 256 requests.
 fn control_queue(shared: &Shared, core: &mut Core, sp: &mut SetpointSubscriber, now_ns: u64) {
     while let Some(c) = shared.control.pop() {
+        if !shared.admit(&c) {
+            continue;
+        }
         setpoints::before(sp, &c);
         if let Some(ack) = core.control(c, now_ns) {
             // The answering side drains this queue every few ms; if it

@@ -4,7 +4,7 @@
 //! frame of the very next cycle.
 
 use crate::core::Core;
-use crate::shared::Control;
+use crate::shared::{Ask, Control};
 use motion_ipc::SetpointSubscriber;
 
 /// Drains the setpoint subscriber into the core's intake. Bounded: at most
@@ -20,7 +20,7 @@ pub(super) fn receive(sp: &mut SetpointSubscriber, core: &mut Core) {
 /// publisher now (the one cycle per acquire that makes those system calls),
 /// not inside a later receive.
 pub(super) fn before(sp: &mut SetpointSubscriber, c: &Control) {
-    if matches!(c, Control::StreamAcquire { .. }) {
+    if matches!(c.ask, Ask::StreamAcquire { .. }) {
         let _ = sp.update_connections();
     }
 }

@@ -28,19 +28,18 @@ use super::Code;
 use crate::axis::state::State;
 use crate::axis::Axis;
 use crate::codes::*;
-use crate::operation::{OpKind, StopCause};
+use crate::operation::{Dynamics, OpKind, StopCause};
 use crate::profile::Profile;
 
 impl Axis {
-    /// MAJ.
-    pub(super) fn jog_op(
-        &mut self,
-        now: u64,
-        speed: f64,
-        accel: f64,
-        decel: f64,
-        lease_ns: u64,
-    ) -> Result<(), Code> {
+    /// MAJ: the jog's dynamics (defaults resolved, the speed signed) and
+    /// lease.
+    pub(super) fn jog_op(&mut self, now: u64, d: Dynamics, lease_ns: u64) -> Result<(), Code> {
+        let Dynamics {
+            speed,
+            accel,
+            decel,
+        } = d;
         self.motion_gate()?;
         self.jog_collides()?;
         self.check_dynamics(speed, accel, decel)?;

@@ -66,7 +66,10 @@ pub(in crate::axis) struct Ops {
 
 impl Axis {
     /// Applies `op` (this step's `Request::op`), answering in `Status::op`.
-    pub(super) fn operation(&mut self, now: u64, op: Operation) {
+    /// What the client left out is filled from this axis's configuration
+    /// here, once ([`Operation::resolve`]).
+    pub(super) fn operation(&mut self, now: u64, mut op: Operation) {
+        op.resolve(&self.cfg);
         let result = match op {
             Operation::Enable => self.enable_op(now),
             Operation::Disable => {
@@ -74,30 +77,8 @@ impl Axis {
                 Ok(())
             }
             Operation::Reset => self.reset_op(now),
-            Operation::Jog {
-                speed,
-                accel,
-                decel,
-                lease_ns,
-            } => self.jog_op(now, speed, accel, decel, lease_ns),
-            Operation::Move {
-                target,
-                relative,
-                speed,
-                accel,
-                decel,
-                supersede,
-            } => self.move_op(
-                now,
-                moves::Asked {
-                    target,
-                    relative,
-                    speed,
-                    accel,
-                    decel,
-                    supersede,
-                },
-            ),
+            Operation::Jog(j) => self.jog_op(now, j.dynamics(), j.lease_ns()),
+            Operation::Move(m) => self.move_op(now, &m, m.dynamics()),
             Operation::StreamStart => self.stream_start(now),
             Operation::StreamEnd => {
                 self.stream_end(now);

@@ -20,44 +20,33 @@ use crate::axis::state::State;
 use crate::axis::Axis;
 use crate::codes::*;
 use crate::config::TravelMode;
-use crate::operation::OpKind;
+use crate::operation::{Dynamics, MoveSpec, OpKind};
 use crate::position::nearest_cyclic;
 use crate::profile::Profile;
 
-/// A move as asked (`Operation::Move`).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Asked {
-    pub target: f64,
-    pub relative: bool,
-    pub speed: f64,
-    pub accel: f64,
-    pub decel: f64,
-    pub supersede: bool,
-}
-
 impl Axis {
-    /// MAM.
-    pub(super) fn move_op(&mut self, now: u64, a: Asked) -> Result<(), Code> {
+    /// MAM: the move as asked, and its dynamics (defaults resolved).
+    pub(super) fn move_op(&mut self, now: u64, a: &MoveSpec, d: Dynamics) -> Result<(), Code> {
         self.motion_gate()?;
         self.move_collides(a.supersede)?;
         if !a.target.is_finite() {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NOT_FINITE));
         }
-        self.check_dynamics(a.speed, a.accel, a.decel)?;
+        self.check_dynamics(d.speed, d.accel, d.decel)?;
         let (t, p, v) = self.motion_state(now);
-        let target = self.move_target(&a, p)?;
+        let target = self.move_target(a, p)?;
         self.switch_allows(target - p)?;
-        self.stop_fits(p, v, a.decel)?;
+        self.stop_fits(p, v, d.decel)?;
         let mv = MoveRun {
             target,
-            speed: a.speed,
-            accel: a.accel,
-            decel: a.decel,
-            planned_speed: a.speed,
+            speed: d.speed,
+            accel: d.accel,
+            decel: d.decel,
+            planned_speed: d.speed,
         };
         let op = self.accept_op(OpKind::Move);
         self.profile
-            .set(Profile::move_to(t, p, v, target, a.speed, a.accel, a.decel));
+            .set(Profile::move_to(t, p, v, target, d.speed, d.accel, d.decel));
         self.state = State::Motion(Motion {
             op,
             run: Run::Move(mv),
@@ -68,7 +57,7 @@ impl Axis {
     /// The raw target of a move from command position `p` (raw): refused
     /// 13 / 4 outside the travel limits (when enforced) or beyond
     /// ±`max_position`.
-    fn move_target(&self, a: &Asked, p: f64) -> Result<f64, Code> {
+    fn move_target(&self, a: &MoveSpec, p: f64) -> Result<f64, Code> {
         let outside = Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET));
         let raw = match (a.relative, self.cfg.travel) {
             (true, _) => p + a.target,
