@@ -23,9 +23,11 @@
 //! at their time; `jerk = 0` is the trapezoid, bit for bit; absurd limits
 //! hold, finite inputs never give a NaN.
 
+mod common;
+
+use common::runner;
 use motion_homing::profile::{reaches, stop_displacement, Kinematics, Profile, Ramp};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
 use std::cell::Cell;
 
 /// The limits of one axis.
@@ -348,14 +350,6 @@ fn check_no_reversal(
         t += cycle;
     }
     Ok(())
-}
-
-fn runner(cases: u32) -> TestRunner {
-    TestRunner::new(Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    })
 }
 
 /// Jogs, moves and stops re-planned from each other's sampled state at

@@ -121,41 +121,37 @@ impl Builder {
     /// acceleration is the segment's own, whatever the one before ended
     /// with.
     pub fn push(&mut self, a: f64, dt: f64) {
-        if !keeps(dt) || self.n == MAX_SEGMENTS {
-            return;
+        if self.append(a, 0.0, dt) {
+            self.p += self.v * dt + 0.5 * a * dt * dt;
+            self.v += a * dt;
+            self.a = a;
+            self.t += dt;
         }
-        self.segs[self.n] = Segment {
-            t0: self.t,
-            p0: self.p,
-            v0: self.v,
-            a0: a,
-            j: 0.0,
-        };
-        self.n += 1;
-        self.p += self.v * dt + 0.5 * a * dt * dt;
-        self.v += a * dt;
-        self.a = a;
-        self.t += dt;
     }
 
     /// Appends a constant-jerk segment continuing the current acceleration.
     pub fn push_jerk(&mut self, j: f64, dt: f64) {
+        if self.append(self.a, j, dt) {
+            (self.p, self.v, self.a) = advance(self.p, self.v, self.a, j, dt);
+            self.t += dt;
+        }
+    }
+
+    /// Stores a segment from the current state with acceleration `a0` and
+    /// jerk `j`, unless `dt` is not kept or the list is full (false).
+    fn append(&mut self, a0: f64, j: f64, dt: f64) -> bool {
         if !keeps(dt) || self.n == MAX_SEGMENTS {
-            return;
+            return false;
         }
         self.segs[self.n] = Segment {
             t0: self.t,
             p0: self.p,
             v0: self.v,
-            a0: self.a,
+            a0,
             j,
         };
         self.n += 1;
-        let (p, v, a) = advance(self.p, self.v, self.a, j, dt);
-        self.p = p;
-        self.v = v;
-        self.a = a;
-        self.t += dt;
+        true
     }
 
     pub fn finish(self, start_ns: u64, end: End, v_end: f64) -> Profile {
