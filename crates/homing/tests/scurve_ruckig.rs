@@ -1,7 +1,8 @@
-//! The S-curve move against Ruckig, the reference jerk-limited
+//! The S-curve move and jog against Ruckig, the reference jerk-limited
 //! trajectory generator (its Rust port `rsruckig`, a dev-dependency: the
 //! engine never links it): for random starts, targets and limits, the
-//! durations of both plans to rest on the target.
+//! durations of both plans to rest on the target, and to a jog's velocity
+//! (Ruckig's velocity interface).
 //!
 //! Ruckig is time-optimal, so ours is never shorter (1e-6 relative for
 //! the rounding of our duration to whole ns). Where both are bound alike
@@ -26,15 +27,19 @@
 use motion_homing::profile::{reaches, Kinematics, Profile, Ramp};
 use rsruckig::prelude::*;
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
 
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// Allocations made by this thread (the tests run on threads of their
+    /// own: one does not count the other's).
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        let _ = ALLOCS.try_with(|n| n.set(n.get() + 1));
         unsafe { System.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
@@ -45,12 +50,11 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static A: Counting = Counting;
 
-/// Allocations made by `f` (this test file runs one test: nothing else
-/// allocates meanwhile).
+/// Allocations made by `f`.
 fn allocations<T>(f: impl FnOnce() -> T) -> (T, usize) {
-    let before = ALLOCS.load(Ordering::Relaxed);
+    let before = ALLOCS.with(Cell::get);
     let r = f();
-    (r, ALLOCS.load(Ordering::Relaxed) - before)
+    (r, ALLOCS.with(Cell::get) - before)
 }
 
 /// xorshift64: the cases are the same on every run.
@@ -123,7 +127,23 @@ enum Bounds {
 /// Ruckig's duration, with the speed cap scaled by `relax`, and the
 /// allocations its `calculate` made.
 fn ruckig(otg: &mut Ruckig<1, ThrowErrorHandler>, c: &Case, b: Bounds, relax: f64) -> (f64, usize) {
+    ruckig_to(otg, c, b, relax, None)
+}
+
+/// As [`ruckig`]; with `Some(w)`, Ruckig's velocity interface to
+/// velocity `w` (a jog) instead of the position `c.target`.
+fn ruckig_to(
+    otg: &mut Ruckig<1, ThrowErrorHandler>,
+    c: &Case,
+    b: Bounds,
+    relax: f64,
+    velocity: Option<f64>,
+) -> (f64, usize) {
     let mut input = InputParameter::new(None);
+    if let Some(w) = velocity {
+        input.control_interface = ControlInterface::Velocity;
+        input.target_velocity[0] = w;
+    }
     input.current_position[0] = c.from.p;
     input.current_velocity[0] = c.from.v;
     input.current_acceleration[0] = c.from.a;
@@ -153,41 +173,47 @@ fn ours(c: &Case) -> f64 {
     p.duration_ns() as f64 * 1e-9
 }
 
-/// Duration ratios ours / Ruckig's of one kind of case.
+/// Duration ratios ours / Ruckig's of one kind of case, and how many
+/// were the same duration.
 #[derive(Default)]
 struct Kind {
     ratios: Vec<f64>,
+    same: usize,
 }
 
 impl Kind {
     fn add(&mut self, ours: f64, theirs: f64) {
         self.ratios.push(ours / theirs);
+        self.same += usize::from((ours - theirs).abs() <= theirs * ROUNDING + NS);
     }
 
-    fn report(&mut self, name: &str) -> (f64, f64) {
+    /// Prints the distribution; true if every case was the same.
+    fn report(&mut self, name: &str) -> bool {
         let r = &mut self.ratios;
         r.sort_by(f64::total_cmp);
         let q = |f: f64| r[((r.len() - 1) as f64 * f).round() as usize];
-        let equal = r.iter().filter(|x| (**x - 1.0).abs() <= 1e-6).count();
         eprintln!(
-            "{name:<44} n {:>5}  min {:.6}  median {:.6}  p90 {:.6}  p99 {:.6}  max {:.6}  equal {:>5.1} %",
+            "{name:<52} n {:>5}  min {:.6}  median {:.6}  p90 {:.6}  p99 {:.6}  max {:.6}  same {:>5.1} %",
             r.len(),
             q(0.0),
             q(0.5),
             q(0.9),
             q(0.99),
             q(1.0),
-            100.0 * equal as f64 / r.len() as f64
+            100.0 * self.same as f64 / r.len() as f64
         );
-        (q(0.0), q(1.0))
+        self.same == r.len()
     }
 }
 
-/// A relative tolerance for our duration, rounded up to whole ns.
+/// Tolerances of a comparison: relative, and our duration's rounding up
+/// to whole ns.
 const ROUNDING: f64 = 1e-6;
+const NS: f64 = 2e-9;
 
 #[test]
 fn moves_against_ruckig() {
+    assert_eq!(allocations(|| vec![1u8]).1, 1, "the counter counts");
     let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, 0.001);
     let mut rng = Rng(0x5eed_cafe_f00d_0001);
     let mut kinds: [Kind; 4] = Default::default();
@@ -233,22 +259,22 @@ fn moves_against_ruckig() {
         their_allocs += n_theirs;
         plans += 1;
         assert!(
-            t_ours >= t_theirs * (1.0 - ROUNDING),
+            t_ours >= t_theirs * (1.0 - ROUNDING) - NS,
             "shorter than the optimum: {t_ours} < {t_theirs}: {c:?}"
         );
         kinds[usize::from(!one_way) * 2 + usize::from(acc != dec)].add(t_ours, t_theirs);
     }
     eprintln!("duration ours / Ruckig's, 6000 random moves:");
     let names = [
-        "one way (rest, cruise, any state with room), acc = dec",
+        "one way (rest, cruise, a state with room), acc = dec",
         "one way, acc != dec (Ruckig's signed bounds = ours)",
         "turning back (moving away, overshooting), acc = dec",
         "turning back, acc != dec: Ruckig at ±max(acc, dec)",
     ];
-    let worst: Vec<f64> = kinds
+    let same: Vec<bool> = kinds
         .iter_mut()
         .zip(names)
-        .map(|(k, n)| k.report(n).1)
+        .map(|(k, n)| k.report(n))
         .collect();
     eprintln!(
         "allocations in {plans} plans: ours {our_allocs}, Ruckig's calculate {their_allocs} \
@@ -258,6 +284,70 @@ fn moves_against_ruckig() {
     assert_eq!(our_allocs, 0, "our planning allocates");
     // Time-optimal wherever the constraints are the same as Ruckig's.
     for k in [0, 1, 2] {
-        assert!(worst[k] <= 1.0 + ROUNDING, "{}: {}", names[k], worst[k]);
+        assert!(same[k], "{}: not all the same", names[k]);
+    }
+}
+
+/// The jog (a velocity change and a cruise) against Ruckig's velocity
+/// interface: the time to reach the jog's velocity at zero acceleration,
+/// from states sampled off our plans. The same (1e-6) wherever both are
+/// bound alike: a change that keeps one direction, and one that turns
+/// with `acc = dec`.
+#[test]
+fn jogs_against_ruckig() {
+    let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, 0.001);
+    let mut rng = Rng(0x5eed_cafe_f00d_0002);
+    let mut kinds: [Kind; 4] = Default::default();
+    for i in 0..4000 {
+        let (vmax, acc, dec, jerk) = limits(&mut rng, i % 2 == 0);
+        let ramp = Ramp {
+            accel: acc,
+            decel: dec,
+            jerk,
+        };
+        let from = if i % 4 == 0 {
+            Kinematics::rest(0.0)
+        } else {
+            sampled_state(&mut rng, vmax, ramp)
+        };
+        let w = rng.range(-1.0, 1.0) * vmax;
+        let c = Case {
+            from,
+            target: 0.0,
+            vmax,
+            acc,
+            dec,
+            jerk,
+        };
+        let v_r = from.v + from.a * from.a.abs() / (2.0 * jerk);
+        let one_way = from.v * w >= 0.0 && v_r * w >= 0.0;
+        let bounds = if one_way {
+            Bounds::Along(w.signum())
+        } else {
+            Bounds::Loose
+        };
+        let jog = Profile::jog_from(0, from, w, ramp);
+        let t_ours = jog.duration_ns() as f64 * 1e-9;
+        let (t_theirs, _) = ruckig_to(&mut otg, &c, bounds, 1.0, Some(w));
+        assert!(
+            t_ours >= t_theirs * (1.0 - ROUNDING) - NS,
+            "shorter than the optimum: {t_ours} < {t_theirs}: {c:?} to {w}"
+        );
+        kinds[usize::from(!one_way) * 2 + usize::from(acc != dec)].add(t_ours, t_theirs);
+    }
+    eprintln!("jog: time to its velocity, ours / Ruckig's, 4000 random jogs:");
+    let names = [
+        "one way (rest or any state), acc = dec",
+        "one way, acc != dec (Ruckig's signed bounds = ours)",
+        "turning (against the motion), acc = dec",
+        "turning, acc != dec: Ruckig at ±max(acc, dec)",
+    ];
+    let same: Vec<bool> = kinds
+        .iter_mut()
+        .zip(names)
+        .map(|(k, n)| k.report(n))
+        .collect();
+    for k in [0, 1, 2] {
+        assert!(same[k], "{}: not all the same", names[k]);
     }
 }
