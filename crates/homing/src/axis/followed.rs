@@ -7,13 +7,13 @@
 //! it back — the same numbers, bit for bit. The memory belongs to the
 //! profile: replacing the profile ([`Followed::set`]) forgets it.
 
-use crate::profile::{Kinematics, Profile};
+use crate::profile::Profile;
 
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Followed {
     profile: Profile,
-    /// `(now, state)`: the last sample taken.
-    memo: Option<(u64, Kinematics)>,
+    /// `(now, position, velocity)`: the last sample taken.
+    memo: Option<(u64, f64, f64)>,
 }
 
 impl Followed {
@@ -33,20 +33,12 @@ impl Followed {
     /// Commanded position and velocity at `now`, remembered for `now`.
     #[inline]
     pub fn at(&mut self, now: u64) -> (f64, f64) {
-        let k = self.state_at(now);
-        (k.p, k.v)
-    }
-
-    /// Commanded position, velocity and acceleration at `now` (what a
-    /// jerk-limited re-plan starts from), remembered for `now`.
-    #[inline]
-    pub fn state_at(&mut self, now: u64) -> Kinematics {
         match self.memo {
-            Some((t, k)) if t == now => k,
+            Some((t, p, v)) if t == now => (p, v),
             _ => {
-                let k = self.profile.state(now);
-                self.memo = Some((now, k));
-                k
+                let (p, v) = self.profile.sample(now);
+                self.memo = Some((now, p, v));
+                (p, v)
             }
         }
     }
@@ -55,7 +47,7 @@ impl Followed {
     #[inline]
     pub fn sample(&self, now: u64) -> (f64, f64) {
         match self.memo {
-            Some((t, k)) if t == now => (k.p, k.v),
+            Some((t, p, v)) if t == now => (p, v),
             _ => self.profile.sample(now),
         }
     }
@@ -81,22 +73,5 @@ mod tests {
         f.set(hold);
         assert_eq!(f.sample(250_000_000), (-3.0, 0.0));
         assert_eq!(f.at(250_000_000), (-3.0, 0.0));
-        // The acceleration is remembered with them: a jerk-limited jog
-        // sampled while it ramps up.
-        let scurve = Profile::jog_from(
-            0,
-            Kinematics::rest(0.0),
-            10.0,
-            crate::profile::Ramp {
-                accel: 100.0,
-                decel: 100.0,
-                jerk: 1000.0,
-            },
-        );
-        f.set(scurve);
-        let k = f.state_at(50_000_000);
-        assert_eq!(k, scurve.state(50_000_000));
-        assert!((k.a - 50.0).abs() < 1e-9, "{k:?}");
-        assert_eq!(f.at(50_000_000), (k.p, k.v));
     }
 }

@@ -2,11 +2,13 @@
 //! (plain or in a given time) and a setpoint stream's segment, as
 //! trapezoids or jerk-limited S-curves.
 //!
-//! A profile is planned once, analytically, in the step that asks for it,
-//! as at most ten constant-jerk segments followed by
-//! either a cruise (jog) or an exact hold (stop, move). The engine samples
-//! it at each cycle's time: a bounded scan and one polynomial, no heap, no
-//! panics. Sampling a continuous profile (instead of integrating velocity
+//! A profile is planned once, in the step that asks for it, as at most ten
+//! constant-jerk segments followed by either a cruise (jog) or an exact
+//! hold (stop, move). The engine samples it at each cycle's time: a
+//! bounded scan and one polynomial, no heap, no panics. Planning is
+//! bounded too: closed forms, and for an S-curve's unknown peak speed or
+//! deceleration at most four root searches of at most 64 evaluations each
+//! (the bench's `profile/*` measures both). Sampling a continuous profile (instead of integrating velocity
 //! cycle by cycle) is what gives the guarantees the tests check
 //! (`tests/properties.rs`, `tests/scurve_properties.rs`):
 //!

@@ -205,7 +205,9 @@ impl Profile {
     }
 
     /// Commanded position, velocity and acceleration at `now_ns`: the
-    /// state a re-plan at `now_ns` starts from.
+    /// state a re-plan at `now_ns` starts from. (Inlined: a caller of
+    /// [`Profile::sample`] does not compute the acceleration.)
+    #[inline]
     pub fn state(&self, now_ns: u64) -> Kinematics {
         let t = self.t(now_ns);
         if t >= self.t_end {
