@@ -198,24 +198,30 @@ impl Profile {
     }
 
     /// Commanded position and velocity at `now_ns`.
-    #[inline]
     pub fn sample(&self, now_ns: u64) -> (f64, f64) {
-        let k = self.state(now_ns);
-        (k.p, k.v)
+        let (p, v, _) = self.eval(now_ns);
+        (p, v)
     }
 
     /// Commanded position, velocity and acceleration at `now_ns`: the
-    /// state a re-plan at `now_ns` starts from. (Inlined: a caller of
-    /// [`Profile::sample`] does not compute the acceleration.)
-    #[inline]
+    /// state a re-plan at `now_ns` starts from.
     pub fn state(&self, now_ns: u64) -> Kinematics {
+        let (p, v, a) = self.eval(now_ns);
+        Kinematics { p, v, a }
+    }
+
+    /// Both of the above (inlined into each: the cycle's
+    /// [`Profile::sample`] returns in registers and skips the
+    /// acceleration).
+    #[inline(always)]
+    fn eval(&self, now_ns: u64) -> (f64, f64, f64) {
         let t = self.t(now_ns);
         if t >= self.t_end {
             return match self.end {
-                End::Hold(p) => Kinematics::rest(p),
+                End::Hold(p) => (p, 0.0, 0.0),
                 End::Cruise => {
                     let dt = t - self.t_end;
-                    Kinematics::moving(self.p_end + self.v_end * dt, self.v_end)
+                    (self.p_end + self.v_end * dt, self.v_end, 0.0)
                 }
             };
         }
@@ -227,14 +233,13 @@ impl Profile {
         let tau = t - s.t0;
         if s.j == 0.0 {
             // A trapezoid's segment, as it was always sampled.
-            return Kinematics {
-                p: s.p0 + s.v0 * tau + 0.5 * s.a0 * tau * tau,
-                v: s.v0 + s.a0 * tau,
-                a: s.a0,
-            };
+            return (
+                s.p0 + s.v0 * tau + 0.5 * s.a0 * tau * tau,
+                s.v0 + s.a0 * tau,
+                s.a0,
+            );
         }
-        let (p, v, a) = advance(s.p0, s.v0, s.a0, s.j, tau);
-        Kinematics { p, v, a }
+        advance(s.p0, s.v0, s.a0, s.j, tau)
     }
 
     /// Every number of the plan is finite: what the S-curve planners check
