@@ -357,7 +357,7 @@ fn check_no_reversal(
 #[test]
 fn chains_of_replans_keep_every_bound() {
     let samples = Cell::new(0usize);
-    runner(400)
+    runner(1000)
         .run(&chain(), |c| {
             let xs = run_chain(&c).map_err(|e| TestCaseError::fail(format!("{e}\n{c:?}")))?;
             samples.set(samples.get() + xs.len());
