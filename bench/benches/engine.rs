@@ -3,12 +3,18 @@
 //! 32 and 64 axes. Goals: ≤ 50 ns per axis step, ≤ 10 µs for a 64-axis
 //! cycle. A summary table against the goals is printed at the end.
 //!
+//! `profile/*`: what a jog or move costs the cycle, trapezoid against
+//! S-curve — planning one (the step that asks for it: a move from a moving
+//! state; a move that must turn back, which plans two ways and keeps the
+//! faster; a stop that must end on a travel limit) and sampling one (every
+//! step: the state at an instant in its last segment, the longest scan).
+//!
 //! A step is measured on fresh copies of the captured axis, a cycle's
 //! worth (64) per timed batch, so the axis's state is in the cache as in
 //! the cycle; `engine_step/seek_cold` streams its copies from memory
 //! instead (criterion's growing `SmallInput` batches), which is what the
 //! step measurements before issue 14 did: that figure is bounded by the
-//! size of `Axis` over the memory bandwidth (≈ 1.2 KB per step).
+//! size of `Axis` over the memory bandwidth (≈ 1.7 KB per step).
 //!
 //! `cargo bench -p motion-bench --bench engine` (≈ 20 s of measuring).
 //!
@@ -26,12 +32,14 @@
 //! The total it prints (`Collected`) divided by N (and by the axis count for
 //! a cycle) is the cost of one step; `callgrind_annotate engine.cg` shows
 //! where it goes. IDs: `engine_step/seek`, `engine_step/torque_detect`,
-//! `cycle/1`, `cycle/8`, `cycle/32`, `cycle/64`.
+//! `cycle/1`, `cycle/8`, `cycle/32`, `cycle/64`, and `profile/*` (e.g.
+//! `profile/plan_scurve`).
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use motion_harness::engine::{
     homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
+use motion_homing::profile::{Kinematics, Profile, Ramp};
 use motion_homing::{Axis, Phase};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -62,7 +70,7 @@ fn check(name: &str, c: &Captured, phase: Phase) {
 
 /// Axes a cycle steps at most: the fresh copies of one timed batch of
 /// `engine_step/*`, so that they sit in the cache as a cycle's axes do
-/// (64 × `size_of::<Axis>()` ≈ 78 KB: in L2, between cycles too).
+/// (64 × `size_of::<Axis>()` ≈ 110 KB: in L2, between cycles too).
 const CYCLE_AXES: u64 = 64;
 
 fn engine_step(c: &mut Criterion) {
@@ -100,6 +108,86 @@ fn engine_step(c: &mut Criterion) {
                 b.iter_batched_ref(|| state.axis.clone(), step, BatchSize::SmallInput)
             });
         }
+    }
+    g.finish();
+}
+
+/// The moves of `profile/*`: 50 units at 100 u/s, acceleration 2000,
+/// deceleration 1500 u/s², and for the S-curve a jerk of 40 000 u/s³.
+fn ramp(jerk: f64) -> Ramp {
+    Ramp {
+        accel: 2000.0,
+        decel: 1500.0,
+        jerk,
+    }
+}
+
+/// A jog's state 30 ms after it started from rest towards 80 u/s: moving,
+/// accelerating (what a supersede re-plans from).
+fn moving(jerk: f64) -> (u64, Kinematics) {
+    let jog = Profile::jog_from(0, Kinematics::rest(0.0), 80.0, ramp(jerk));
+    (30_000_000, jog.state(30_000_000))
+}
+
+/// The routines of `profile/*`, by name (also run by `--instructions`).
+fn profile_routines() -> Vec<(String, Box<dyn FnMut()>)> {
+    let mut all: Vec<(String, Box<dyn FnMut()>)> = Vec::new();
+    for (kind, jerk) in [("trapezoid", 0.0), ("scurve", 4e4)] {
+        let (now, from) = moving(jerk);
+        all.push((
+            format!("profile/plan_{kind}"),
+            Box::new(move || {
+                black_box(Profile::move_from(
+                    black_box(now),
+                    black_box(from),
+                    50.0,
+                    100.0,
+                    ramp(jerk),
+                ));
+            }),
+        ));
+        // Moving at +80 towards -1: it must turn back.
+        all.push((
+            format!("profile/plan_turn_{kind}"),
+            Box::new(move || {
+                black_box(Profile::move_from(
+                    black_box(now),
+                    black_box(from),
+                    -1.0,
+                    100.0,
+                    ramp(jerk),
+                ));
+            }),
+        ));
+        // A stop on a limit 1 ahead: harder than its deceleration.
+        all.push((
+            format!("profile/stop_at_{kind}"),
+            Box::new(move || {
+                black_box(Profile::stop_at_from(
+                    black_box(now),
+                    black_box(from),
+                    from.p + 1.0,
+                    jerk,
+                ));
+            }),
+        ));
+        let mv = Profile::move_from(now, from, 50.0, 100.0, ramp(jerk));
+        let last = now + mv.duration_ns() - 1_000_000;
+        all.push((
+            format!("profile/sample_{kind}"),
+            Box::new(move || {
+                black_box(black_box(&mv).state(black_box(last)));
+            }),
+        ));
+    }
+    all
+}
+
+fn profile(c: &mut Criterion) {
+    let mut g = c.benchmark_group("profile");
+    for (name, mut routine) in profile_routines() {
+        let id = name.strip_prefix("profile/").unwrap_or(&name).to_string();
+        g.bench_function(id, |b| b.iter(&mut routine));
     }
     g.finish();
 }
@@ -184,6 +272,11 @@ fn summary(dir: &Path, since: SystemTime) {
         ("engine_step/torque_detect".into(), 1, Some(50.0)),
         ("engine_step/seek_cold".into(), 1, None),
     ];
+    for what in ["plan", "plan_turn", "stop_at", "sample"] {
+        for kind in ["trapezoid", "scurve"] {
+            rows.push((format!("profile/{what}_{kind}"), 1, None));
+        }
+    }
     for n in AXES {
         rows.push((format!("cycle/{n}"), n, (n == 64).then_some(10_000.0)));
     }
@@ -213,6 +306,10 @@ fn summary(dir: &Path, since: SystemTime) {
     println!(
         "engine_step/* = one Axis::step on a copy in the cache (64 copies per batch, as a cycle's axes); \
          seek_cold: copies streamed from memory"
+    );
+    println!(
+        "profile/* = planning a move (from a moving state; turning back; a stop on a limit) and sampling one, \
+         trapezoid against S-curve"
     );
     println!(
         "cycle/N = Core::step + Core::fill for N homing axes (engine steps + counts↔units for every axis)"
@@ -248,9 +345,17 @@ mod instructions {
                 }
             });
         };
+        let mut profiles = profile_routines();
         match id {
             "engine_step/seek" => step(seek_state(), Phase::Seek),
             "engine_step/torque_detect" => step(torque_state(), Phase::Seek),
+            _ if id.starts_with("profile/") => {
+                let (_, routine) = profiles
+                    .iter_mut()
+                    .find(|(name, _)| name == id)
+                    .expect("ID: a profile/* benchmark");
+                counted(n, routine.as_mut());
+            }
             _ => {
                 let k = id
                     .strip_prefix("cycle/")
@@ -288,6 +393,7 @@ fn main() {
         .output_directory(&dir)
         .configure_from_args();
     engine_step(&mut c);
+    profile(&mut c);
     cycle(&mut c);
     c.final_summary();
     if !args.iter().any(|a| a == "--list" || a == "--test") {

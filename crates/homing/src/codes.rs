@@ -36,7 +36,7 @@
 //! | 41   | 33    | *ours* absolute home mode on a non-absolute feedback device |
 //! | 41   | 34    | *ours* a homing speed the sequence commands is above `max_speed` |
 //! | 41   | 35    | *ours* limit-switch sequence with a unidirectional direction (the axis must come back off the limit) |
-//! | 41   | 36    | *ours* limit-switch sequence whose `home_offset` does not end the axis off the switch: it must point away from the limit, into the travel, by more than one cycle of travel at Home Return Speed |
+//! | 41   | 36    | *ours* limit-switch sequence whose `home_offset` does not end the axis off the switch: `limit_switch`'s must point away from the limit, into the travel, by more than one cycle of travel at Home Return Speed; `limit_switch_then_marker`'s (which rests on its marker, beyond the clear point) must be 0 or point away from the limit |
 //! | 41   | 37    | *ours* `home_reverse_at_limit` on a sequence that cannot reverse (only active bidirectional switch and switch then marker can; a unidirectional search is refused here, not failed at the limit) |
 //! | 41   | 38    | *ours* limit-switch sequence or `home_reverse_at_limit` on an axis without limit switches (`limit_switches = false`, or a cyclic axis, which has no ends) |
 //! | 1014 | 0     | homing interrupted externally: the wrapper's code, kept for tools that map it; this engine reports every interruption it sees more precisely (a stop request or the supervisor shutting down: 12/1, a shutdown: 12/12, lost feedback: 12/40) |

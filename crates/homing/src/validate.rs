@@ -340,18 +340,38 @@ fn reverses(cfg: &AxisConfig) -> bool {
 }
 
 /// A limit-switch home must not park the axis on the switch: Home Position
-/// is the event (the clear point, or the marker beyond it) plus the offset,
-/// so the offset must point away from the limit, into the travel, by more
-/// than one cycle of travel at Home Return Speed — twice the worst error of
-/// a sampled clear point, so Home Position is off the switch however the
-/// edge was sampled. (The marker of `limit_switch_then_marker` lies beyond
-/// the clear point, which only adds distance.) The switch's repeatability
-/// and hysteresis are the machine's: the README asks for an offset that
-/// covers them too.
+/// is the event plus the offset.
+///
+/// * `limit_switch`: the event is the clear point, the switch's very edge,
+///   so the offset must point away from the limit, into the travel, by
+///   more than one cycle of travel at Home Return Speed — twice the worst
+///   error of a sampled clear point, so Home Position is off the switch
+///   however the edge was sampled.
+/// * `limit_switch_then_marker` (CiA 402 methods 1 and 2, commonly used
+///   with no offset): the event is the first marker found once the switch
+///   has cleared, beyond its clear point, so a zero offset rests on the
+///   marker, off the switch, and an offset into the travel only adds
+///   distance. An offset towards the limit is refused: how far the marker
+///   lies from the switch is the machine's, not the configuration's. (A
+///   marker within the clear point's own sampling error of it is an
+///   ambiguous marker: `marker_min_distance` flags or refuses it.)
+///
+/// The switch's repeatability and hysteresis are the machine's: the README
+/// asks for an offset that covers them too.
 fn limit_offset(p: &mut Problems, cfg: &AxisConfig) {
     let dir = cfg.home_direction.sign();
-    let margin = cfg.home_return_speed * cfg.cycle_ns as f64 * 1e-9;
-    if cfg.home_offset * dir < -margin {
+    let on_marker = cfg.home_sequence == HomeSequence::LimitSwitchThenMarker;
+    let margin = if on_marker {
+        0.0
+    } else {
+        cfg.home_return_speed * cfg.cycle_ns as f64 * 1e-9
+    };
+    let off = if on_marker {
+        cfg.home_offset * dir <= 0.0
+    } else {
+        cfg.home_offset * dir < -margin
+    };
+    if off {
         return;
     }
     let (limit, sign) = if dir > 0.0 {
@@ -359,14 +379,23 @@ fn limit_offset(p: &mut Problems, cfg: &AxisConfig) {
     } else {
         ("negative", "positive")
     };
+    let must = if on_marker {
+        format!(
+            "limit_switch_then_marker rests on its marker, beyond the switch's clear point: the \
+             offset must be 0 or {sign} (away from the limit, into the travel)"
+        )
+    } else {
+        format!(
+            "the offset must be {sign} (away from the limit, into the travel) by more than \
+             {margin} units, one cycle of travel at home_return_speed; choose a distance that \
+             also covers the switch's repeatability"
+        )
+    };
     p.add(
         "home_offset",
         EX_LIMIT_OFFSET,
         format!(
-            "{} would leave the axis at (or on) the {limit} limit switch it homes on: \
-             the offset must be {sign} (away from the limit, into the travel) by more than \
-             {margin} units, one cycle of travel at home_return_speed; choose a distance that \
-             also covers the switch's repeatability",
+            "{} would leave the axis at (or on) the {limit} limit switch it homes on: {must}",
             cfg.home_offset
         ),
     );

@@ -5,7 +5,8 @@
 //!
 //! * homing succeeds from any start position inside the travel: the
 //!   limit-switch sequences, and the switch sequences with
-//!   `home_reverse_at_limit`, end homed at Home Position, off both limits;
+//!   `home_reverse_at_limit`, end homed at Home Position, off both limits
+//!   (`limit_switch_then_marker` also with no offset: on its marker);
 //! * the event never differs from the reference by more than ½·R·T for a
 //!   sampled edge (R the return speed, T the cycle) and by nothing for a
 //!   latched one (marker, registration: the plant latches the exact
@@ -151,9 +152,16 @@ impl Layout {
             home_direction: self.direction(),
             home_sequence: self.sequence,
             home_reverse_at_limit: !limit,
-            // Into the travel for a limit, by more than a cycle of travel at
-            // R (validation's margin); either way for the switch.
-            home_offset: if limit || self.start_at < 0.5 {
+            // Two fifths of the limit-then-marker homes rest on the marker
+            // itself (CiA 402 methods 1 and 2 as commonly used); else into
+            // the travel for a limit, by more than a cycle of travel at R
+            // (validation's margin for a limit's edge); either way for the
+            // switch.
+            home_offset: if self.sequence == HomeSequence::LimitSwitchThenMarker
+                && self.offset < 2.0
+            {
+                0.0
+            } else if limit || self.start_at < 0.5 {
                 -s * (self.offset + self.return_speed * self.cycle)
             } else {
                 s * self.offset
@@ -214,7 +222,7 @@ impl Layout {
 #[test]
 fn homing_succeeds_from_any_start_and_the_event_is_within_its_bound() {
     let worst = RefCell::new((0.0f64, String::new()));
-    let cases = Cell::new([0usize; 2]);
+    let cases = Cell::new([0usize; 3]);
     TestRunner::new(Config {
         cases: 192,
         failure_persistence: None,
@@ -262,6 +270,7 @@ fn homing_succeeds_from_any_start_and_the_event_is_within_its_bound() {
         prop_assert!(m.lo < o.final_raw && o.final_raw < m.hi, "rests on a limit");
         let mut n = cases.get();
         n[usize::from(st.reversed_at_limit)] += 1;
+        n[2] += usize::from(m.sequence.uses_limit_switch() && cfg.home_offset == 0.0);
         cases.set(n);
         Ok(())
     })
@@ -270,11 +279,13 @@ fn homing_succeeds_from_any_start_and_the_event_is_within_its_bound() {
     let n = cases.get();
     println!(
         "limit switches: worst sampled event error {frac:.3} x R x T (bound 0.5); \
-         {} runs without and {} with a reversal at a limit; case {case}",
-        n[0], n[1]
+         {} runs without and {} with a reversal at a limit, {} on a limit's marker with no \
+         offset; case {case}",
+        n[0], n[1], n[2]
     );
     assert!(
-        n[1] > 0,
-        "no case reversed: the layouts miss what they test"
+        n[1] > 0 && n[2] > 0,
+        "no case reversed, or none homed on a limit's marker with no offset: the layouts miss \
+         what they test"
     );
 }

@@ -431,6 +431,61 @@ fn refused_configurations() {
     assert!(validate(&cfg(&|c| c.home_offset = 0.0021)).is_empty());
 }
 
+/// `limit_switch_then_marker` with no offset — CiA 402 methods 1 and 2 as
+/// they are commonly used: accepted, and the axis rests on the marker it
+/// found once the switch had cleared, off the switch, from every start;
+/// also with the marker 0.1 from the switch's edge (markers at ±89.9). An
+/// offset towards the limit is still refused, and so is a plain
+/// `limit_switch` home with no offset (`refused_configurations`): that one
+/// would rest on the switch's edge.
+#[test]
+fn then_marker_with_no_offset_rests_on_the_marker_off_the_switch() {
+    let mut rows = Vec::new();
+    for dir in [BidirectionalForward, BidirectionalReverse] {
+        let s = dir.sign();
+        let cfg = AxisConfig {
+            home_offset: 0.0,
+            ..axis(LimitSwitchThenMarker, dir)
+        };
+        assert!(validate(&cfg).is_empty(), "{:?}", validate(&cfg));
+        for start in [-50.0, 2.0, 50.0, 95.0 * s] {
+            rows.push(row(
+                format!("then marker {dir} offset 0 from {start}"),
+                cfg,
+                plant(start),
+                reference(LimitSwitchThenMarker, dir),
+            ));
+            let close = 89.9 * s;
+            rows.push(row(
+                format!("then marker {dir} offset 0 from {start}, marker 0.1 off the edge"),
+                cfg,
+                PlantConfig {
+                    marker_at: close,
+                    ..plant(start)
+                },
+                Want::Homed {
+                    event: close,
+                    tol: EXACT,
+                },
+            ));
+        }
+        let toward = AxisConfig {
+            home_offset: 0.001 * s,
+            ..cfg
+        };
+        rows.push(row(
+            format!("then marker {dir} offset 0.001 towards the limit"),
+            toward,
+            plant(0.0),
+            Want::Fails {
+                err: ERR_ILLEGAL_HOMING_CONFIG,
+                exerr: EX_LIMIT_OFFSET,
+            },
+        ));
+    }
+    verify_all(&rows);
+}
+
 #[test]
 fn the_checker_can_fail() {
     let mut r = row(

@@ -13,12 +13,11 @@
 
 mod common;
 
-use common::{run, run_with, Outcome};
+use common::{run, run_with, runner, Outcome};
 use motion_homing::codes::*;
 use motion_homing::*;
 use motion_plant::PlantConfig;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
 use std::sync::Mutex;
 
 #[derive(Clone, Debug)]
@@ -228,14 +227,6 @@ fn check_limits(o: &Outcome, cycle: f64, vmax: f64, acc: f64, dec: f64) -> Resul
         }
     }
     Ok(())
-}
-
-fn runner(cases: u32) -> TestRunner {
-    TestRunner::new(Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    })
 }
 
 #[test]

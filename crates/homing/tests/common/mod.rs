@@ -379,3 +379,13 @@ pub fn max_speed(cmds: &[Command], cycle_s: f64) -> f64 {
         .map(|w| (w[1].position - w[0].position).abs() / cycle_s)
         .fold(0.0, f64::max)
 }
+
+/// A property runner of `cases` cases, without failure files: a failing
+/// case is printed whole, to be turned into a test of its own.
+pub fn runner(cases: u32) -> proptest::test_runner::TestRunner {
+    proptest::test_runner::TestRunner::new(proptest::test_runner::Config {
+        cases,
+        failure_persistence: None,
+        ..proptest::test_runner::Config::default()
+    })
+}

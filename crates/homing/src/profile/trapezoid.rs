@@ -1,129 +1,20 @@
-//! Motion profiles of the homing legs: jog to a speed, stop, and a
-//! point-to-point trapezoid from any starting velocity.
+//! The trapezoid (no jerk limit): jog to a speed, stop, stop on a point,
+//! a setpoint stream's segment, and the point-to-point move from any
+//! starting velocity, plain and in a given time. At most four constant
+//! acceleration segments; the acceleration steps between them.
 //!
-//! A profile is planned once, analytically, as at most four constant
-//! acceleration segments followed by either a cruise (jog) or an exact hold
-//! (stop, move). The engine samples it at each cycle's time. Sampling a
-//! continuous profile (instead of integrating velocity cycle by cycle) is what
-//! gives the guarantees the tests check:
-//!
-//! * the speed between two samples is an average of the continuous speed, so
-//!   it never exceeds the configured maximum;
-//! * the second difference of the samples is a weighted average of the
-//!   continuous acceleration, so it stays within `[-deceleration, +acceleration]`
-//!   (in the direction of motion), also across a re-plan because every re-plan
-//!   starts from the exact sampled state;
-//! * a move returns its target bit-exactly once its duration has elapsed: no
-//!   residual creep, no overshoot.
+//! These are the profiles of homing's legs, of a fault's stop and of every
+//! operation planned with `jerk = 0`: their numbers are the ones the engine
+//! had before jerk-limited profiles existed, bit for bit. A trapezoid
+//! re-planned from a moving state starts from its position and velocity;
+//! the acceleration of the state it replaces does not carry over.
 //!
 //! Acceleration is used while speed magnitude grows, deceleration while it
 //! shrinks, which is how Home Acceleration and Home Deceleration are defined.
 
-const MAX_SEGMENTS: usize = 4;
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Segment {
-    /// Time from the profile's start at which the segment begins, s.
-    t0: f64,
-    /// State at the beginning of the segment.
-    p0: f64,
-    v0: f64,
-    /// Constant acceleration over the segment, units/s².
-    a: f64,
-    /// Duration, s.
-    dt: f64,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum End {
-    /// After the segments, stay exactly here.
-    Hold(f64),
-    /// After the segments, keep the final velocity forever (a jog).
-    Cruise,
-}
-
-/// A planned motion. `Copy`, fixed size, no heap.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Profile {
-    start_ns: u64,
-    segs: [Segment; MAX_SEGMENTS],
-    n: usize,
-    /// State at the end of the last segment.
-    p_end: f64,
-    v_end: f64,
-    t_end: f64,
-    end: End,
-}
-
-/// Builds the segment list while tracking the state at its end.
-struct Builder {
-    segs: [Segment; MAX_SEGMENTS],
-    n: usize,
-    t: f64,
-    p: f64,
-    v: f64,
-}
-
-impl Builder {
-    fn new(p: f64, v: f64) -> Self {
-        let zero = Segment {
-            t0: 0.0,
-            p0: p,
-            v0: v,
-            a: 0.0,
-            dt: 0.0,
-        };
-        Self {
-            segs: [zero; MAX_SEGMENTS],
-            n: 0,
-            t: 0.0,
-            p,
-            v,
-        }
-    }
-
-    /// Appends a constant-acceleration segment. Non-positive or non-finite
-    /// durations are dropped: they are rounding leftovers of a zero-length phase.
-    fn push(&mut self, a: f64, dt: f64) {
-        if dt.is_nan() || dt <= 0.0 || !dt.is_finite() || self.n == MAX_SEGMENTS {
-            return;
-        }
-        self.segs[self.n] = Segment {
-            t0: self.t,
-            p0: self.p,
-            v0: self.v,
-            a,
-            dt,
-        };
-        self.n += 1;
-        self.p += self.v * dt + 0.5 * a * dt * dt;
-        self.v += a * dt;
-        self.t += dt;
-    }
-
-    fn finish(self, start_ns: u64, end: End, v_end: f64) -> Profile {
-        let p_end = match end {
-            End::Hold(p) => p,
-            End::Cruise => self.p,
-        };
-        Profile {
-            start_ns,
-            segs: self.segs,
-            n: self.n,
-            p_end,
-            v_end,
-            t_end: self.t,
-            end,
-        }
-    }
-}
+use super::segments::{Builder, End, Profile};
 
 impl Profile {
-    /// Stand still at `p`.
-    pub fn hold(now_ns: u64, p: f64) -> Self {
-        Builder::new(p, 0.0).finish(now_ns, End::Hold(p), 0.0)
-    }
-
     /// Change velocity from `v0` to `v_target` (accelerating at `acc` while the
     /// speed grows, decelerating at `dec` while it shrinks, through zero if the
     /// sign changes), then cruise at `v_target` forever.
@@ -268,47 +159,6 @@ impl Profile {
         // the last bit).
         p.t_end = t;
         p
-    }
-
-    /// Time until a stop or move is done, rounded up to whole ns (0 for a
-    /// hold; a jog is never done and reports its acceleration time).
-    pub fn duration_ns(&self) -> u64 {
-        (self.t_end * 1e9).ceil().min(u64::MAX as f64) as u64
-    }
-
-    fn t(&self, now_ns: u64) -> f64 {
-        crate::time::ns_to_s(now_ns.saturating_sub(self.start_ns))
-    }
-
-    /// Commanded position and velocity at `now_ns`.
-    pub fn sample(&self, now_ns: u64) -> (f64, f64) {
-        let t = self.t(now_ns);
-        if t >= self.t_end {
-            return match self.end {
-                End::Hold(p) => (p, 0.0),
-                End::Cruise => {
-                    let dt = t - self.t_end;
-                    (self.p_end + self.v_end * dt, self.v_end)
-                }
-            };
-        }
-        let mut i = 0;
-        while i + 1 < self.n && t >= self.segs[i + 1].t0 {
-            i += 1;
-        }
-        let s = &self.segs[i];
-        let tau = t - s.t0;
-        (s.p0 + s.v0 * tau + 0.5 * s.a * tau * tau, s.v0 + s.a * tau)
-    }
-
-    /// True once a stop or move has reached its end (always false for a jog).
-    pub fn is_done(&self, now_ns: u64) -> bool {
-        matches!(self.end, End::Hold(_)) && self.t(now_ns) >= self.t_end
-    }
-
-    /// Where a stop or move ends (the jog's cruise start for a jog).
-    pub fn end_position(&self) -> f64 {
-        self.p_end
     }
 }
 
