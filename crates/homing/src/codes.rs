@@ -178,6 +178,9 @@ pub const EX_PARAM_DECELERATION: u16 = 3;
 pub const EX_PARAM_TARGET: u16 = 4;
 pub const EX_PARAM_NOT_FINITE: u16 = 5;
 pub const EX_PARAM_LEASE: u16 = 6;
+/// No speed bound: `max_speed` is not set and the homing derives none
+/// (an immediate, absolute or passive homing): nothing may move the axis.
+pub const EX_PARAM_NO_MAX_SPEED: u16 = 7;
 
 // EXERR under ERR 1019.
 pub const EX_SETPOINT_NOT_FINITE: u16 = 1;

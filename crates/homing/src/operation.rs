@@ -62,8 +62,9 @@ pub enum Operation {
     /// checked (ERR 1019 when refused).
     StreamStart,
     /// The stream ends (released by its owner, or the owner is gone): the
-    /// axis comes to rest, landing on the last setpoint when the
-    /// deceleration allows. Always accepted.
+    /// axis stops at once from where its command is (a program that
+    /// releases at rest on its last setpoint finds it there). Always
+    /// accepted.
     StreamEnd,
     /// MAS / MC_Stop: ends a jog, move or stream normally (no error,
     /// HomedStatus kept, the drive stays enabled) with the deceleration of

@@ -268,6 +268,7 @@ impl Axis {
         self.report(now_ns);
         let cmd = self.output(now_ns);
         self.ops.prev_step_ns = Some(now_ns);
+        self.ops.limits_before = self.soft_limits_raw();
         cmd
     }
 
