@@ -2,8 +2,10 @@
 //! through the supervised setpoint stream — the commissioning tool and the
 //! reference client of the stream. The file is checked first; then the
 //! axes are acquired (owner "motionctl"), the rows published at their times
-//! (filled in where rows are further apart than 10 ms), the axes released
-//! once the last setpoint is reached, and followed to rest. Progress on
+//! — filled in on the line between rows further apart than 5 ms, because
+//! an axis stops (1019 / 5) when no setpoint has arrived for its
+//! `stream_timeout_ms`, however far ahead the last one lay —, the axes
+//! released once the last setpoint is reached, and followed to rest. Progress on
 //! stderr; at the end one row per axis with the largest following error
 //! seen (command − actual, from the 100 Hz status) and the final error
 //! (last row − final position).
@@ -29,7 +31,6 @@ pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
         Ok(r) => r,
         Err(e) => return fail(a.json, vec![ErrorEntry::message(e)], super::EXIT_USAGE),
     };
-    let points = csv::points(&rows);
     let mut s = match client.stream("motionctl", &a.axes) {
         Ok(s) => s,
         Err(StreamError::Op(e)) => return op_error(a.json, "stream", &e),
@@ -46,7 +47,7 @@ pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
     let cycle = s.answer().cycle;
     let mut play = Play::new(axes.len());
     let mut progress = Progress::new();
-    if let Err(e) = play.run(&mut s, &points, &axes, &mut progress) {
+    if let Err(e) = play.run(&mut s, &rows, &axes, &mut progress) {
         drop(s);
         return client_error(a.json, &e);
     }
@@ -118,23 +119,25 @@ impl Play {
         }
     }
 
-    /// Publishes every point at its time (the program's clock:
-    /// CLOCK_MONOTONIC from the first point), watching the status between
-    /// points; stops early on a signal or when an axis no longer streams.
-    /// Then waits until the last setpoint is commanded.
+    /// Publishes every point of `rows` ([`csv::points`]) at its time (the
+    /// program's clock: CLOCK_MONOTONIC from the first row), watching the
+    /// status between points; stops early on a signal or when an axis no
+    /// longer streams. Then waits until the last setpoint is commanded.
     fn run(
         &mut self,
         s: &mut Stream,
-        points: &[Row],
+        rows: &[Row],
         axes: &[Followed],
         progress: &mut Progress,
     ) -> Result<(), ClientError> {
         let t0 = motion_rt::now_ns();
-        let first = points[0].t;
+        let first = rows[0].t;
         let at = |p: &Row| t0 + ((p.t - first) * 1e9) as u64;
         let mut next_look = t0;
-        for p in points {
-            let t = at(p);
+        let mut last_gap = 0.0;
+        let mut before = first;
+        for p in csv::points(rows) {
+            let t = at(&p);
             while motion_rt::now_ns() < t {
                 std::thread::sleep(Duration::from_nanos(
                     (t - motion_rt::now_ns()).min(2_000_000),
@@ -147,6 +150,7 @@ impl Play {
                 log::error!("{e}");
                 return Ok(());
             }
+            (last_gap, before) = (p.t - before, p.t);
             if motion_rt::now_ns() >= next_look {
                 next_look = motion_rt::now_ns() + 50_000_000;
                 if !self.look(s, axes, progress)? {
@@ -154,16 +158,12 @@ impl Play {
                 }
             }
         }
-        // The last segment takes its own length to be reached: then the
-        // stream is released (the engine lands the axis on the last
-        // setpoint). Not longer: a stream silent longer than the axis's
-        // stream_timeout_ms (default 50) after its last setpoint stops the
-        // axis with an error.
-        let last = points
-            .len()
-            .checked_sub(2)
-            .map_or(0.0, |k| points[k + 1].t - points[k].t);
-        std::thread::sleep(Duration::from_secs_f64(last.min(csv::FILL_S)));
+        // The last segment takes its own length (at most 5 ms) to be
+        // reached: then the stream is released (a program at rest on its
+        // last setpoint finds the axis there). Not longer: a stream silent
+        // longer than the axis's stream_timeout_ms (default 50) after its
+        // last setpoint arrived stops the axis with an error.
+        std::thread::sleep(Duration::from_secs_f64(last_gap.min(csv::FILL_S)));
         Ok(())
     }
 

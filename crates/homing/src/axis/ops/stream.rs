@@ -86,10 +86,10 @@ impl Axis {
         if matches!(self.state, State::Motion(_) | State::Stopping { .. }) {
             return Err(super::rules::COLLISION);
         }
+        self.speed_bound()?;
         if !self.status.homed && !self.cfg.stream_unhomed {
             return Err((ERR_SETPOINT_REFUSED, EX_SETPOINT_NOT_HOMED));
         }
-        self.speed_bound()?;
         if self.speed_cap() <= 0.0 {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_SPEED));
         }
