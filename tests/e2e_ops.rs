@@ -709,3 +709,41 @@ fn an_unhomed_stream_obeys_unhomed_speed_and_no_speed_bound_moves_nothing() {
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
 }
+
+#[test]
+fn a_restarted_motion_io_switches_no_drive_on_by_itself() {
+    let _serial = serial();
+    // X enabled at rest; its motion-io is killed and the supervisor starts
+    // it again (after its back-off). The new process's sim drive starts
+    // off, and nothing asks for it on: the request was withdrawn when the
+    // feedback was lost (nothing was left to stop) and again when the new
+    // process attached. Only `enable` switches it on.
+    let cfg = ops("ops_iorestart");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.servo_action && a.enabled);
+    let pid = find_process("motion-io", &cfg.prefix).expect("its motion-io");
+    signal_pid(pid, Signal::SIGKILL);
+    let attached_again = wait_for(Duration::from_secs(20), || {
+        let st = d.status();
+        st.io.iter().any(|io| io.restarts >= 1 && io.attached)
+            && st
+                .axes
+                .iter()
+                .any(|a| a.name == "X" && a.position.is_some())
+    });
+    assert!(attached_again, "{:#?}", d.status().io);
+    // a while of the new process's cycles: never enabled
+    for _ in 0..20 {
+        let x = d.axis("X");
+        assert!(
+            !x.enabled && !x.servo_action,
+            "switched on by itself: {x:#?}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.servo_action && a.enabled);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}

@@ -522,3 +522,113 @@ fn a_fault_during_a_reset_is_a_fault() {
     r.run(1);
     assert!(r.axis.status().faulted && !r.axis.status().jogging);
 }
+
+#[test]
+fn a_lost_drive_or_a_restarted_io_process_withdraws_the_enable_in_every_state() {
+    // The drive is gone (the I/O process says so) or its I/O process was
+    // restarted (its drives start off): in every state the enable request
+    // is withdrawn at once and not raised again when the drive is back — a
+    // new process would otherwise switch the drive on by itself.
+    type Setup = fn() -> Rig;
+    let states: [(&str, Setup); 5] = [
+        ("idle, enabled", || {
+            let mut r = Rig::at(0.0);
+            r.enable();
+            r
+        }),
+        ("homed by an active homing", || {
+            let cfg = AxisConfig {
+                max_speed: 50.0,
+                ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
+            };
+            let mut r = Rig::new(cfg, machine());
+            r.step(home());
+            assert!(r.run_until(60_000, |s| s.dn));
+            assert!(r.axis.status().homed && r.cmds.last().unwrap().enable);
+            r
+        }),
+        ("seek", || {
+            let cfg = AxisConfig {
+                max_speed: 50.0,
+                ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
+            };
+            let mut r = Rig::new(cfg, machine());
+            for _ in 0..100 {
+                r.step(home());
+            }
+            r
+        }),
+        ("homing's abort ramp", ramping_after_a_stopped_homing),
+        ("jogging", || {
+            let mut r = Rig::at(0.0);
+            r.enable();
+            r.op(jog(10.0)).unwrap();
+            r.run(50);
+            r
+        }),
+    ];
+    for (name, setup) in states {
+        for restart in [false, true] {
+            let mut r = setup();
+            let home = r.axis.status().ip;
+            if restart {
+                let now = r.now();
+                r.axis.reconnected(now);
+            } else {
+                r.frame = |_, _| None;
+                for _ in 0..3 {
+                    r.step(Request {
+                        home,
+                        drive_lost: true,
+                        ..Request::default()
+                    });
+                }
+                r.frame = |_, fb| Some(fb);
+            }
+            let from = r.k;
+            for _ in 0..50 {
+                r.step(Request {
+                    home,
+                    ..Request::default()
+                });
+            }
+            assert!(
+                r.since(from).iter().all(|c| !c.enable),
+                "{name}, restart {restart}: {:?}",
+                r.axis.status()
+            );
+            let s = r.axis.status();
+            assert!(
+                !s.jogging && !s.stopping && !s.servo_action,
+                "{name}: {s:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn lost_feedback_withdraws_the_enable_once_nothing_is_left_to_stop() {
+    // The I/O process goes silent (killed, hung): at rest the enable
+    // request is withdrawn as soon as the loss rule trips; in motion the
+    // stop at max_deceleration runs first (the drive may still follow),
+    // then it is withdrawn. A new I/O process never gets a standing
+    // request.
+    for moving in [false, true] {
+        let mut r = Rig::at(0.0);
+        r.enable();
+        if moving {
+            r.op(jog(10.0)).unwrap();
+            r.run(50);
+        }
+        r.frame = |_, _| None;
+        assert!(r.run_until(200, |s| !s.feedback_ok), "lost");
+        assert!(r.run_until(200, |s| !s.stopping && !s.jogging));
+        r.run(1);
+        assert!(!r.cmds.last().unwrap().enable, "moving {moving}");
+        r.frame = |_, fb| Some(fb);
+        let from = r.k;
+        r.run(50);
+        assert!(r.since(from).iter().all(|c| !c.enable), "moving {moving}");
+        assert!(!r.axis.status().servo_action);
+    }
+}

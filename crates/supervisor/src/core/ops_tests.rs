@@ -192,3 +192,28 @@ fn a_gantry_side_faulting_during_a_reset_stops_the_other_side() {
         assert!(apart <= 5.0 * 0.01 + 25.0 / 200.0, "{late}: racked {apart}");
     }
 }
+
+#[test]
+fn a_restarted_io_process_gets_no_enable_it_did_not_ask_for() {
+    // X enabled and at rest; its I/O process restarts (a new origin): the
+    // new process's drives start off, and the cycle must not switch them
+    // on by a request left standing. From the restart on, every command
+    // asks for the power stage off, until someone enables it again.
+    let mut b = Bench::new(ONE_AXIS);
+    b.run(5);
+    b.op(1, Operation::Enable, 0);
+    b.run(20);
+    assert!(b.snap().axes[0].enable && b.snap().axes[0].status.servo_action);
+    b.origin[0] = 4321;
+    b.run(2);
+    for _ in 0..50 {
+        b.cycle();
+        assert!(!b.snap().axes[0].enable, "{:?}", b.snap().axes[0].status);
+    }
+    b.op(1, Operation::Enable, 0);
+    b.run(20);
+    assert!(
+        b.snap().axes[0].status.servo_action,
+        "enabled again on request"
+    );
+}

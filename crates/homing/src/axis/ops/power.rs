@@ -26,7 +26,9 @@
 //!   withdrawn in the step that sees it, in every state — idle, enabling,
 //!   every homing leg, homing's abort ramp, an operation's motion or its
 //!   stop — so the drive stays off until someone enables it again
-//!   (EN 60204-1 §7.5), and a reset can never walk it back on. A stop in
+//!   (EN 60204-1 §7.5), and a reset can never walk it back on. A drive
+//!   the I/O process reports lost, and the drives of a restarted I/O
+//!   process, are treated alike (`drive_gone_away`). A stop in
 //!   progress is abandoned (the drive no longer follows it: the command
 //!   holds where the axis is). In motion that is an axis fault (12 / 16).
 //! * **Enable** holds the actual position: while the power stage is off
@@ -137,7 +139,7 @@ impl Axis {
     /// The power stage off now (an enable waiting for it fails). The
     /// command stays where it is: at rest, the axis is there; from the next
     /// sample on it follows the actual position.
-    pub(super) fn power_off(&mut self) {
+    pub(in crate::axis) fn power_off(&mut self) {
         self.enable = false;
         self.ops.power.confirmed = false;
         if let Some((id, _)) = self.ops.power.enabling.take() {
@@ -269,6 +271,30 @@ impl Axis {
                 EX_TERMINATED_ON_REQUEST,
                 Abort::Disable,
             ),
+            _ => self.drive_gone(now),
+        }
+    }
+
+    /// The drive is gone — lost (`Request::drive_lost`), or its I/O
+    /// process restarted (whose drives start off): as a dropped power stage,
+    /// in every state the enable request is withdrawn at once (a drive that
+    /// comes back is never switched on by a request left standing); an
+    /// operation's motion ends as an axis fault (12 / `exerr`), homing that
+    /// drives the axis aborts with it, homing's abort ramp is abandoned.
+    pub(in crate::axis) fn drive_gone_away(&mut self, now: u64, exerr: u16) {
+        match self.state {
+            State::Motion(_) => {
+                self.op_fault(
+                    now,
+                    (ERR_SERVO_MESSAGE, exerr),
+                    StopCause::FeedbackLost,
+                    true,
+                );
+            }
+            _ if self.status.ip && self.homing_drives_the_axis() => {
+                self.fail(now, ERR_SERVO_MESSAGE, exerr, Abort::Disable);
+            }
+            State::Idle if !self.enable => {}
             _ => self.drive_gone(now),
         }
     }
