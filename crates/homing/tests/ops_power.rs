@@ -321,19 +321,37 @@ fn a_virtual_axis_is_enabled_and_jogged_without_a_drive() {
     assert!(r.axis.status().jogging && r.cmd_axis() > 0.5);
 }
 
-/// Homing's seek at 20 u/s stopped at step 100: its abort ramp (Home
-/// Deceleration 500: 40 ms) runs from there.
-fn ramping_after_a_stopped_homing() -> Rig {
-    let cfg = AxisConfig {
+/// A switch homing on the test machine, with a speed bound.
+fn switch_homing() -> AxisConfig {
+    AxisConfig {
         max_speed: 50.0,
         ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    };
-    let mut r = Rig::new(cfg, machine());
-    r.step(home());
-    while r.k < 100 {
+    }
+}
+
+/// Homing, 100 steps in: seeking at 20 u/s.
+fn seeking() -> Rig {
+    let mut r = Rig::new(switch_homing(), machine());
+    for _ in 0..100 {
         r.step(home());
     }
     assert_eq!(r.axis.status().phase, Phase::Seek);
+    r
+}
+
+/// Enabled at 0, jogging at 10 u/s for 50 steps.
+fn jogging() -> Rig {
+    let mut r = Rig::at(0.0);
+    r.enable();
+    r.op(jog(10.0)).unwrap();
+    r.run(50);
+    r
+}
+
+/// Homing's seek at 20 u/s stopped at step 100: its abort ramp (Home
+/// Deceleration 500: 40 ms) runs from there.
+fn ramping_after_a_stopped_homing() -> Rig {
+    let mut r = seeking();
     r.step(Request {
         home: true,
         stop: true,
@@ -413,30 +431,11 @@ fn a_fault_or_dropped_power_stage_withdraws_the_enable_in_every_state() {
             r.run(5);
             r
         }),
-        ("seek", || {
-            let cfg = AxisConfig {
-                max_speed: 50.0,
-                ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-            };
-            let mut r = Rig::new(cfg, machine());
-            for _ in 0..100 {
-                r.step(home());
-            }
-            r
-        }),
+        ("seek", seeking),
         ("homing's abort ramp", ramping_after_a_stopped_homing),
-        ("jogging", || {
-            let mut r = Rig::at(0.0);
-            r.enable();
-            r.op(jog(10.0)).unwrap();
-            r.run(50);
-            r
-        }),
+        ("jogging", jogging),
         ("stopping a jog", || {
-            let mut r = Rig::at(0.0);
-            r.enable();
-            r.op(jog(10.0)).unwrap();
-            r.run(50);
+            let mut r = jogging();
             r.op(Operation::Stop).unwrap();
             r
         }),
@@ -537,35 +536,15 @@ fn a_lost_drive_or_a_restarted_io_process_withdraws_the_enable_in_every_state() 
             r
         }),
         ("homed by an active homing", || {
-            let cfg = AxisConfig {
-                max_speed: 50.0,
-                ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-            };
-            let mut r = Rig::new(cfg, machine());
+            let mut r = Rig::new(switch_homing(), machine());
             r.step(home());
             assert!(r.run_until(60_000, |s| s.dn));
             assert!(r.axis.status().homed && r.cmds.last().unwrap().enable);
             r
         }),
-        ("seek", || {
-            let cfg = AxisConfig {
-                max_speed: 50.0,
-                ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-            };
-            let mut r = Rig::new(cfg, machine());
-            for _ in 0..100 {
-                r.step(home());
-            }
-            r
-        }),
+        ("seek", seeking),
         ("homing's abort ramp", ramping_after_a_stopped_homing),
-        ("jogging", || {
-            let mut r = Rig::at(0.0);
-            r.enable();
-            r.op(jog(10.0)).unwrap();
-            r.run(50);
-            r
-        }),
+        ("jogging", jogging),
     ];
     for (name, setup) in states {
         for restart in [false, true] {

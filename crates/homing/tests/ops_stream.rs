@@ -25,6 +25,18 @@ fn sine(t_s: f64) -> f64 {
     1.0 - (2.0 * std::f64::consts::PI * t_s).cos()
 }
 
+/// Enabled, not homed, streaming (`stream_unhomed`).
+fn unhomed_streaming() -> Rig {
+    let cfg = AxisConfig {
+        stream_unhomed: true,
+        ..op_axis()
+    };
+    let mut r = Rig::new(cfg, op_plant(0.0));
+    r.enable();
+    r.op(Operation::StreamStart).unwrap();
+    r
+}
+
 /// A bad setpoint made from the good one's time and position.
 type Bad = fn(u64, f64) -> (u64, f64, Option<f64>);
 
@@ -232,13 +244,7 @@ fn clearing_the_reference_stops_the_stream_unless_stream_unhomed() {
     r.setpoint(50 * MS, 0.0, None);
     refused(&r, EX_SETPOINT_NOT_HOMED);
     // stream_unhomed: the stream goes on; it may even start unhomed.
-    let cfg = AxisConfig {
-        stream_unhomed: true,
-        ..op_axis()
-    };
-    let mut r = Rig::new(cfg, op_plant(0.0));
-    r.enable();
-    r.op(Operation::StreamStart).unwrap();
+    let mut r = unhomed_streaming();
     for k in 0..50u64 {
         r.setpoint(k * MS, k as f64 * 0.001, None);
     }
@@ -493,14 +499,20 @@ fn a_late_setpoint_brakes_the_command_within_the_limits() {
     within_limits(&r, from, 50.0, 5000.0);
 }
 
+/// Streaming, a setpoint at 0, then one 10 s ahead at 9 (0.9 u/s).
+fn far_ahead() -> Rig {
+    let mut r = streaming();
+    r.setpoint(0, 0.0, None);
+    r.setpoint(10_000 * MS, 9.0, None);
+    r
+}
+
 #[test]
 fn a_program_that_falls_silent_is_stopped_from_its_last_setpoints_arrival() {
     // A setpoint 10 s ahead (0.9 u/s), then nothing: the axis stops
     // stream_timeout (50 ms) after it arrived, not at the end of its
     // segment — a hung program runs out nothing.
-    let mut r = streaming();
-    r.setpoint(0, 0.0, None);
-    r.setpoint(10_000 * MS, 9.0, None);
+    let mut r = far_ahead();
     let arrived = r.k - 1;
     assert!(r.run_until(1000, |s| s.faulted), "{:?}", r.axis.status());
     assert_eq!(r.k - 1, arrived + 51, "the first step after 50 ms");
@@ -515,9 +527,7 @@ fn a_program_that_falls_silent_is_stopped_from_its_last_setpoints_arrival() {
 fn a_released_stream_stops_at_once_however_far_its_last_setpoint_lies() {
     // The owner asks for 9 units 10 s away and is gone (released, or its
     // death noticed): the axis stops now, at the stream's deceleration.
-    let mut r = streaming();
-    r.setpoint(0, 0.0, None);
-    r.setpoint(10_000 * MS, 9.0, None);
+    let mut r = far_ahead();
     r.run(20);
     let id = r.op(Operation::StreamEnd).unwrap();
     let at = r.cmds[r.cmds.len() - 2].position;
@@ -593,13 +603,7 @@ fn a_fault_mid_stream_stops_inside_the_travel_limits_at_a_deceleration_that_can(
 fn an_unhomed_stream_obeys_unhomed_speed() {
     // stream_unhomed: not homed, the cap is unhomed_speed (20 here, from
     // home_speed) as for jog and move, not max_speed (50).
-    let cfg = AxisConfig {
-        stream_unhomed: true,
-        ..op_axis()
-    };
-    let mut r = Rig::new(cfg, op_plant(0.0));
-    r.enable();
-    r.op(Operation::StreamStart).unwrap();
+    let mut r = unhomed_streaming();
     let from = r.k - 1;
     let (mut p, mut v) = (0.0, 0.0);
     for k in 0..100u64 {
@@ -611,9 +615,7 @@ fn an_unhomed_stream_obeys_unhomed_speed() {
     assert!(r.run_until(100, |s| !s.stopping));
     within_limits(&r, from, 20.0, 5000.0);
     // A setpoint's feed-forward above the cap is refused as well.
-    let mut r = Rig::new(cfg, op_plant(0.0));
-    r.enable();
-    r.op(Operation::StreamStart).unwrap();
+    let mut r = unhomed_streaming();
     r.setpoint(0, 0.0, Some(25.0));
     refused(&r, EX_SETPOINT_SPEED);
 }

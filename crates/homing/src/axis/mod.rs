@@ -34,8 +34,10 @@
 //! * **Aborts** (stop, timeout, search limit, lost, invalid or implausible
 //!   feedback, an ambiguous marker when refused) stop
 //!   the axis at Home Deceleration with the overrides still in force, release
-//!   if needed, then restore. A drive fault or shutdown cannot be stopped by
-//!   us: the drive is disabled and the overrides restored at once.
+//!   if needed, then restore. A drive fault, a dropped power stage, a lost
+//!   drive, a restarted I/O process or shutdown cannot be stopped by us: the
+//!   drive is disabled and the overrides restored at once — also during an
+//!   abort's stop, which is then abandoned (`ops::power`).
 
 mod at_limit;
 mod detect;

@@ -4,6 +4,7 @@
 //! stopped within its bound, every side with it.
 
 use super::testbench::{Bench, MS};
+use super::tests::switch_axis;
 use crate::shared::Control;
 use motion_homing::Operation;
 
@@ -113,44 +114,15 @@ fn a_hung_program_has_its_axis_stopped_from_its_last_setpoints_arrival() {
     assert!(went <= 0.9 * 0.051 + 0.81 / 2000.0 + 1e-9, "went {went}");
 }
 
-/// Gantry G (sides G1, G2, switch homing), unhomed: jogged at up to
-/// home_speed 10.
-const GANTRY: &str = r#"
-[supervisor]
-cycle_us = 1000
-cpu = 0
-
-[[axis]]
-name = "G1"
-counts_per_unit = 1000.0
-home_sequence = "switch"
-home_speed = 10.0
-home_return_speed = 2.0
-home_acceleration = 100.0
-home_deceleration = 100.0
-max_speed = 20.0
-[axis.sim]
-start = -10.0
-switch = [0.0, 5.0]
-
-[[axis]]
-name = "G2"
-counts_per_unit = 1000.0
-home_sequence = "switch"
-home_speed = 10.0
-home_return_speed = 2.0
-home_acceleration = 100.0
-home_deceleration = 100.0
-max_speed = 20.0
-[axis.sim]
-start = -10.0
-switch = [0.0, 5.0]
-
-[[gantry]]
-name = "G"
-axes = ["G1", "G2"]
-max_skew = 1.0
-"#;
+/// Gantry G (sides G1, G2: switch homing), unhomed: jogged at up to
+/// home_speed 20.
+fn gantry() -> String {
+    format!(
+        "[supervisor]\ncycle_us = 1000\ncpu = 0\n{}{}\n[[gantry]]\nname = \"G\"\naxes = [\"G1\", \"G2\"]\nmax_skew = 1.0\n",
+        switch_axis("G1", "counts_per_unit = 1000.0"),
+        switch_axis("G2", "counts_per_unit = 1000.0")
+    )
+}
 
 #[test]
 fn a_gantry_side_faulting_during_a_reset_stops_the_other_side() {
@@ -160,7 +132,7 @@ fn a_gantry_side_faulting_during_a_reset_stops_the_other_side() {
     // the cycle after, instead of jogging on for enable_timeout while G1
     // stands switched off (the gantry racked by the jog's travel).
     for late in [0u64, 2] {
-        let mut b = Bench::new(GANTRY);
+        let mut b = Bench::new(&gantry());
         b.run(5);
         b.op(0b11, Operation::Enable, 0);
         b.run(20);
