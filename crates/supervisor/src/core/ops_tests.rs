@@ -11,7 +11,7 @@ use motion_homing::Operation;
 /// One axis X: immediate homing at 0, max_speed 20, stream_acceleration
 /// 1000 (home_acceleration 100 × 10), max_deceleration 100, travel limits
 /// ±20, the default stream_timeout_ms 50; a 1 ms cycle.
-const ONE_AXIS: &str = r#"
+pub(super) const ONE_AXIS: &str = r#"
 [supervisor]
 cycle_us = 1000
 cpu = 0
@@ -27,10 +27,10 @@ max_speed = 20.0
 travel_limits = [-20.0, 20.0]
 "#;
 
-const TOKEN: u64 = 0x0bad_cafe;
+pub(super) const TOKEN: u64 = 0x0bad_cafe;
 
 /// X homed, enabled, and streamed by [`TOKEN`], at rest at 0.
-fn streaming() -> Bench {
+pub(super) fn streaming() -> Bench {
     let mut b = Bench::new(ONE_AXIS);
     b.run(5);
     b.home(1, false);
@@ -51,7 +51,7 @@ fn streaming() -> Bench {
 }
 
 /// X's commanded position now.
-fn cmd(b: &Bench) -> f64 {
+pub(super) fn cmd(b: &Bench) -> f64 {
     b.snap().axes[0].cmd_position
 }
 

@@ -31,6 +31,17 @@
 //! commanded positions as the cycle samples them: no timestamp can buy a
 //! faster or harder command.
 //!
+//! Why shape rather than only refuse: judged on the cycle's timeline
+//! alone, a 100 Hz stream on a 1 kHz cycle could change its velocity per
+//! setpoint by no more than `stream_acceleration` × one cycle — a tenth of
+//! what its own timeline honestly allows — and a setpoint one cycle late
+//! would still stop the command dead on the one before. Shaping keeps
+//! every honest stream (the bench's circles at the cycle rate and at
+//! 100 Hz, the 100 Hz Python programs) within the bounds, on its
+//! setpoints wherever they are reachable; refusing what cannot be followed
+//! within a stop's distance keeps a hostile stream from dragging the
+//! command far from the path it asked for.
+//!
 //! **Checks** of every setpoint on the program's own timeline (a program's
 //! trajectory that is nonsense is refused before it is followed), each an
 //! axis fault that stops the axis and ends the stream (ER 1019 / EXERR): 1
