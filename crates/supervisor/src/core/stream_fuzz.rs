@@ -214,7 +214,7 @@ fn no_timestamp_buys_a_faster_or_harder_command_through_the_cycle() {
             let mut b = streaming();
             let mut x = vec![cmd(&b)];
             let (mut t, mut p, mut seq) = (0u64, 0.0f64, 0u64);
-            let mut one = |b: &mut Bench, x: &mut Vec<f64>| {
+            let one = |b: &mut Bench, x: &mut Vec<f64>| {
                 b.cycle();
                 x.push(cmd(b));
             };
