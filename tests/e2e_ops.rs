@@ -32,7 +32,7 @@ fn wait_axis(d: &Daemon, name: &str, secs: u64, f: impl Fn(&AxisStatus) -> bool)
 
 /// At rest: no operation motion, not stopping.
 fn at_rest(a: &AxisStatus) -> bool {
-    !a.jogging && !a.moving && !a.streaming && !a.stopping && !a.op.ip
+    !a.jogging && !a.moving && !a.streaming && !a.stopping && !a.op_ip
 }
 
 fn pos(a: &AxisStatus) -> f64 {
@@ -41,7 +41,7 @@ fn pos(a: &AxisStatus) -> f64 {
 
 /// The commanded position (axis coordinates).
 fn cmd(a: &AxisStatus) -> f64 {
-    value(a.command, &a.name)
+    value(a.cmd_position, &a.name)
 }
 
 /// `motionctl ARGS --json` refused (exit 1) with ERR `err` / EXERR `exerr`.

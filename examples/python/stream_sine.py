@@ -32,14 +32,7 @@ import math
 import sys
 import time
 
-from motion_supervisor_client import (
-    MS_COMMAND,
-    MS_STREAMING,
-    ST_ER,
-    ST_FEEDBACK,
-    accepted,
-    text,
-)
+from motion_supervisor_client import accepted, text
 from motion_supervisor_client.cli import connect, refused
 from motion_supervisor_client.paths import default_runtime_dir
 
@@ -47,7 +40,7 @@ from motion_supervisor_client.paths import default_runtime_dir
 def stream(sup, a, index, s) -> tuple:
     """Publishes the sine; (ok, largest following error seen)."""
     start = sup.status().axes[index]
-    p0 = start.cmd_position if start.motion & MS_COMMAND else start.position
+    p0 = start.cmd_position if start.cmd_position is not None else start.position
     w = 2.0 * math.pi * a.hz
     period = 1.0 / a.rate
     t0 = time.monotonic_ns()
@@ -60,9 +53,9 @@ def stream(sup, a, index, s) -> tuple:
         s.publish([(index, position, a.amplitude * w * math.sin(w * t))], t_ns=t0 + int(t * 1e9))
         if k % 10 == 0:
             st = sup.status().axes[index]
-            if st.bits & ST_FEEDBACK and st.motion & MS_COMMAND:
+            if st.cmd_position is not None and st.position is not None:
                 worst = max(worst, abs(st.cmd_position - st.position))
-            if k > 0 and not st.motion & MS_STREAMING:
+            if k > 0 and not st.streaming:
                 print(f"{a.axis}: the stream stopped: ERR {st.err}/{st.exerr}", file=sys.stderr)
                 return False, worst, p0
     return True, worst, p0
@@ -99,10 +92,10 @@ def main() -> int:
     # answer) to rest; refused: the stream was over already (an error).
     rel = s.release()
     for e, _ in sup.follow(rel if accepted(rel) else s.answer, 30.0):
-        ok = ok and not e.bits & ST_ER
+        ok = ok and not e.er
         print(
-            f"{text(e.name)}: ER {int(bool(e.bits & ST_ER))} ERR {e.err}/{e.exerr} "
-            f"position {e.position:.6f} (started at {p0:.6f}); "
+            f"{text(e.name)}: ER {int(e.er)} ERR {e.err}/{e.exerr} "
+            f"position {'-' if e.position is None else f'{e.position:.6f}'} (started at {p0:.6f}); "
             f"largest following error seen {worst:.6f}"
         )
     return 0 if ok else 1

@@ -6,12 +6,13 @@ package, 0.10.0): status, home, stop, unhome, enable, disable, reset, jog
     sup = Supervisor("motion")
     print(sup.status().axis_count)
 
-`layout` (the ctypes mirrors and numbers) and `check` (their field-by-field
-comparison with the description the Rust side writes) need only the
-standard library; the client names below load iceoryx2 when first used.
+`layout` (the ctypes classes, numbers and status properties, built from
+the layout description the Rust side writes) and `check` (their
+field-by-field comparison with that description) need only the standard
+library; the client names below load iceoryx2 when first used.
 """
 
-from .layout import *  # noqa: F401,F403  (the mirrors and numbers)
+from .layout import *  # noqa: F401,F403  (the classes and numbers)
 
 __version__ = "0.1.0"
 

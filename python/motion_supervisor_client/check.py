@@ -1,7 +1,9 @@
-"""Compares the ctypes mirrors with the layout description the Rust side
+"""Compares the ctypes classes with the layout description the Rust side
 writes (`layout.json`): every struct's size, alignment and iceoryx2 type
 name, every field's name, offset, size, alignment and type in declaration
-order, and every constant. A mismatch is named `Struct.field: what`.
+order (as ctypes lays them out, which is what a reader of shared memory
+gets), every constant, and every status row's property (it reads its own
+place). A mismatch is named `Struct.field: what`.
 
     python -m motion_supervisor_client.check     # exit 1 on any mismatch
 """
@@ -109,6 +111,36 @@ def compare(description: dict, module) -> list:
         got = getattr(module, name, None)
         if got != value:
             out.append(f"constant {name}: {got!r} in Python, {value!r} in Rust")
+    out += _compare_status(description.get("status"), module)
+    return out
+
+
+def _compare_status(status, module) -> list:
+    """Every status row is a property of the entry reading its place: a
+    flag row sees only its own bit, a number or integer row only its slot."""
+    if status is None:
+        return ["the description has no status table"]
+    entry = getattr(module, status["entry"], None)
+    if entry is None:
+        return []  # named above as a missing mirror
+    out = []
+    for row in status["rows"]:
+        name, place = row["name"], row["place"]
+        if not isinstance(getattr(entry, name, None), property):
+            out.append(f"{status['entry']}.{name}: no property for the status row")
+            continue
+        e = entry()
+        area = getattr(e, row["area"])
+        if row["area"] == "flags":
+            e.flags = 1 << place
+            others = [r["name"] for r in status["rows"] if r["type"] == "flag" and r is not row]
+            ok = getattr(e, name) is True and not any(getattr(e, n, False) for n in others)
+        else:
+            area[place] = 1
+            got = getattr(e, name)
+            ok = got == (row["enum"][1] if row["type"] == "enum" else 1)
+        if not ok:
+            out.append(f"{status['entry']}.{name}: does not read {row['area']} place {place}")
     return out
 
 
@@ -121,7 +153,8 @@ def main() -> int:
         print(p, file=sys.stderr)
     n = sum(len(s["fields"]) for s in description["structs"])
     if not problems:
-        print(f"the ctypes mirrors match the Rust layout description ({n} fields)")
+        rows = len(description["status"]["rows"])
+        print(f"the ctypes classes match the Rust layout description ({n} fields, {rows} status rows)")
     return 1 if problems else 0
 
 

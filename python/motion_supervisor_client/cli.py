@@ -18,7 +18,7 @@ import argparse
 import sys
 
 from .paths import default_runtime_dir
-from .layout import ST_DN, ST_EN, ST_ER, ST_EVENT, ST_FEEDBACK, ST_HOMED, ST_IP, ST_PC, OP_PC, text
+from .layout import text
 
 
 def show(frame) -> None:
@@ -27,12 +27,12 @@ def show(frame) -> None:
     for io in frame.ios[: frame.io_count]:
         print(f"io {text(io.name)}: {'attached' if io.attached else 'NOT attached'}")
     for a in frame.axes[: frame.axis_count]:
-        bits = " ".join(n for n, b in (("EN", ST_EN), ("DN", ST_DN), ("ER", ST_ER), ("IP", ST_IP), ("PC", ST_PC)) if a.bits & b)
-        pos = f"{a.position:.4f}" if a.bits & ST_FEEDBACK else "-"
+        bits = " ".join(n.upper() for n in ("en", "dn", "er", "ip", "pc") if getattr(a, n))
+        pos = _number(a.position, 4)
         io = ios[a.io] if a.io < len(ios) else "?"
         print(
             f"{text(a.name):<8} io {io:<6} phase {text(a.phase):<12} [{bits}] "
-            f"homed {'yes' if a.bits & ST_HOMED else 'no'} ERR {a.err}/{a.exerr} position {pos}"
+            f"homed {'yes' if a.homed else 'no'} ERR {a.err}/{a.exerr} position {pos}"
         )
 
 
@@ -47,7 +47,12 @@ def refused(what: str, r) -> int:
 
 
 def _er(e) -> int:
-    return int(bool(e.bits & ST_ER))
+    return int(e.er)
+
+
+def _number(x, digits: int) -> str:
+    """A status number (`-`: none)."""
+    return "-" if x is None else f"{x:.{digits}f}"
 
 
 def home(sup, axis: str, timeout: float) -> int:
@@ -62,12 +67,11 @@ def home(sup, axis: str, timeout: float) -> int:
     except TimeoutError as e:
         print(e, file=sys.stderr)
         return 1
-    ok = bool(a.bits & ST_PC) and bool(a.bits & ST_HOMED) and not a.bits & ST_ER
-    event = f"{a.event_raw:.6f}" if a.bits & ST_EVENT else "-"
+    ok = a.pc and a.homed and not a.er
     print(
-        f"{axis}: {'homed' if ok else 'NOT homed'}: PC {int(bool(a.bits & ST_PC))} "
-        f"ER {_er(a)} ERR {a.err}/{a.exerr} event_raw {event} "
-        f"position {a.position:.6f} raw {a.raw:.6f} in {a.elapsed_s:.3f} s"
+        f"{axis}: {'homed' if ok else 'NOT homed'}: PC {int(a.pc)} "
+        f"ER {_er(a)} ERR {a.err}/{a.exerr} event_raw {_number(a.event_raw, 6)} "
+        f"position {_number(a.position, 6)} raw {_number(a.raw, 6)} in {a.elapsed_s:.3f} s"
     )
     return 0 if ok else 1
 
@@ -91,9 +95,9 @@ def move(sup, axis: str, target: float, relative: bool, speed: float, timeout: f
         return refused("move", r)
     ok = True
     for e, op in sup.follow(r, timeout):
-        pc = e.op_id == op and bool(e.op_flags & OP_PC)
-        ok = ok and pc and not e.bits & ST_ER
-        print(f"{text(e.name)}: PC {int(pc)} ER {_er(e)} ERR {e.err}/{e.exerr} position {e.position:.6f}")
+        pc = e.op_id == op and e.op_pc
+        ok = ok and pc and not e.er
+        print(f"{text(e.name)}: PC {int(pc)} ER {_er(e)} ERR {e.err}/{e.exerr} position {_number(e.position, 6)}")
     return 0 if ok else 1
 
 
@@ -109,8 +113,8 @@ def jog(sup, axis: str, speed: float, duration: float) -> int:
             print("the jog ended by itself (stop, limit, fault)")
     ok = True
     for e, _ in sup.follow(j.answer, 30.0):
-        ok = ok and not e.bits & ST_ER
-        print(f"{text(e.name)}: ER {_er(e)} ERR {e.err}/{e.exerr} position {e.position:.6f}")
+        ok = ok and not e.er
+        print(f"{text(e.name)}: ER {_er(e)} ERR {e.err}/{e.exerr} position {_number(e.position, 6)}")
     return 0 if ok else 1
 
 

@@ -25,11 +25,11 @@ import iceoryx2 as iox2
 
 from .layout import (
     CONTROL_LAYOUT, FLAG_END, FLAG_PARALLEL, FLAG_RELATIVE, FLAG_SUPERSEDE,
-    MS_JOGGING, MS_MOVING, MS_STREAMING, NAME_LEN, NO_INDEX, OP_IP,
+    NAME_LEN, NO_INDEX,
     REQ_DISABLE, REQ_ENABLE, REQ_HOME, REQ_JOG, REQ_JOG_RENEW, REQ_MOVE,
     REQ_RESET, REQ_STOP, REQ_STREAM_ACQUIRE, REQ_STREAM_RELEASE, REQ_UNHOME,
-    RESULT_ACCEPTED, SETPOINT_LAYOUT, SP_VELOCITY, ST_IP, ST_STOPPING,
-    SX_IN_SEQUENCE, ControlRequest, ControlResponse, SetpointFrame,
+    RESULT_ACCEPTED, SETPOINT_LAYOUT, SP_VELOCITY,
+    ControlRequest, ControlResponse, SetpointFrame,
     StatusFrame, put_text, text,
 )
 from .paths import default_runtime_dir
@@ -158,14 +158,15 @@ class Supervisor:
 
     def wait_homed(self, axis: str, r: ControlResponse, timeout: float = 60.0):
         """The status entry of `axis` once the home sequence answered by `r`
-        has ended (homed or not: look at its bits); TimeoutError if not in
+        has ended (homed or not: `entry.homed`, `entry.pc`, `entry.er`);
+        TimeoutError if not in
         `timeout` s."""
         until = time.monotonic() + timeout
         while time.monotonic() < until:
             frame = self.status()
             if frame.cycle >= r.cycle:
                 for a in frame.axes[: frame.axis_count]:
-                    if text(a.name) == axis and not (a.extra & SX_IN_SEQUENCE) and not (a.bits & (ST_IP | ST_STOPPING)):
+                    if text(a.name) == axis and not (a.in_sequence or a.ip or a.stopping):
                         return a
             time.sleep(0.02)
         raise TimeoutError(f"{axis}: no result within {timeout} s")
@@ -204,13 +205,12 @@ class Supervisor:
         """Follows the accepted axes of answer `r` until each one's operation
         (by its id) has ended and the axis is at rest: [(entry, op_id)]."""
         axes = [(a.index, a.op_id) for a in r.axes[: r.axis_count] if a.accepted and a.index != NO_INDEX]
-        busy = MS_JOGGING | MS_MOVING | MS_STREAMING
         until = time.monotonic() + timeout
         while time.monotonic() < until:
             frame = self.status()
             if frame.cycle >= r.cycle:
                 entries = [(frame.axes[i], op) for i, op in axes]
-                if all(e.op_id != op or not ((e.op_flags & OP_IP) or (e.bits & ST_STOPPING) or (e.motion & busy))
+                if all(e.op_id != op or not (e.op_ip or e.stopping or e.in_motion)
                        for e, op in entries):
                     return entries
             time.sleep(0.02)

@@ -1,250 +1,109 @@
-"""ctypes mirrors of the supervisor's wire structs and their numbers.
+"""ctypes classes of the supervisor's wire structs and their numbers, built
+at import from the layout description the Rust side writes (`layout.json`,
+installed with this package).
 
-The control plane's messages (crates/control/src/message.rs, layout 3) and
-the setpoint frame (crates/frames/src/setpoint.rs, layout 1). Every struct,
-field and constant here is compared, field by field (name, offset, size,
-alignment, type), against `layout.json`, which the Rust side writes from
-the Rust types themselves (crates/control/tests/wire_layout.rs) and fails
-on when it is stale: see `check.py` and python/tests/test_layout.py.
-iceoryx2 itself only compares a type's name, size and alignment when a
-service is opened — a swapped pair of fields would pass that.
+The description (written by crates/control/tests/wire_layout.rs from the
+Rust types themselves, which fails when the checked-in file is stale) has
+every struct's fields with their types, every constant, and the status
+table: where each field of an axis's status lives in a status entry (a bit
+of its `flags` word, a slot of its `ints` or `values` area). So nothing is
+restated here: a struct becomes a ctypes class of the same name, a constant
+a module name, a status row a property of `AxisStatusEntry`
+(`entry.homed`, `entry.position`, `entry.err`, ...). `check.py` then
+compares what ctypes made of the classes (offsets, sizes, alignments) with
+the description field by field: iceoryx2 itself only compares a type's
+name, size and alignment when a service is opened.
+
+A status row's property: a flag is a bool; a `value` a float; a `maybe` a
+float or None (no valid feedback, nothing latched); an integer an int; an
+enumeration its name (`"jog"`, `"lease_expired"`; "?" for a number this
+description does not know). A newer supervisor's rows that this
+description does not have are simply not there.
 
 This module needs nothing but the standard library.
 """
 
 import ctypes
+import json
+import math
+from pathlib import Path
 
-# ---- sizes and versions ---------------------------------------------------
-CONTROL_LAYOUT = 3
-SETPOINT_LAYOUT = 1
-NAME_LEN = 32
-MAX_AXES = 64
-MAX_IOS = 16
-MESSAGE_LEN = 256
-START_ERROR_LEN = 128
-DATA_LEN = 32 * 1024
-PHASE_LEN = 16
-NO_INDEX = 0xFFFF
-NO_AXIS = 0xFF
+#: The description this package was built against.
+DESCRIPTION = json.loads(Path(__file__).with_name("layout.json").read_text(encoding="utf-8"))
 
-# ---- request kinds, flags, results, refusal reasons -----------------------
-REQ_HOME, REQ_STOP, REQ_UNHOME, REQ_STATUS = 1, 2, 3, 4
-REQ_STATS, REQ_TRACE, REQ_TRACE_FETCH, REQ_HLOG = 5, 6, 7, 8
-REQ_ENABLE, REQ_DISABLE, REQ_RESET = 9, 10, 11
-REQ_JOG, REQ_JOG_RENEW, REQ_MOVE = 12, 13, 14
-REQ_STREAM_ACQUIRE, REQ_STREAM_RELEASE = 15, 16
-FLAG_RESET, FLAG_SINCE_RESET, FLAG_PARALLEL = 1, 2, 4
-FLAG_RELATIVE, FLAG_SUPERSEDE, FLAG_END = 8, 16, 32
-RESULT_ACCEPTED, RESULT_REFUSED, RESULT_BAD_REQUEST = 0, 1, 2
-RESULT_FORBIDDEN, RESULT_NOT_READY = 3, 4
-REASON_NONE, REASON_UNKNOWN_AXIS, REASON_ALREADY_HOMING = 0, 1, 2
-REASON_IO_NOT_ATTACHED, REASON_INSTRUCTION, REASON_EXITING = 3, 4, 5
-REASON_GANTRY, REASON_BUSY, REASON_OWNED = 6, 7, 8
-REASON_TOKEN, REASON_OPERATION = 9, 10
-
-# ---- status bits -----------------------------------------------------------
-ST_EN, ST_DN, ST_ER, ST_IP, ST_PC = 1, 2, 4, 8, 16
-ST_HOMING, ST_HOMED, ST_ENABLED, ST_FAULT = 32, 64, 128, 256
-ST_SWITCH, ST_MARKER, ST_FEEDBACK, ST_EVENT = 512, 1024, 2048, 4096
-ST_STOPPING, ST_TRACE = 8192, 16384
-MS_SERVO_ACTION, MS_JOGGING, MS_MOVING, MS_STREAMING = 1, 2, 4, 8
-MS_LIMIT_NEGATIVE, MS_LIMIT_POSITIVE, MS_FAULTED, MS_COMMAND = 16, 32, 64, 128
-OP_IP, OP_PC, OP_REFUSED = 1, 2, 4
-SX_TIMED_OUT, SX_LOST_HOMED, SX_IN_SEQUENCE, SX_LOST_FEEDBACK = 1, 2, 4, 8
-SX_LOST_RECONNECT, SX_RESTORED, SX_DRIVE_LOST = 16, 32, 64
-W_AMBIGUOUS_MARKER, W_DRIFT, W_SWITCH_DRIFT, W_REFERENCE_INVALIDATED = 1, 2, 4, 8
-SP_VELOCITY = 1
+_PRIMITIVES = {
+    "u8": ctypes.c_uint8,
+    "u16": ctypes.c_uint16,
+    "u32": ctypes.c_uint32,
+    "u64": ctypes.c_uint64,
+    "f32": ctypes.c_float,
+    "f64": ctypes.c_double,
+}
 
 
-class ControlRequest(ctypes.Structure):
-    _fields_ = [
-        ("layout_version", ctypes.c_uint32),
-        ("kind", ctypes.c_uint32),
-        ("key", ctypes.c_uint64 * 2),
-        ("request_id", ctypes.c_uint64),
-        ("flags", ctypes.c_uint32),
-        ("axis_count", ctypes.c_uint32),
-        ("offset", ctypes.c_uint64),
-        ("timeout_s", ctypes.c_double),
-        ("position", ctypes.c_double),
-        ("speed", ctypes.c_double),
-        ("accel", ctypes.c_double),
-        ("decel", ctypes.c_double),
-        ("token", ctypes.c_uint64),
-        ("node_id", ctypes.c_uint64 * 2),
-        ("lease_ms", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
-        ("owner", ctypes.c_uint8 * NAME_LEN),
-        ("axes", (ctypes.c_uint8 * NAME_LEN) * MAX_AXES),
-    ]
-
-    @staticmethod
-    def type_name() -> str:
-        return "motion_control::ControlRequest@3"
+def _ctype(spelled: str, classes: dict):
+    """A field type as the description spells it (`u32`, `[u8; 32]`,
+    `[[u8; 32]; 64]`, `AxisAnswer`) as a ctypes type."""
+    if spelled.startswith("["):
+        inner, n = spelled[1:-1].rsplit(";", 1)
+        return _ctype(inner.strip(), classes) * int(n)
+    return _PRIMITIVES.get(spelled) or classes[spelled]
 
 
-class AxisAnswer(ctypes.Structure):
-    _fields_ = [
-        ("name", ctypes.c_uint8 * NAME_LEN),
-        ("accepted", ctypes.c_uint8),
-        ("reason", ctypes.c_uint8),
-        ("err", ctypes.c_uint16),
-        ("exerr", ctypes.c_uint16),
-        ("index", ctypes.c_uint16),
-        ("op_id", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
-    ]
+def _structure(s: dict, classes: dict):
+    attrs = {"_fields_": [(f["name"], _ctype(f["type"], classes)) for f in s["fields"]]}
+    if s["type_name"] is not None:
+        name = s["type_name"]
+        attrs["type_name"] = staticmethod(lambda: name)
+    return type(s["name"], (ctypes.Structure,), attrs)
 
 
-class ControlResponse(ctypes.Structure):
-    _fields_ = [
-        ("layout_version", ctypes.c_uint32),
-        ("kind", ctypes.c_uint32),
-        ("session", ctypes.c_uint32),
-        ("result", ctypes.c_uint32),
-        ("request_id", ctypes.c_uint64),
-        ("axis_count", ctypes.c_uint32),
-        ("data_len", ctypes.c_uint32),
-        ("offset", ctypes.c_uint64),
-        ("total", ctypes.c_uint64),
-        ("cycle", ctypes.c_uint64),
-        ("token", ctypes.c_uint64),
-        ("message", ctypes.c_uint8 * MESSAGE_LEN),
-        ("axes", AxisAnswer * MAX_AXES),
-        ("data", ctypes.c_uint8 * DATA_LEN),
-    ]
+def _row_property(row: dict):
+    """The property reading one status row from an entry."""
+    place, kind = row["place"], row["type"]
+    if kind == "flag":
+        def get(self):
+            return bool(self.flags >> place & 1)
+    elif kind == "value":
+        def get(self):
+            return self.values[place]
+    elif kind == "maybe":
+        def get(self):
+            v = self.values[place]
+            return v if math.isfinite(v) else None
+    elif kind == "enum":
+        names = row["enum"]
 
-    @staticmethod
-    def type_name() -> str:
-        return "motion_control::ControlResponse@3"
-
-
-class AxisStatusEntry(ctypes.Structure):
-    _fields_ = [
-        ("name", ctypes.c_uint8 * NAME_LEN),
-        ("phase", ctypes.c_uint8 * PHASE_LEN),
-        ("io", ctypes.c_uint8),
-        ("warnings", ctypes.c_uint8),
-        ("bits", ctypes.c_uint16),
-        ("err", ctypes.c_uint16),
-        ("exerr", ctypes.c_uint16),
-        ("drive_error_code", ctypes.c_uint16),
-        ("home_mode", ctypes.c_uint8),
-        ("home_sequence", ctypes.c_uint8),
-        ("home_direction", ctypes.c_uint8),
-        ("aborted_by", ctypes.c_uint8),
-        ("extra", ctypes.c_uint8),
-        ("reserved1", ctypes.c_uint8),
-        ("position", ctypes.c_double),
-        ("raw", ctypes.c_double),
-        ("velocity", ctypes.c_double),
-        ("torque", ctypes.c_double),
-        ("event_raw", ctypes.c_double),
-        ("elapsed_s", ctypes.c_double),
-        ("timeout_s", ctypes.c_double),
-        ("search_travel", ctypes.c_double),
-        ("search_limit", ctypes.c_double),
-        ("lost_after_s", ctypes.c_double),
-        ("skew", ctypes.c_double),
-        ("feedback_gap_s", ctypes.c_double),
-        ("drift", ctypes.c_double),
-        ("switch_to_marker", ctypes.c_double),
-        ("cmd_position", ctypes.c_double),
-        ("op_id", ctypes.c_uint32),
-        ("op_err", ctypes.c_uint16),
-        ("op_exerr", ctypes.c_uint16),
-        ("motion", ctypes.c_uint16),
-        ("op_kind", ctypes.c_uint8),
-        ("op_flags", ctypes.c_uint8),
-        ("last_stop", ctypes.c_uint8),
-        ("reserved2", ctypes.c_uint8 * 3),
-        ("owner", ctypes.c_uint8 * NAME_LEN),
-    ]
+        def get(self):
+            n = self.ints[place]
+            return names[n] if n < len(names) else "?"
+    else:
+        def get(self):
+            return self.ints[place]
+    return property(get, doc=row["doc"])
 
 
-class IoStatusEntry(ctypes.Structure):
-    _fields_ = [
-        ("name", ctypes.c_uint8 * NAME_LEN),
-        ("attached", ctypes.c_uint8),
-        ("reserved", ctypes.c_uint8 * 7),
-        ("frames_received", ctypes.c_uint64),
-        ("frames_missing", ctypes.c_uint64),
-        ("frames_refused", ctypes.c_uint64),
-        ("attachments", ctypes.c_uint64),
-        ("gaps", ctypes.c_uint64 * 4),
-        ("longest_gap_cycles", ctypes.c_uint64),
-        ("gap_cycles", ctypes.c_uint64),
-        ("spawn_restarts", ctypes.c_uint32),
-        ("spawn_retry_s", ctypes.c_float),
-        ("start_error", ctypes.c_uint8 * START_ERROR_LEN),
-    ]
+def _build(description: dict) -> dict:
+    classes = {}
+    for s in description["structs"]:  # nested structs come first
+        classes[s["name"]] = _structure(s, classes)
+    status = description["status"]
+    entry = classes[status["entry"]]
+    for row in status["rows"]:
+        setattr(entry, row["name"], _row_property(row))
+    motion = description["constants"]["IN_MOTION"]
+    entry.in_motion = property(lambda self: bool(self.flags & motion), doc="A jog, a move or a stream moves the axis.")
+    return classes
 
 
-class StreamStatusEntry(ctypes.Structure):
-    _fields_ = [
-        ("frames", ctypes.c_uint64),
-        ("setpoints", ctypes.c_uint64),
-        ("refused_layout", ctypes.c_uint64),
-        ("refused_key", ctypes.c_uint64),
-        ("refused_count", ctypes.c_uint64),
-        ("refused_token", ctypes.c_uint64),
-        ("refused_sequence", ctypes.c_uint64),
-        ("refused_axis", ctypes.c_uint64),
-        ("acquired", ctypes.c_uint32),
-        ("owners", ctypes.c_uint32),
-    ]
+globals().update(DESCRIPTION["constants"])
+globals().update(_build(DESCRIPTION))
 
-
-class StatusFrame(ctypes.Structure):
-    _fields_ = [
-        ("layout_version", ctypes.c_uint32),
-        ("session", ctypes.c_uint32),
-        ("sequence", ctypes.c_uint64),
-        ("cycle", ctypes.c_uint64),
-        ("uptime_ns", ctypes.c_uint64),
-        ("cycle_us", ctypes.c_uint32),
-        ("axis_count", ctypes.c_uint32),
-        ("io_count", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
-        ("axes", AxisStatusEntry * MAX_AXES),
-        ("ios", IoStatusEntry * MAX_IOS),
-        ("stream", StreamStatusEntry),
-    ]
-
-    @staticmethod
-    def type_name() -> str:
-        return "motion_control::StatusFrame@3"
-
-
-class SetpointAxis(ctypes.Structure):
-    _fields_ = [
-        ("axis", ctypes.c_uint32),
-        ("flags", ctypes.c_uint32),
-        ("position", ctypes.c_double),
-        ("velocity", ctypes.c_double),
-    ]
-
-
-class SetpointFrame(ctypes.Structure):
-    _fields_ = [
-        ("layout_version", ctypes.c_uint32),
-        ("session", ctypes.c_uint32),
-        ("key", ctypes.c_uint64 * 2),
-        ("token", ctypes.c_uint64),
-        ("seq", ctypes.c_uint64),
-        ("t_ns", ctypes.c_uint64),
-        ("count", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
-        ("axes", SetpointAxis * MAX_AXES),
-    ]
-
-    @staticmethod
-    def type_name() -> str:
-        return "motion_frames::SetpointFrame@layout1"
-
-
-#: Every mirror (each ctypes struct of this module), named like its Rust type.
+#: Every class built from the description, named like its Rust type.
 MIRRORS = tuple(v for v in list(globals().values()) if isinstance(v, type) and issubclass(v, ctypes.Structure))
+
+#: The status table's rows (name, type, place, unit, JSON key, OPC UA name, doc).
+STATUS_ROWS = tuple(DESCRIPTION["status"]["rows"])
 
 
 def text(arr) -> str:

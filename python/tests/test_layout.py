@@ -1,7 +1,8 @@
-"""The ctypes mirrors against the layout description the Rust side writes
-(crates/control/tests/wire_layout.rs, which fails when layout.json is
-stale): field by field, and the check itself against deliberately wrong
-mirrors and descriptions.
+"""The ctypes classes (built from the layout description the Rust side
+writes: crates/control/tests/wire_layout.rs, which fails when layout.json
+is stale) against that description: field by field, every status row's
+property, and the check itself against deliberately wrong classes and
+descriptions.
 
     cd python && python -m unittest discover -s tests -v
 """
@@ -47,7 +48,8 @@ class TheMirrorsMatchRust(unittest.TestCase):
     def test_every_rust_wire_struct_is_described_and_mirrored(self):
         names = [s["name"] for s in self.description["structs"]]
         for expected in ("ControlRequest", "ControlResponse", "AxisAnswer", "StatusFrame", "AxisStatusEntry",
-                         "IoStatusEntry", "StreamStatusEntry", "SetpointFrame", "SetpointAxis"):
+                         "IoStatusEntry", "IoCounters", "GapCounts", "StreamCounts", "SetpointFrame",
+                         "SetpointAxis"):
             self.assertIn(expected, names)
         self.assertEqual(sorted(names), sorted(m.__name__ for m in layout.MIRRORS))
 
@@ -105,10 +107,10 @@ class AWrongMirrorFails(unittest.TestCase):
         self.assertIn("AxisAnswer.err: offset is 40 in Python, 34 in Rust", p)
 
     def test_a_missing_and_an_extra_field(self):
-        fields = [(n, t) for n, t in layout.StreamStatusEntry._fields_ if n != "owners"] + [("spare", ctypes.c_uint32)]
-        p = self.problems(StreamStatusEntry=struct_like(layout.StreamStatusEntry, fields=fields))
-        self.assertIn("StreamStatusEntry.owners: missing in Python", p)
-        self.assertIn("StreamStatusEntry.spare: not in the Rust type", p)
+        fields = [(n, t) for n, t in layout.StreamCounts._fields_ if n != "owners"] + [("spare", ctypes.c_uint32)]
+        p = self.problems(StreamCounts=struct_like(layout.StreamCounts, fields=fields))
+        self.assertIn("StreamCounts.owners: missing in Python", p)
+        self.assertIn("StreamCounts.spare: not in the Rust type", p)
 
     def test_a_short_array(self):
         fields = [(n, ctypes.c_uint8 * 31 if n == "owner" else t) for n, t in layout.ControlRequest._fields_]
@@ -121,9 +123,9 @@ class AWrongMirrorFails(unittest.TestCase):
         self.assertIn("SetpointAxis.position: offset is 16 in Python, 8 in Rust", p)
 
     def test_a_wrong_type_name(self):
-        wrong = struct_like(layout.StatusFrame, type_name=staticmethod(lambda: "motion_control::StatusFrame@2"))
+        wrong = struct_like(layout.StatusFrame, type_name=staticmethod(lambda: "motion_control::StatusFrame@3"))
         p = self.problems(StatusFrame=wrong)
-        self.assertTrue(any(x.startswith("StatusFrame: type_name is 'motion_control::StatusFrame@2'") for x in p), p)
+        self.assertTrue(any(x.startswith("StatusFrame: type_name is 'motion_control::StatusFrame@3'") for x in p), p)
 
     def test_a_missing_mirror_and_a_wrong_constant(self):
         ns = mirrors_with()
@@ -151,10 +153,10 @@ class AChangedRustTypeFails(unittest.TestCase):
     def test_each_attribute_of_a_field(self):
         self.assertIn("ControlRequest.lease_ms: offset is 112 in Python, 116 in Rust",
                       self.mutated("ControlRequest", "lease_ms", offset=116))
-        self.assertIn("AxisStatusEntry.motion: size is 2 in Python, 4 in Rust",
-                      self.mutated("AxisStatusEntry", "motion", size=4))
-        self.assertIn("AxisStatusEntry.motion: align is 2 in Python, 4 in Rust",
-                      self.mutated("AxisStatusEntry", "motion", align=4))
+        self.assertIn("AxisStatusEntry.flags: size is 8 in Python, 4 in Rust",
+                      self.mutated("AxisStatusEntry", "flags", size=4))
+        self.assertIn("AxisStatusEntry.flags: align is 8 in Python, 4 in Rust",
+                      self.mutated("AxisStatusEntry", "flags", align=4))
         self.assertIn("StatusFrame.cycle: type is 'u64' in Python, 'i64' in Rust",
                       self.mutated("StatusFrame", "cycle", type="i64"))
 
@@ -166,14 +168,72 @@ class AChangedRustTypeFails(unittest.TestCase):
     def test_the_struct_itself(self):
         self.assertIn("ControlResponse: size is 36160 in Python, 36168 in Rust",
                       self.mutated("ControlResponse", size=36168))
-        self.assertIn("StatusFrame: type_name is 'motion_control::StatusFrame@3' in Python, "
-                      "'motion_control::StatusFrame@4' in Rust",
-                      self.mutated("StatusFrame", type_name="motion_control::StatusFrame@4"))
+        self.assertIn("StatusFrame: type_name is 'motion_control::StatusFrame@4' in Python, "
+                      "'motion_control::StatusFrame@5' in Rust",
+                      self.mutated("StatusFrame", type_name="motion_control::StatusFrame@5"))
 
     def test_a_new_struct_without_a_mirror(self):
         d = copy.deepcopy(self.description)
         d["structs"].append({"name": "NewThing", "type_name": None, "size": 8, "align": 8, "fields": []})
         self.assertIn("NewThing: no ctypes mirror", check.compare(d, layout))
+
+
+def row(name):
+    return next(r for r in layout.STATUS_ROWS if r["name"] == name)
+
+
+class TheStatusRowsAreProperties(unittest.TestCase):
+    """Each row of the status table reads its own place of an entry, typed
+    as the row says; the names programs use are there."""
+
+    def test_the_names_programs_use(self):
+        e = layout.AxisStatusEntry()
+        for name in ("name", "position", "cmd_position", "err", "exerr", "homed", "pc", "er", "jogging"):
+            self.assertTrue(hasattr(e, name), name)
+        self.assertEqual(layout.text(e.name), "")
+
+    def test_each_type_reads_its_place(self):
+        e = layout.AxisStatusEntry()
+        e.flags = 1 << row("homed")["place"]
+        self.assertIs(e.homed, True)
+        self.assertIs(e.homing, False)
+        e.values[row("position")["place"]] = float("nan")
+        self.assertIsNone(e.position)
+        e.values[row("position")["place"]] = 12.5
+        self.assertEqual(e.position, 12.5)
+        e.ints[row("err")["place"]] = 12
+        self.assertEqual(e.err, 12)
+        e.ints[row("op_kind")["place"]] = row("op_kind")["enum"].index("jog")
+        self.assertEqual(e.op_kind, "jog")
+        e.ints[row("op_kind")["place"]] = 250
+        self.assertEqual(e.op_kind, "?")
+        e.flags = 1 << row("moving")["place"]
+        self.assertTrue(e.in_motion)
+
+    def test_a_property_reading_another_place_is_caught(self):
+        entry = layout.AxisStatusEntry
+        wrong = struct_like(entry, **{"homed": property(lambda self: bool(self.flags & 1)),
+                                      "position": property(lambda self: self.values[0 if row("position")["place"] else 1])})
+        for r in layout.STATUS_ROWS:
+            if r["name"] not in ("homed", "position"):
+                setattr(wrong, r["name"], getattr(entry, r["name"]))
+        ns = mirrors_with(AxisStatusEntry=wrong)
+        p = check.compare(check.load_description(), ns)
+        self.assertIn("AxisStatusEntry.homed: does not read flags place 6", p)
+        self.assertIn(f"AxisStatusEntry.position: does not read values place {row('position')['place']}", p)
+
+    def test_a_row_without_a_property_is_caught(self):
+        d = copy.deepcopy(check.load_description())
+        d["status"]["rows"].append(dict(row("homed"), name="latched", place=63))
+        self.assertIn("AxisStatusEntry.latched: no property for the status row", check.compare(d, layout))
+
+    def test_a_new_row_becomes_a_property_without_a_line_of_python(self):
+        d = copy.deepcopy(check.load_description())
+        d["status"]["rows"].append(dict(row("position"), name="latched_position", place=31, json="latched_position"))
+        classes = layout._build(d)
+        e = classes["AxisStatusEntry"]()
+        e.values[31] = 2.5
+        self.assertEqual(e.latched_position, 2.5)
 
 
 if __name__ == "__main__":

@@ -32,47 +32,50 @@ pub fn followed(resp: &ControlResponse) -> Vec<Followed> {
         .collect()
 }
 
-impl AxisStatusEntry {
+/// How an axis's operation ended, from its status entry.
+pub trait OpOutcome {
     /// The operation `op_id` has ended on this axis (or a later one took
     /// over) and the axis is at rest.
-    pub fn op_ended(&self, op_id: u32) -> bool {
-        let moving = self.motion & (MS_JOGGING | MS_MOVING | MS_STREAMING) != 0;
-        let busy =
-            (self.op_id == op_id && self.op_flags & OP_IP != 0) || self.has(ST_STOPPING) || moving;
-        self.op_id != op_id || !busy
+    fn op_ended(&self, op_id: u32) -> bool;
+    /// How operation `op_id` ended, as a row of `move --json`.
+    fn op_row(&self, op_id: u32) -> MotionRow;
+}
+
+impl OpOutcome for AxisStatusEntry {
+    fn op_ended(&self, op_id: u32) -> bool {
+        let mine = self.op_id() == op_id;
+        let busy = (mine && self.op_ip()) || self.stopping() || self.in_motion();
+        !mine || !busy
     }
 
-    /// How operation `op_id` ended, as a row of `move --json`.
-    pub fn op_row(&self, op_id: u32) -> MotionRow {
-        let refused = self.op_id == op_id && self.op_flags & OP_REFUSED != 0;
-        let (err, exerr) = if self.has(ST_ER) {
-            (self.err, self.exerr)
+    fn op_row(&self, op_id: u32) -> MotionRow {
+        let mine = self.op_id() == op_id;
+        let refused = mine && self.op_refused();
+        let (err, exerr) = if self.er() {
+            (self.err(), self.exerr())
         } else if refused {
-            (self.op_err, self.op_exerr)
+            (self.op_err(), self.op_exerr())
         } else {
             (0, 0)
         };
-        let error = if self.op_id != op_id {
+        let error = if !mine {
             Some("another operation took the axis over".to_string())
         } else if err != 0 {
             Some(motion_report::codes::describe(
                 err,
                 exerr,
-                Some(self.feedback_gap_s),
+                Some(self.feedback_gap_s()),
             ))
         } else {
             None
         };
         MotionRow {
-            name: get_str(&self.name),
-            pc: self.op_id == op_id && self.op_flags & OP_PC != 0,
-            er: self.has(ST_ER) || refused,
+            name: self.name_text(),
+            pc: mine && self.op_pc(),
+            er: self.er() || refused,
             err,
             exerr,
-            position: self
-                .has(ST_FEEDBACK)
-                .then_some(self.position)
-                .filter(|p| p.is_finite()),
+            position: self.position(),
             error,
             ..MotionRow::default()
         }

@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use crate::client::{Client, ClientError};
 use crate::message::*;
+use crate::report::AxisReport;
 use crate::request::{Axes, Request};
 use motion_report::AxisResult;
 
@@ -75,7 +76,7 @@ pub fn home_and_follow(
         progress(&st, &members);
         let done = members.iter().all(|&i| {
             let a = &st.axes[i];
-            a.extra & SX_IN_SEQUENCE == 0 && !a.has(ST_IP) && !a.has(ST_STOPPING)
+            !a.in_sequence() && !a.ip() && !a.stopping()
         });
         if done {
             let names = st.axis_names();

@@ -4,8 +4,8 @@
 //!   service and the status frame, with a layout version in their iceoryx2
 //!   type names (as the frames have). Plain fixed-size data, so any iceoryx2
 //!   client can speak them — the Python package in `python/` does, with
-//!   nothing but the `iceoryx2` package; its ctypes mirrors are checked field
-//!   by field against the description `tests/wire_layout.rs` writes.
+//!   nothing but the `iceoryx2` package, whose ctypes classes are built from
+//!   the description `tests/wire_layout.rs` writes (status rows included).
 //! * [`request`] — a request as an enum ([`Request`]): decoded from the
 //!   wire once, at the daemon's edge, and encoded from it by Rust clients;
 //!   an unknown kind is an error, never another request.
@@ -13,6 +13,10 @@
 //!   [`Reason`]); the `REASON_*`/`RESULT_*` numbers are written there.
 //! * [`client`] — what `motionctl` (and any Rust HMI) uses: join the
 //!   supervisor's domain through its session file, send requests, read status.
+//! * [`report`] — a status frame and an answer in the reports' words
+//!   ([`AxisReport`]: `status --json`'s and `home --json`'s rows, errors and
+//!   warnings in words). The status entries and their fields are
+//!   `motion-status`'s table.
 //! * [`ops`] — enable, disable, reset, move and the hold-to-run [`Jog`]
 //!   for Rust clients; [`stream`] — the supervised setpoint stream's
 //!   [`stream::Stream`] handle and the acquire answer's axis map;
@@ -29,7 +33,6 @@ pub mod client;
 pub mod follow;
 pub mod homing;
 pub mod message;
-mod names;
 pub mod ops;
 pub mod progress;
 pub mod report;
@@ -39,8 +42,10 @@ pub mod server;
 pub mod stream;
 
 pub use client::{Client, ClientError};
+pub use follow::OpOutcome;
 pub use message::*;
 pub use ops::{Jog, JogSpec, MoveSpec, OpError};
+pub use report::AxisReport;
 pub use request::{Axes, DecodeError, Request, Since};
 pub use response::{AxisOutcome, Reason};
 pub use server::{Server, ServerError};

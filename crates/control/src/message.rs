@@ -6,31 +6,33 @@
 //! so a client of another layout cannot even open the services. Text
 //! (names, messages, report data) is UTF-8, NUL-padded.
 //!
-//! Any client can speak them: `python/motion_supervisor_client/layout.py`
-//! mirrors them with `ctypes`, checked field by field against `layout.json`,
-//! which `tests/wire_layout.rs` writes from these types (and fails on when
-//! it is stale): a change here is a regenerated description away from a
-//! failing Python test.
+//! Any client can speak them: `tests/wire_layout.rs` writes their layout
+//! description, with the status table's rows, to
+//! `python/motion_supervisor_client/layout.json` (and fails when it is
+//! stale); the Python package builds its `ctypes` classes and a property
+//! per status row from that file and checks them against it field by
+//! field.
 
 use iceoryx2::prelude::{PlacementDefault, ZeroCopySend};
 
-/// Layout version of every type in this file. Bump it on ANY change.
-pub const CONTROL_LAYOUT: u32 = 3;
+/// Layout version of every type in this file and of the status entries
+/// (`motion-status`). Bump it on any change of a struct, and when a status
+/// row moves, is removed or changes its type; a status row added in the
+/// room of its area moves nothing and needs no bump (see
+/// `motion_status::schema`).
+pub const CONTROL_LAYOUT: u32 = 4;
 
-/// Bytes of a name (axis, I/O process).
-pub const NAME_LEN: usize = 32;
+/// Bytes of a name (axis, I/O process) and of a phase name; text fields
+/// are written and read with `put_str` / `get_str`.
+pub use motion_status::{get_str, put_str, NAME_LEN, PHASE_LEN};
 /// Axes a message carries.
 pub const MAX_AXES: usize = 64;
 /// I/O processes a status frame carries.
 pub const MAX_IOS: usize = 16;
 /// Bytes of a response's message.
 pub const MESSAGE_LEN: usize = 256;
-/// Bytes of `IoStatusEntry::start_error`.
-pub const START_ERROR_LEN: usize = 128;
 /// Bytes of a response's data (a page of a report, a trace or a log).
 pub const DATA_LEN: usize = 32 * 1024;
-/// Bytes of a phase name.
-pub const PHASE_LEN: usize = 16;
 /// `AxisAnswer::index` of a name that is no axis.
 pub const NO_INDEX: u16 = u16::MAX;
 
@@ -163,7 +165,7 @@ pub fn reason_text(reason: u8) -> &'static str {
 /// `home_deceleration`; a jog's `speed` and a move's `position` have none).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::ControlRequest@3")]
+#[type_name("motion_control::ControlRequest@4")]
 pub struct ControlRequest {
     pub layout_version: u32,
     /// `REQ_*`.
@@ -232,7 +234,7 @@ pub struct AxisAnswer {
 /// The answer to a [`ControlRequest`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::ControlResponse@3")]
+#[type_name("motion_control::ControlResponse@4")]
 pub struct ControlResponse {
     pub layout_version: u32,
     /// The request's kind.
@@ -264,247 +266,18 @@ pub struct ControlResponse {
 }
 
 // ---- status -------------------------------------------------------------
-/// `AxisStatusEntry::bits`.
-pub const ST_EN: u16 = 1 << 0;
-pub const ST_DN: u16 = 1 << 1;
-pub const ST_ER: u16 = 1 << 2;
-pub const ST_IP: u16 = 1 << 3;
-pub const ST_PC: u16 = 1 << 4;
-/// Axis HomingStatus.
-pub const ST_HOMING: u16 = 1 << 5;
-/// Axis HomedStatus.
-pub const ST_HOMED: u16 = 1 << 6;
-/// The drive reports enabled.
-pub const ST_ENABLED: u16 = 1 << 7;
-/// The drive reports a fault.
-pub const ST_FAULT: u16 = 1 << 8;
-/// The home switch is actuated (logical).
-pub const ST_SWITCH: u16 = 1 << 9;
-/// A marker passed / the marker latch holds a position.
-pub const ST_MARKER: u16 = 1 << 10;
-/// `position`, `raw`, `velocity`, `torque` are valid (fresh feedback).
-pub const ST_FEEDBACK: u16 = 1 << 11;
-/// `event_raw` is valid.
-pub const ST_EVENT: u16 = 1 << 12;
-/// Decelerating after an abort.
-pub const ST_STOPPING: u16 = 1 << 13;
-/// A trace of the next homing is armed or recording.
-pub const ST_TRACE: u16 = 1 << 14;
-
-/// `AxisStatusEntry::motion`: ServoActionStatus (enable requested and the
-/// drive reports enabled).
-pub const MS_SERVO_ACTION: u16 = 1 << 0;
-/// JogStatus.
-pub const MS_JOGGING: u16 = 1 << 1;
-/// MoveStatus.
-pub const MS_MOVING: u16 = 1 << 2;
-/// A setpoint stream commands the axis.
-pub const MS_STREAMING: u16 = 1 << 3;
-/// The negative / positive hardware overtravel limit switch is tripped.
-pub const MS_LIMIT_NEGATIVE: u16 = 1 << 4;
-pub const MS_LIMIT_POSITIVE: u16 = 1 << 5;
-/// An axis fault is present (ER set by a drive fault, a limit switch, a
-/// refused setpoint, lost feedback): only `reset` clears it.
-pub const MS_FAULTED: u16 = 1 << 6;
-/// `cmd_position` is valid.
-pub const MS_COMMAND: u16 = 1 << 7;
-
-/// `AxisStatusEntry::op_flags`: the last operation is in process.
-pub const OP_IP: u8 = 1 << 0;
-/// ... ended as asked (MAM: at its target; a jog or stream: ended normally).
-pub const OP_PC: u8 = 1 << 1;
-/// ... was refused (`op_err` / `op_exerr` say why).
-pub const OP_REFUSED: u8 = 1 << 2;
-
-/// `AxisStatusEntry::aborted_by` when no other axis aborted it.
-pub const NO_AXIS: u8 = 0xff;
-/// `AxisStatusEntry::extra`: the home sequence's timeout stopped the axis.
-pub const SX_TIMED_OUT: u8 = 1 << 0;
-/// HomedStatus was lost after the axis last homed successfully.
-pub const SX_LOST_HOMED: u8 = 1 << 1;
-/// A home sequence will start, or has started, the axis.
-pub const SX_IN_SEQUENCE: u8 = 1 << 2;
-/// With `SX_LOST_HOMED`: lost because its feedback was lost.
-pub const SX_LOST_FEEDBACK: u8 = 1 << 3;
-/// With `SX_LOST_HOMED`: lost because its I/O process reconnected.
-pub const SX_LOST_RECONNECT: u8 = 1 << 4;
-/// HomedStatus comes from the stored reference of an absolute axis,
-/// applied without motion (not from a homing run since start-up).
-pub const SX_RESTORED: u8 = 1 << 5;
-/// The I/O process reports the axis's drive lost (it stopped answering on
-/// its fieldbus, left operation, or was power-cycled): not a reading, not
-/// enabled.
-pub const SX_DRIVE_LOST: u8 = 1 << 6;
-
-/// `AxisStatusEntry::warnings`: the last homing's marker lay closer to the
-/// switch edge than `marker_min_distance` (which marker is taken is a
-/// matter of chance).
-pub const W_AMBIGUOUS_MARKER: u8 = 1 << 0;
-/// The last homing's event lay further than `drift_limit` from the recent
-/// events of the axis (`drift`).
-pub const W_DRIFT: u8 = 1 << 1;
-/// The last homing's switch-to-marker distance lay further than
-/// `drift_limit` from the recent ones (`drift`).
-pub const W_SWITCH_DRIFT: u8 = 1 << 2;
-/// The stored reference of this absolute axis was invalidated (the reason
-/// is in the log and the homing record).
-pub const W_REFERENCE_INVALIDATED: u8 = 1 << 3;
-
-/// One axis of the status frame.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, ZeroCopySend, PlacementDefault)]
-pub struct AxisStatusEntry {
-    pub name: [u8; NAME_LEN],
-    /// Homing phase by name (`idle`, `seek`, ...), NUL-padded.
-    pub phase: [u8; PHASE_LEN],
-    /// Index of its I/O process in `StatusFrame::ios`.
-    pub io: u8,
-    /// `W_*`: warnings of the last homing (it did not fail because of them).
-    pub warnings: u8,
-    /// `ST_*`.
-    pub bits: u16,
-    pub err: u16,
-    pub exerr: u16,
-    /// The drive's error code (CiA 402 0x603F) while it reports a fault.
-    pub drive_error_code: u16,
-    /// CIP numbers: Home Mode (0 passive, 1 active, 2 absolute), Home
-    /// Sequence (0..=5), Home Direction (0..=3).
-    pub home_mode: u8,
-    pub home_sequence: u8,
-    pub home_direction: u8,
-    /// Index of the axis whose failure aborted this axis's home sequence
-    /// (`NO_AXIS`: none).
-    pub aborted_by: u8,
-    /// `SX_*`.
-    pub extra: u8,
-    pub reserved1: u8,
-    /// Axis position (current reference), raw position, units; velocity
-    /// units/s; torque % rated (valid with `ST_FEEDBACK`).
-    pub position: f64,
-    pub raw: f64,
-    pub velocity: f64,
-    pub torque: f64,
-    /// Raw position of the home event (valid with `ST_EVENT`).
-    pub event_raw: f64,
-    /// Time in the current (or last) homing and its timeout (0 = none), s.
-    pub elapsed_s: f64,
-    pub timeout_s: f64,
-    /// Distance travelled in the current search leg and the limit (0 =
-    /// unbounded), units.
-    pub search_travel: f64,
-    pub search_limit: f64,
-    /// With `SX_LOST_HOMED`: seconds after homing ended that HomedStatus
-    /// was lost.
-    pub lost_after_s: f64,
-    /// A gantry side: the largest skew of its gantry's last homing (how far
-    /// apart the sides found their events), units; NaN otherwise.
-    pub skew: f64,
-    /// How long the feedback had been missing when the feedback-loss rule
-    /// tripped (ERR 12 / EXERR 40, or HomedStatus lost), s; 0 otherwise.
-    pub feedback_gap_s: f64,
-    /// With `W_DRIFT` / `W_SWITCH_DRIFT`: how far from the median of the
-    /// recent events, units; NaN otherwise.
-    pub drift: f64,
-    /// Switch then marker: the distance from the switch edge to the marker
-    /// of the last homing, units; NaN otherwise.
-    pub switch_to_marker: f64,
-    /// The position commanded this cycle, axis coordinates, units (valid
-    /// with `MS_COMMAND`): with `position`, the following error.
-    pub cmd_position: f64,
-    /// The last operation (enable, disable, reset, jog, move, stream, stop):
-    /// its id, the ERR / EXERR of a refusal, its kind (`OpKind` number).
-    pub op_id: u32,
-    pub op_err: u16,
-    pub op_exerr: u16,
-    /// `MS_*`.
-    pub motion: u16,
-    pub op_kind: u8,
-    /// `OP_*`.
-    pub op_flags: u8,
-    /// Why the last motion stopped (`StopCause` number, 0 none).
-    pub last_stop: u8,
-    pub reserved2: [u8; 3],
-    /// The program that owns the axis (setpoint stream), NUL-padded; empty:
-    /// none.
-    pub owner: [u8; NAME_LEN],
-}
-
-/// One I/O process of the status frame.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-pub struct IoStatusEntry {
-    pub name: [u8; NAME_LEN],
-    /// 1 = fresh feedback arrives (within the feedback-loss rule).
-    pub attached: u8,
-    pub reserved: [u8; 7],
-    pub frames_received: u64,
-    pub frames_missing: u64,
-    /// Refused: bad layout, wrong axis count, wrong session key.
-    pub frames_refused: u64,
-    /// Times it attached (the first included).
-    pub attachments: u64,
-    /// Gaps by length: 1, 2–3, 4–10, > 10 cycles.
-    pub gaps: [u64; 4],
-    pub longest_gap_cycles: u64,
-    /// Cycles without a fresh answer right now.
-    pub gap_cycles: u64,
-    /// A spawned I/O process: times the supervisor started it again.
-    pub spawn_restarts: u32,
-    /// A spawned I/O process: seconds until its next start (0: running).
-    pub spawn_retry_s: f32,
-    /// A spawned I/O process: the error it ended with at its last failed
-    /// start (its first line), NUL-padded; empty when none.
-    pub start_error: [u8; START_ERROR_LEN],
-}
-
-impl Default for IoStatusEntry {
-    /// All zero (every field is an integer, a float or a byte array).
-    fn default() -> Self {
-        Self {
-            name: [0; NAME_LEN],
-            attached: 0,
-            reserved: [0; 7],
-            frames_received: 0,
-            frames_missing: 0,
-            frames_refused: 0,
-            attachments: 0,
-            gaps: [0; 4],
-            longest_gap_cycles: 0,
-            gap_cycles: 0,
-            spawn_restarts: 0,
-            spawn_retry_s: 0.0,
-            start_error: [0; START_ERROR_LEN],
-        }
-    }
-}
-
-/// The setpoint stream's intake as the status frame shows it: frames taken,
-/// and refused by why (counted since start).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, ZeroCopySend, PlacementDefault)]
-pub struct StreamStatusEntry {
-    /// Frames that reached the intake's checks.
-    pub frames: u64,
-    /// Setpoints handed to engines.
-    pub setpoints: u64,
-    /// Refused: another layout, without the session key, too many entries,
-    /// a token owning none of the axes, a sequence number not above the
-    /// last, an entry for an axis the token does not own.
-    pub refused_layout: u64,
-    pub refused_key: u64,
-    pub refused_count: u64,
-    pub refused_token: u64,
-    pub refused_sequence: u64,
-    pub refused_axis: u64,
-    /// Streams granted since start, and running now.
-    pub acquired: u32,
-    pub owners: u32,
-}
+// The entries of the status frame are `motion-status`'s: the axis entry is
+// its table's flags word and value areas (each field's place is a row of
+// that table), the I/O process and stream entries its one declaration of
+// those counters.
+pub use motion_status::{
+    AxisStatusEntry, GapCounts, IoCounters, IoStatusEntry, StreamCounts, NO_AXIS, START_ERROR_LEN,
+};
 
 /// The status service's frame, published at 100 Hz.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, ZeroCopySend, PlacementDefault)]
-#[type_name("motion_control::StatusFrame@3")]
+#[type_name("motion_control::StatusFrame@4")]
 pub struct StatusFrame {
     pub layout_version: u32,
     /// The supervisor's session id.
@@ -521,7 +294,7 @@ pub struct StatusFrame {
     pub reserved: u32,
     pub axes: [AxisStatusEntry; MAX_AXES],
     pub ios: [IoStatusEntry; MAX_IOS],
-    pub stream: StreamStatusEntry,
+    pub stream: StreamCounts,
 }
 
 macro_rules! zeroed {
@@ -547,22 +320,6 @@ macro_rules! zeroed {
 zeroed!(ControlRequest);
 zeroed!(ControlResponse);
 zeroed!(StatusFrame);
-
-/// Writes `s` NUL-padded into `buf`, cut at a character boundary.
-pub fn put_str(buf: &mut [u8], s: &str) {
-    buf.fill(0);
-    let mut n = s.len().min(buf.len());
-    while !s.is_char_boundary(n) {
-        n -= 1;
-    }
-    buf[..n].copy_from_slice(&s.as_bytes()[..n]);
-}
-
-/// The text of a NUL-padded field (invalid UTF-8 replaced, never a panic).
-pub fn get_str(buf: &[u8]) -> String {
-    let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
-    String::from_utf8_lossy(&buf[..end]).into_owned()
-}
 
 impl ControlRequest {
     /// The named axes (empty: every axis).
@@ -613,7 +370,7 @@ impl StatusFrame {
 const _: () = {
     use core::mem::{align_of, offset_of, size_of};
     assert!(
-        CONTROL_LAYOUT == 3,
+        CONTROL_LAYOUT == 4,
         "update the layout asserts together with CONTROL_LAYOUT"
     );
     assert!(size_of::<ControlRequest>() == 152 + MAX_AXES * NAME_LEN);
@@ -646,36 +403,13 @@ const _: () = {
     assert!(offset_of!(ControlResponse, data) == 64 + MESSAGE_LEN + 48 * MAX_AXES);
     assert!(size_of::<ControlResponse>() == 64 + MESSAGE_LEN + 48 * MAX_AXES + DATA_LEN);
 
-    assert!(size_of::<AxisStatusEntry>() == 232);
-    assert!(offset_of!(AxisStatusEntry, cmd_position) == 176);
-    assert!(offset_of!(AxisStatusEntry, op_id) == 184);
-    assert!(offset_of!(AxisStatusEntry, motion) == 192);
-    assert!(offset_of!(AxisStatusEntry, op_kind) == 194);
-    assert!(offset_of!(AxisStatusEntry, last_stop) == 196);
-    assert!(offset_of!(AxisStatusEntry, owner) == 200);
-    assert!(offset_of!(AxisStatusEntry, io) == 48);
-    assert!(offset_of!(AxisStatusEntry, bits) == 50);
-    assert!(offset_of!(AxisStatusEntry, drive_error_code) == 56);
-    assert!(offset_of!(AxisStatusEntry, home_mode) == 58);
-    assert!(offset_of!(AxisStatusEntry, extra) == 62);
-    assert!(offset_of!(AxisStatusEntry, position) == 64);
-    assert!(offset_of!(AxisStatusEntry, search_limit) == 128);
-
-    assert!(size_of::<IoStatusEntry>() == 256);
-    assert!(offset_of!(IoStatusEntry, frames_received) == 40);
-    assert!(offset_of!(IoStatusEntry, gaps) == 72);
-    assert!(offset_of!(IoStatusEntry, gap_cycles) == 112);
-    assert!(offset_of!(IoStatusEntry, spawn_restarts) == 120);
-    assert!(offset_of!(IoStatusEntry, spawn_retry_s) == 124);
-    assert!(offset_of!(IoStatusEntry, start_error) == 128);
-
-    assert!(size_of::<StreamStatusEntry>() == 72);
-    assert!(offset_of!(StreamStatusEntry, acquired) == 64);
-
+    const AXIS: usize = size_of::<AxisStatusEntry>();
+    const IO: usize = size_of::<IoStatusEntry>();
+    assert!(AXIS == 448 && IO == 272 && size_of::<StreamCounts>() == 72);
     assert!(offset_of!(StatusFrame, axes) == 48);
-    assert!(offset_of!(StatusFrame, ios) == 48 + 232 * MAX_AXES);
-    assert!(offset_of!(StatusFrame, stream) == 48 + 232 * MAX_AXES + 256 * MAX_IOS);
-    assert!(size_of::<StatusFrame>() == 48 + 232 * MAX_AXES + 256 * MAX_IOS + 72);
+    assert!(offset_of!(StatusFrame, ios) == 48 + AXIS * MAX_AXES);
+    assert!(offset_of!(StatusFrame, stream) == 48 + AXIS * MAX_AXES + IO * MAX_IOS);
+    assert!(size_of::<StatusFrame>() == 48 + AXIS * MAX_AXES + IO * MAX_IOS + 72);
 };
 
 #[cfg(test)]
@@ -683,11 +417,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn strings_are_bounded_and_never_panic() {
-        let mut b = [0u8; 4];
-        put_str(&mut b, "Xä€");
-        assert_eq!(get_str(&b), "Xä"); // cut at a character boundary
-        assert_eq!(get_str(&[0xff, 0xfe, 0]), "\u{fffd}\u{fffd}");
+    fn request_names_are_bounded_and_never_panic() {
         let mut r = ControlRequest::zeroed();
         assert!(r.set_axes(&["X", "Y"]));
         assert_eq!(r.axis_names(), ["X", "Y"]);

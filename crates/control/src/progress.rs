@@ -9,8 +9,8 @@ use crate::message::*;
 pub struct Progress {
     tty: bool,
     drawn: usize,
-    /// Per followed axis: (phase, bits) last printed.
-    last: Vec<(String, u16)>,
+    /// Per followed axis: (phase, the flags its line shows) last printed.
+    last: Vec<(String, u64)>,
 }
 
 impl Progress {
@@ -24,88 +24,76 @@ impl Progress {
     }
 
     fn line(a: &AxisStatusEntry) -> String {
-        let pos = if a.has(ST_FEEDBACK) {
-            format!("{:>12.4}", a.position)
-        } else {
-            format!("{:>12}", "-")
-        };
-        let state = if a.has(ST_ER) {
-            format!("ER {}/{}", a.err, a.exerr)
-        } else if a.has(ST_PC) {
+        let pos = cell(a.position());
+        let state = if a.er() {
+            format!("ER {}/{}", a.err(), a.exerr())
+        } else if a.pc() {
             "PC".to_string()
-        } else if a.has(ST_IP) {
+        } else if a.ip() {
             "IP".to_string()
-        } else if a.extra & SX_IN_SEQUENCE != 0 {
+        } else if a.in_sequence() {
             "waiting".to_string()
-        } else if a.has(ST_HOMED) {
+        } else if a.homed() {
             "homed".to_string()
         } else {
             String::new()
         };
         format!(
             "{:<10} {:<12} pos {pos}  {:>7.2} s  {state}",
-            get_str(&a.name),
-            get_str(&a.phase),
-            a.elapsed_s
+            a.name_text(),
+            a.phase_text(),
+            a.elapsed_s()
         )
     }
 
     /// A line of an operation (jog, move, stream): position, command and
     /// what the axis does.
     fn motion_line(a: &AxisStatusEntry) -> String {
-        let val = |ok: bool, x: f64| {
-            if ok && x.is_finite() {
-                format!("{x:>12.4}")
-            } else {
-                format!("{:>12}", "-")
-            }
-        };
-        let state = if a.has(ST_ER) {
-            format!("ER {}/{}", a.err, a.exerr)
-        } else if a.has(ST_STOPPING) {
+        let state = if a.er() {
+            format!("ER {}/{}", a.err(), a.exerr())
+        } else if a.stopping() {
             "stopping".to_string()
-        } else if a.motion_has(MS_JOGGING) {
-            "jogging".to_string()
-        } else if a.motion_has(MS_MOVING) {
-            "moving".to_string()
-        } else if a.motion_has(MS_STREAMING) {
-            "streaming".to_string()
-        } else if a.op_flags & OP_PC != 0 {
+        } else if let Some(what) = a.in_motion_as() {
+            what.to_string()
+        } else if a.op_pc() {
             "done".to_string()
         } else {
             "at rest".to_string()
         };
         format!(
             "{:<10} pos {}  cmd {}  {state}",
-            get_str(&a.name),
-            val(a.has(ST_FEEDBACK), a.position),
-            val(a.motion_has(MS_COMMAND), a.cmd_position),
+            a.name_text(),
+            cell(a.position()),
+            cell(a.cmd_position()),
         )
     }
 
     /// Shows the axes `members` of `st` as an operation's progress (jog,
     /// move, stream).
     pub fn show_motion(&mut self, st: &StatusFrame, members: &[usize]) {
-        self.draw(st, members, Self::motion_line, |a| {
-            a.bits & (ST_ER | ST_STOPPING) | a.motion << 8
-        });
+        let shown = motion_status::axis::mask(&["er", "stopping", "op_pc"]);
+        self.draw(
+            st,
+            members,
+            Self::motion_line,
+            shown | motion_status::axis::motion_mask(),
+        );
     }
 
     /// Shows the axes `members` of `st`.
     pub fn show(&mut self, st: &StatusFrame, members: &[usize]) {
-        self.draw(st, members, Self::line, |a| {
-            a.bits & (ST_ER | ST_PC | ST_IP | ST_HOMED)
-        });
+        let shown = motion_status::axis::mask(&["er", "pc", "ip", "in_sequence", "homed"]);
+        self.draw(st, members, Self::line, shown);
     }
 
     /// On a terminal every line redrawn in place; elsewhere a line per
-    /// axis whenever its phase or `key` bits change.
+    /// axis whenever its phase or one of the flags `shown` changes.
     fn draw(
         &mut self,
         st: &StatusFrame,
         members: &[usize],
         line: fn(&AxisStatusEntry) -> String,
-        key: fn(&AxisStatusEntry) -> u16,
+        shown: u64,
     ) {
         let mut err = std::io::stderr().lock();
         if self.tty {
@@ -122,7 +110,7 @@ impl Progress {
             }
             for (k, &i) in members.iter().enumerate() {
                 let a = &st.axes[i];
-                let key = (get_str(&a.phase), key(a));
+                let key = (a.phase_text(), a.flags & shown);
                 if key != self.last[k] {
                     let _ = writeln!(err, "{}", line(a));
                     self.last[k] = key;
@@ -130,6 +118,11 @@ impl Progress {
             }
         }
     }
+}
+
+/// A number for a progress line (`-`: no value).
+fn cell(x: Option<f64>) -> String {
+    x.map_or(format!("{:>12}", "-"), |v| format!("{v:>12.4}"))
 }
 
 impl Default for Progress {

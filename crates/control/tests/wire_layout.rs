@@ -1,25 +1,30 @@
-//! The layout description of every wire struct a client mirrors — the
+//! The layout description of every wire struct a client speaks — the
 //! control plane's messages and the setpoint frame — written from the Rust
 //! types themselves (`offset_of!`, `size_of`, `align_of`, the iceoryx2 type
-//! names) and checked in as `python/motion_supervisor_client/layout.json`.
+//! names), with the status table's rows (`motion_status::axis`: where each
+//! status field lives in an axis entry and how it is shown), and checked in
+//! as `python/motion_supervisor_client/layout.json`.
 //!
-//! The Python package compares its `ctypes` mirrors against that file field
-//! by field (`python/tests/test_layout.py`, run by `python_tests.rs`). This
+//! The Python package builds its `ctypes` classes and a property per status
+//! row from that file at import, and checks the classes against it field
+//! by field (`python/tests/test_layout.py`, run by `python_client.rs`). This
 //! test fails when the checked-in file differs from what the code produces,
-//! so the description can never go stale: change a message, bump its layout,
-//! then regenerate it with
+//! so the description can never go stale: change a message (bump its
+//! layout) or add a status row, then regenerate it with
 //!
 //! ```text
 //! MOTION_LAYOUT_WRITE=1 cargo test -p motion-control --test wire_layout
 //! ```
 //!
-//! and the Python test names every field the mirrors must follow.
+//! and the Python package follows by itself.
 
 use std::fmt::Write as _;
 
 use iceoryx2::prelude::ZeroCopySend;
 use motion_control::*;
 use motion_frames::{SetpointAxis, SetpointFrame, SETPOINT_LAYOUT, SP_VELOCITY};
+use motion_status::axis::ROWS;
+use motion_status::schema::{FLAG_BITS, INT_SLOTS, VALUE_SLOTS};
 
 /// Where the description lives, relative to this crate.
 const DESCRIPTION: &str = concat!(
@@ -59,8 +64,10 @@ by_name!(
     AxisAnswer,
     ControlResponse,
     AxisStatusEntry,
+    GapCounts,
+    IoCounters,
     IoStatusEntry,
-    StreamStatusEntry,
+    StreamCounts,
     StatusFrame,
     SetpointAxis,
     SetpointFrame
@@ -149,20 +156,20 @@ fn structs() -> Vec<Struct> {
             data_len, offset, total, cycle, token, message, axes, data,
         }),
         describe!(AxisStatusEntry, None, {
-            name, phase, io, warnings, bits, err, exerr, drive_error_code,
-            home_mode, home_sequence, home_direction, aborted_by, extra,
-            reserved1, position, raw, velocity, torque, event_raw, elapsed_s,
-            timeout_s, search_travel, search_limit, lost_after_s, skew,
-            feedback_gap_s, drift, switch_to_marker, cmd_position, op_id,
-            op_err, op_exerr, motion, op_kind, op_flags, last_stop, reserved2,
-            owner,
+            name, phase, owner, io, reserved, flags, ints, values,
+        }),
+        describe!(GapCounts, None, {
+            one, two_to_three, four_to_ten, over_ten, longest_cycles,
+        }),
+        describe!(IoCounters, None, {
+            frames_received, frames_missing, frames_refused, frames_too_old,
+            attachments, incarnations, gaps, gap_cycles,
         }),
         describe!(IoStatusEntry, None, {
-            name, attached, reserved, frames_received, frames_missing,
-            frames_refused, attachments, gaps, longest_gap_cycles, gap_cycles,
-            spawn_restarts, spawn_retry_s, start_error,
+            name, attached, reserved, spawn_restarts, spawn_retry_s, reserved2,
+            counters, start_error,
         }),
-        describe!(StreamStatusEntry, None, {
+        describe!(StreamCounts, None, {
             frames, setpoints, refused_layout, refused_key, refused_count,
             refused_token, refused_sequence, refused_axis, acquired, owners,
         }),
@@ -179,12 +186,13 @@ fn structs() -> Vec<Struct> {
 }
 
 /// The numbers a client needs besides the layouts (kinds, flags, results,
-/// reasons, status bits), by their Rust names.
+/// reasons, the status entry's room, the flags of a running operation), by
+/// their Rust names.
 fn constants() -> Vec<(&'static str, u64)> {
     macro_rules! c {
         ($($n:ident),* $(,)?) => { vec![$((stringify!($n), $n as u64)),*] };
     }
-    c![
+    let mut out = c![
         CONTROL_LAYOUT,
         SETPOINT_LAYOUT,
         NAME_LEN,
@@ -196,6 +204,9 @@ fn constants() -> Vec<(&'static str, u64)> {
         PHASE_LEN,
         NO_INDEX,
         NO_AXIS,
+        FLAG_BITS,
+        INT_SLOTS,
+        VALUE_SLOTS,
         REQ_HOME,
         REQ_STOP,
         REQ_UNHOME,
@@ -234,45 +245,37 @@ fn constants() -> Vec<(&'static str, u64)> {
         REASON_OWNED,
         REASON_TOKEN,
         REASON_OPERATION,
-        ST_EN,
-        ST_DN,
-        ST_ER,
-        ST_IP,
-        ST_PC,
-        ST_HOMING,
-        ST_HOMED,
-        ST_ENABLED,
-        ST_FAULT,
-        ST_SWITCH,
-        ST_MARKER,
-        ST_FEEDBACK,
-        ST_EVENT,
-        ST_STOPPING,
-        ST_TRACE,
-        MS_SERVO_ACTION,
-        MS_JOGGING,
-        MS_MOVING,
-        MS_STREAMING,
-        MS_LIMIT_NEGATIVE,
-        MS_LIMIT_POSITIVE,
-        MS_FAULTED,
-        MS_COMMAND,
-        OP_IP,
-        OP_PC,
-        OP_REFUSED,
-        SX_TIMED_OUT,
-        SX_LOST_HOMED,
-        SX_IN_SEQUENCE,
-        SX_LOST_FEEDBACK,
-        SX_LOST_RECONNECT,
-        SX_RESTORED,
-        SX_DRIVE_LOST,
-        W_AMBIGUOUS_MARKER,
-        W_DRIFT,
-        W_SWITCH_DRIFT,
-        W_REFERENCE_INVALIDATED,
         SP_VELOCITY,
-    ]
+    ];
+    out.push(("IN_MOTION", motion_status::axis::motion_mask()));
+    out
+}
+
+/// The status table: which field of `AxisStatusEntry` holds each row
+/// (`flags` bit, `ints` or `values` slot by type), and how to show it.
+fn status_rows(out: &mut String) {
+    *out += "  \"status\": {\"entry\": \"AxisStatusEntry\", \"rows\": [\n";
+    for (i, r) in ROWS.iter().enumerate() {
+        let comma = if i + 1 < ROWS.len() { "," } else { "" };
+        let opt = |x: Option<&str>| x.map_or("null".to_string(), quoted);
+        let names: Vec<String> = r.ty.enum_names().into_iter().map(quoted).collect();
+        let _ = writeln!(
+            out,
+            "    {{\"name\": {}, \"type\": {}, \"area\": {}, \"place\": {}, \"unit\": {}, \
+             \"json\": {}, \"mark\": {}, \"opcua\": {}, \"enum\": [{}], \"doc\": {}}}{comma}",
+            quoted(r.name),
+            quoted(r.ty.name()),
+            quoted(r.ty.area().field()),
+            r.place,
+            quoted(r.unit.symbol()),
+            quoted(r.json),
+            opt(r.mark),
+            opt(r.opcua),
+            names.join(", "),
+            quoted(&r.doc_line()),
+        );
+    }
+    *out += "  ]},\n";
 }
 
 fn quoted(s: &str) -> String {
@@ -291,7 +294,9 @@ fn description() -> String {
         let comma = if i + 1 < constants.len() { "," } else { "" };
         let _ = writeln!(out, "    {}: {value}{comma}", quoted(name));
     }
-    out += "  },\n  \"structs\": [\n";
+    out += "  },\n";
+    status_rows(&mut out);
+    out += "  \"structs\": [\n";
     let structs = structs();
     for (i, s) in structs.iter().enumerate() {
         let type_name = s.type_name.map_or("null".to_string(), quoted);

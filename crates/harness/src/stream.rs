@@ -5,7 +5,7 @@
 //! `motion_control`'s [`Stream`](motion_control::stream::Stream) — the
 //! Rust client a program uses, so what is measured is what a program sees.
 
-use motion_control::{Axes, Client, Request, MS_SERVO_ACTION, RESULT_ACCEPTED, ST_HOMED};
+use motion_control::{Axes, Client, Request, RESULT_ACCEPTED};
 use motion_rt::{enter_realtime, now_ns, PeriodicTimer, RtConfig};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -36,8 +36,7 @@ pub fn home_and_enable(prefix: &str, n: usize) -> Result<(), String> {
         let st = c
             .status(Duration::from_secs(2))
             .map_err(|e| e.to_string())?;
-        let ready =
-            (st.axes().iter().take(n)).all(|a| a.has(ST_HOMED) && a.motion_has(MS_SERVO_ACTION));
+        let ready = (st.axes().iter().take(n)).all(|a| a.homed() && a.servo_action());
         if ready {
             return Ok(());
         }

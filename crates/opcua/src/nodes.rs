@@ -66,10 +66,10 @@ pub fn build(space: &mut AddressSpace, ns: u16, m: &MachineConfig, cfg: &OpcuaCo
         .has_type_definition(ObjectTypeId::BaseObjectType)
         .insert(space);
         let unit = cfg.unit_of(&a.name);
-        for v in AXIS_LIVE {
+        for v in AXIS_LIVE.iter() {
             let vid = axis_var_id(ns, &a.name, v.name);
             variable(space, ns, &obj, &vid_path(&vid), v.name, v.data_type, None);
-            if let Some(names) = v.enum_names {
+            if let Some(names) = &v.enum_names {
                 enum_strings(space, ns, &vid, names);
             }
             units_of(space, ns, &vid, v.kind, unit);
@@ -216,7 +216,7 @@ fn units_of(
 }
 
 /// `EnumStrings` of a CIP enumeration (its numbers index them).
-fn enum_strings(space: &mut AddressSpace, _ns: u16, of: &NodeId, names: EnumNames) {
+fn enum_strings(space: &mut AddressSpace, _ns: u16, of: &NodeId, names: &[&str]) {
     let texts: Vec<LocalizedText> = names.iter().map(|n| LocalizedText::new("", n)).collect();
     property(
         space,

@@ -1,8 +1,9 @@
-//! What the address space holds, as tables: the variables of an axis, of an
-//! I/O process and of the latency statistics, each with its type, unit kind
-//! and where its value comes from. [`crate::nodes`] builds the nodes from
-//! these tables and [`crate::values`] fills them, so a variable is named
-//! once.
+//! What the address space holds, as tables: the variables of an axis (its
+//! live ones are the status table's rows that have an OPC UA name, from
+//! `motion_status::axis`), of an I/O process and of the latency
+//! statistics, each with its type, unit kind and where its value comes
+//! from. [`crate::nodes`] builds the nodes from these tables and
+//! [`crate::values`] fills them, so a variable is named once.
 //!
 //! Node ids are strings in the namespace `urn:motion-supervisor`:
 //! `Machine`, `Machine.Axes.X`, `Machine.Axes.X.HomedStatus`,
@@ -12,7 +13,10 @@
 
 use motion_config::AxisEntry;
 use motion_control::*;
+use motion_status::axis::Reading;
+use motion_status::{Row, Type, Unit};
 use opcua::types::{DataTypeId, NodeId, Variant};
+use std::sync::LazyLock;
 
 /// The namespace of every node of ours (interface.md).
 pub const NAMESPACE_URI: &str = "urn:motion-supervisor";
@@ -67,149 +71,91 @@ pub enum Kind {
     Micros,
 }
 
-/// A CIP enumeration shown as a MultiStateDiscrete variable (its
-/// `EnumStrings` give the names).
-pub type EnumNames = &'static [&'static str];
-
-pub const HOME_MODES: EnumNames = &["passive", "active", "absolute"];
-pub const HOME_SEQUENCES: EnumNames = &[
-    "immediate",
-    "switch",
-    "marker",
-    "switch_then_marker",
-    "torque",
-    "torque_then_marker",
-];
-pub const HOME_DIRECTIONS: EnumNames = &[
-    "unidirectional_forward",
-    "bidirectional_forward",
-    "unidirectional_reverse",
-    "bidirectional_reverse",
-];
-
 /// A variable of an axis that follows the status frame. `None` from
-/// `read` means "no valid value now" (no fresh feedback): the variable's
-/// status turns Bad.
+/// [`LiveVar::read`] means "no valid value now" (no fresh feedback, nothing
+/// latched): the variable's status turns Bad.
 pub struct LiveVar {
     pub name: &'static str,
     pub data_type: DataTypeId,
     pub kind: Kind,
-    pub enum_names: Option<EnumNames>,
-    pub read: fn(&AxisStatusEntry, &[String]) -> Option<Variant>,
+    /// A CIP enumeration shown as a MultiStateDiscrete variable: its
+    /// `EnumStrings`, indexed by its number.
+    pub enum_names: Option<Vec<&'static str>>,
+    source: Source,
 }
 
-fn bit(a: &AxisStatusEntry, b: u16) -> Option<Variant> {
-    Some(Variant::from(a.has(b)))
+/// Where a live variable's value comes from.
+enum Source {
+    /// A row of the status table.
+    Row(&'static Row),
+    /// A text made from the entry (`names`: every axis's name).
+    Text(fn(&AxisStatusEntry, &[String]) -> String),
 }
 
-fn fb(a: &AxisStatusEntry, x: f64) -> Option<Variant> {
-    (a.has(ST_FEEDBACK) && x.is_finite()).then_some(Variant::from(x))
-}
+impl LiveVar {
+    /// The variable of a status table row.
+    fn row(r: &'static Row) -> Option<Self> {
+        let (data_type, enum_names) = match r.ty {
+            Type::Flag => (DataTypeId::Boolean, None),
+            Type::Value | Type::Maybe => (DataTypeId::Double, None),
+            Type::U16 => (DataTypeId::UInt16, None),
+            Type::U32 => (DataTypeId::UInt32, None),
+            Type::Enum(_) => (DataTypeId::Byte, Some(r.ty.enum_names())),
+        };
+        let kind = match r.unit {
+            Unit::None => Kind::Plain,
+            Unit::Units => Kind::Position,
+            Unit::UnitsPerSecond => Kind::Speed,
+            Unit::Percent => Kind::Torque,
+            Unit::Seconds => Kind::Seconds,
+        };
+        Some(Self {
+            name: r.opcua?,
+            data_type,
+            kind,
+            enum_names,
+            source: Source::Row(r),
+        })
+    }
 
-macro_rules! live {
-    ($name:literal, Boolean, $bit:ident) => {
-        LiveVar {
-            name: $name,
-            data_type: DataTypeId::Boolean,
+    fn text(name: &'static str, read: fn(&AxisStatusEntry, &[String]) -> String) -> Self {
+        Self {
+            name,
+            data_type: DataTypeId::String,
             kind: Kind::Plain,
             enum_names: None,
-            read: |a, _| bit(a, $bit),
+            source: Source::Text(read),
         }
-    };
-    ($name:literal, $dt:ident, $kind:ident, $read:expr) => {
-        LiveVar {
-            name: $name,
-            data_type: DataTypeId::$dt,
-            kind: Kind::$kind,
-            enum_names: None,
-            read: $read,
+    }
+
+    /// The value in entry `a` (`names`: every axis's name).
+    pub fn read(&self, a: &AxisStatusEntry, names: &[String]) -> Option<Variant> {
+        match &self.source {
+            Source::Text(f) => Some(Variant::from(f(a, names))),
+            Source::Row(r) => match (a.reading(r), r.ty) {
+                (Reading::Flag(b), _) => Some(Variant::from(b)),
+                (Reading::Number(x), _) => x.map(Variant::from),
+                (Reading::Int(n), Type::U16) => Some(Variant::from(n as u16)),
+                (Reading::Int(n), Type::Enum(_)) => Some(Variant::from(n as u8)),
+                (Reading::Int(n), _) => Some(Variant::from(n)),
+            },
         }
-    };
-    ($name:literal, enum $names:ident, $read:expr) => {
-        LiveVar {
-            name: $name,
-            data_type: DataTypeId::Byte,
-            kind: Kind::Plain,
-            enum_names: Some($names),
-            read: $read,
-        }
-    };
+    }
 }
 
-/// Every live variable of an axis, named after the CIP attributes and bits.
-pub const AXIS_LIVE: &[LiveVar] = &[
-    live!("HomingStatus", Boolean, ST_HOMING),
-    live!("HomedStatus", Boolean, ST_HOMED),
-    live!("EN", Boolean, ST_EN),
-    live!("DN", Boolean, ST_DN),
-    live!("ER", Boolean, ST_ER),
-    live!("IP", Boolean, ST_IP),
-    live!("PC", Boolean, ST_PC),
-    live!("ERR", UInt16, Plain, |a, _| Some(Variant::from(a.err))),
-    live!("EXERR", UInt16, Plain, |a, _| Some(Variant::from(a.exerr))),
-    live!("Phase", String, Plain, |a, _| Some(Variant::from(get_str(
-        &a.phase
-    )))),
-    live!("ActualPosition", Double, Position, |a, _| fb(a, a.position)),
-    live!("RawPosition", Double, Position, |a, _| fb(a, a.raw)),
-    live!("ActualVelocity", Double, Speed, |a, _| fb(a, a.velocity)),
-    live!("ActualTorque", Double, Torque, |a, _| fb(a, a.torque)),
-    live!("HomeSwitch", Boolean, ST_SWITCH),
-    live!("Marker", Boolean, ST_MARKER),
-    live!("DriveEnabled", Boolean, ST_ENABLED),
-    live!("DriveFault", Boolean, ST_FAULT),
-    live!("DriveErrorCode", UInt16, Plain, |a, _| Some(Variant::from(
-        a.drive_error_code
-    ))),
-    live!("Stopping", Boolean, ST_STOPPING),
-    live!("EventPosition", Double, Position, |a, _| {
-        (a.has(ST_EVENT) && a.event_raw.is_finite()).then_some(Variant::from(a.event_raw))
-    }),
-    live!("HomingElapsed", Double, Seconds, |a, _| Some(
-        Variant::from(a.elapsed_s)
-    )),
-    live!("Restored", Boolean, Plain, |a, _| Some(Variant::from(
-        a.extra & SX_RESTORED != 0
-    ))),
-    live!("Message", String, Plain, |a, names| Some(Variant::from(
-        a.error_text(names).unwrap_or_default()
-    ))),
-    live!("Warnings", String, Plain, |a, _| Some(Variant::from(
-        a.warning_texts().join("; ")
-    ))),
-    live!("HomeMode", enum HOME_MODES, |a, _| Some(Variant::from(a.home_mode))),
-    live!("HomeSequence", enum HOME_SEQUENCES, |a, _| Some(Variant::from(a.home_sequence))),
-    live!("HomeDirection", enum HOME_DIRECTIONS, |a, _| Some(Variant::from(a.home_direction))),
-    // The operations' status (issue 15): MSO/MAJ/MAM's bits, the limit
-    // switches, the commanded position.
-    live!("ServoActionStatus", Boolean, Plain, |a, _| motion(
-        a,
-        MS_SERVO_ACTION
-    )),
-    live!("JogStatus", Boolean, Plain, |a, _| motion(a, MS_JOGGING)),
-    live!("MoveStatus", Boolean, Plain, |a, _| motion(a, MS_MOVING)),
-    live!("StreamStatus", Boolean, Plain, |a, _| motion(
-        a,
-        MS_STREAMING
-    )),
-    live!("AxisFault", Boolean, Plain, |a, _| motion(a, MS_FAULTED)),
-    live!("NegativeOvertravel", Boolean, Plain, |a, _| motion(
-        a,
-        MS_LIMIT_NEGATIVE
-    )),
-    live!("PositiveOvertravel", Boolean, Plain, |a, _| motion(
-        a,
-        MS_LIMIT_POSITIVE
-    )),
-    live!("CommandPosition", Double, Position, |a, _| {
-        (a.motion & MS_COMMAND != 0 && a.cmd_position.is_finite())
-            .then_some(Variant::from(a.cmd_position))
-    }),
-];
-
-fn motion(a: &AxisStatusEntry, bit: u16) -> Option<Variant> {
-    Some(Variant::from(a.motion & bit != 0))
-}
+/// Every live variable of an axis: each status table row with an OPC UA
+/// name (named after the CIP attributes and bits), then the texts.
+pub static AXIS_LIVE: LazyLock<Vec<LiveVar>> = LazyLock::new(|| {
+    let rows = motion_status::axis::ROWS.iter().filter_map(LiveVar::row);
+    rows.chain([
+        LiveVar::text("Phase", |a, _| a.phase_text()),
+        LiveVar::text("Message", |a, names| {
+            a.error_text(names).unwrap_or_default()
+        }),
+        LiveVar::text("Warnings", |a, _| a.warning_texts().join("; ")),
+    ])
+    .collect()
+});
 
 /// A configured attribute of an axis (from the machine config, which the
 /// daemon runs with; constant while it runs).
@@ -266,16 +212,24 @@ pub const IO_VARS: &[IoVar] = &[
         data_type: DataTypeId::Boolean,
         read: |i| Variant::from(i.attached != 0),
     },
-    io_var!("FramesReceived", |i| Variant::from(i.frames_received)),
-    io_var!("FramesMissing", |i| Variant::from(i.frames_missing)),
-    io_var!("FramesRefused", |i| Variant::from(i.frames_refused)),
-    io_var!("Attachments", |i| Variant::from(i.attachments)),
-    io_var!("Gaps1", |i| Variant::from(i.gaps[0])),
-    io_var!("Gaps2To3", |i| Variant::from(i.gaps[1])),
-    io_var!("Gaps4To10", |i| Variant::from(i.gaps[2])),
-    io_var!("GapsOver10", |i| Variant::from(i.gaps[3])),
-    io_var!("LongestGapCycles", |i| Variant::from(i.longest_gap_cycles)),
-    io_var!("GapCycles", |i| Variant::from(i.gap_cycles)),
+    io_var!("FramesReceived", |i| Variant::from(
+        i.counters.frames_received
+    )),
+    io_var!("FramesMissing", |i| Variant::from(
+        i.counters.frames_missing
+    )),
+    io_var!("FramesRefused", |i| Variant::from(
+        i.counters.frames_refused
+    )),
+    io_var!("Attachments", |i| Variant::from(i.counters.attachments)),
+    io_var!("Gaps1", |i| Variant::from(i.counters.gaps.one)),
+    io_var!("Gaps2To3", |i| Variant::from(i.counters.gaps.two_to_three)),
+    io_var!("Gaps4To10", |i| Variant::from(i.counters.gaps.four_to_ten)),
+    io_var!("GapsOver10", |i| Variant::from(i.counters.gaps.over_ten)),
+    io_var!("LongestGapCycles", |i| Variant::from(
+        i.counters.gaps.longest_cycles
+    )),
+    io_var!("GapCycles", |i| Variant::from(i.counters.gap_cycles)),
 ];
 
 /// The latency series (`Machine.Latency.<series>.<column>`, µs) and their
@@ -300,6 +254,14 @@ mod tests {
     #[test]
     fn names_are_unique_and_cover_the_spec() {
         let mut names: Vec<&str> = AXIS_LIVE.iter().map(|v| v.name).collect();
+        let published = motion_status::axis::ROWS
+            .iter()
+            .filter(|r| r.opcua.is_some());
+        assert_eq!(
+            AXIS_LIVE.len(),
+            published.count() + 3,
+            "every named row, and the texts"
+        );
         names.extend(AXIS_CONFIG.iter().map(|v| v.name));
         let n = names.len();
         names.sort();
@@ -313,6 +275,15 @@ mod tests {
         for i in ["ERR", "EXERR"] {
             let v = AXIS_LIVE.iter().find(|v| v.name == i).unwrap();
             assert_eq!(v.data_type, DataTypeId::UInt16, "{i}");
+        }
+        let modes = AXIS_LIVE.iter().find(|v| v.name == "HomeMode").unwrap();
+        assert_eq!(
+            modes.enum_names.as_deref(),
+            Some(&["passive", "active", "absolute"][..])
+        );
+        for t in ["Phase", "Message", "Warnings"] {
+            let v = AXIS_LIVE.iter().find(|v| v.name == t).unwrap();
+            assert_eq!(v.data_type, DataTypeId::String, "{t}");
         }
         for d in ["ActualPosition", "ActualVelocity"] {
             let v = AXIS_LIVE.iter().find(|v| v.name == d).unwrap();
@@ -347,18 +318,20 @@ mod tests {
 
     #[test]
     fn feedback_values_need_fresh_feedback() {
-        let mut a = AxisStatusEntry {
-            position: 1.5,
-            ..Default::default()
-        };
+        let mut a = AxisStatusEntry::default();
         let pos = AXIS_LIVE
             .iter()
             .find(|v| v.name == "ActualPosition")
             .unwrap();
-        assert!((pos.read)(&a, &[]).is_none());
-        a.bits |= ST_FEEDBACK;
-        assert_eq!((pos.read)(&a, &[]), Some(Variant::from(1.5)));
-        a.position = f64::NAN;
-        assert!((pos.read)(&a, &[]).is_none(), "never a NaN reading");
+        assert!(pos.read(&a, &[]).is_none(), "no feedback: no value");
+        let slot = AxisStatusEntry::row("position").unwrap().place as usize;
+        a.values[slot] = 1.5;
+        assert_eq!(pos.read(&a, &[]), Some(Variant::from(1.5)));
+        a.values[slot] = f64::INFINITY;
+        assert!(pos.read(&a, &[]).is_none(), "never a non-finite reading");
+        let homed = AXIS_LIVE.iter().find(|v| v.name == "HomedStatus").unwrap();
+        assert_eq!(homed.read(&a, &[]), Some(Variant::from(false)));
+        a.flags = motion_status::axis::mask(&["homed"]);
+        assert_eq!(homed.read(&a, &[]), Some(Variant::from(true)));
     }
 }

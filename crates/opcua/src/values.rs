@@ -120,13 +120,13 @@ impl<T: InMemoryNodeManagerImpl> Publisher<T> {
                     .collect()
             });
             for (v, id) in AXIS_LIVE.iter().zip(ids.iter()) {
-                Self::put(&mut self.last, &mut out, id, (v.read)(a, &names), t);
+                Self::put(&mut self.last, &mut out, id, v.read(a, &names), t);
             }
-            let er = a.has(ST_ER);
+            let er = a.er();
             let was = self.er.insert(name.clone(), er).unwrap_or(er);
             if er && !was {
                 let msg = a.error_text(&names).unwrap_or_else(|| "ER".into());
-                let ev = events::axis_error(ns, name, a.err, a.exerr, &msg, t);
+                let ev = events::axis_error(ns, name, a.err(), a.exerr(), &msg, t);
                 events::raise(&self.subs, ns, name, &ev);
             }
         }

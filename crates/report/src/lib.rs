@@ -5,10 +5,10 @@
 //!
 //! * [`latency`] — percentiles of the three latencies (`home`/`run`/`stats`).
 //! * [`home`] — `home --json`: one row per axis (interface.md).
-//! * [`status`] — `status --json`: the live state of every axis and I/O process.
+//! * [`status`] — `status --json`: the live state of every axis and I/O
+//!   process (its rows generated from `motion-status`'s table).
 //! * [`io`] — per I/O process: attached, frames, gaps by length.
-//! * [`motion`] — `move --json` / `stream --json`, and the operation part of
-//!   the status.
+//! * [`motion`] — `move --json` / `stream --json`.
 //! * [`errors`] — `{"errors": [...]}`, printed on every failure with `--json`
 //!   (also for a refused command line).
 //! * [`codes`] — ERR/EXERR in plain words.
@@ -33,10 +33,10 @@ pub use home::{
     AcceptedReport, Allocations, AxisResult, CheckReport, CpuUse, CtlHomeReport, HomeReport,
     RtInfo, RunReport, StatsReport, TraceReport,
 };
-pub use io::{GapCounts, IoReport};
+pub use io::{GapCounts, IoCounters, IoReport};
 pub use latency::{LateWakeup, Latency, Percentiles};
-pub use motion::{MotionReport, MotionRow, OpReport, StreamIntake};
-pub use status::{AxisStatus, IoStatus, StatusReport};
+pub use motion::{MotionReport, MotionRow};
+pub use status::{AxisStatus, IoStatus, StatusReport, StreamIntake};
 pub use trace::TraceRow;
 
 /// Rounds to `digits` decimals for printing (JSON keeps what a reader can use,

@@ -1,5 +1,5 @@
-//! `move --json` and `stream --json` (interface.md): one row per axis, how
-//! its operation ended; and the operation part of `status --json`.
+//! `move --json` and `stream --json`: one row per axis, how its operation
+//! ended.
 
 use serde::{Deserialize, Serialize};
 
@@ -39,34 +39,4 @@ impl MotionReport {
     pub fn succeeded(&self) -> bool {
         !self.axes.is_empty() && self.axes.iter().all(|r| r.pc && !r.er)
     }
-}
-
-/// The last operation of an axis, in `status --json`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct OpReport {
-    /// Incremented by the engine for every accepted operation (0: none yet).
-    pub id: u32,
-    /// `enable`, `disable`, `reset`, `jog`, `move`, `stream`, `stop`, or
-    /// `none`.
-    pub kind: String,
-    pub ip: bool,
-    pub pc: bool,
-    /// ERR / EXERR of a refusal (0 / 0 when accepted).
-    pub err: u16,
-    pub exerr: u16,
-}
-
-/// The setpoint stream's intake, in `status --json`.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct StreamIntake {
-    pub frames: u64,
-    pub setpoints: u64,
-    pub refused_layout: u64,
-    pub refused_key: u64,
-    pub refused_count: u64,
-    pub refused_token: u64,
-    pub refused_sequence: u64,
-    pub refused_axis: u64,
-    pub acquired: u32,
-    pub owners: u32,
 }

@@ -91,15 +91,15 @@ fn opt(x: Option<f64>, width: usize) -> String {
     }
 }
 
+/// The width of the first column: the longest axis name (at least the
+/// header's "axis"), and two spaces.
+fn name_width<'a>(names: impl Iterator<Item = &'a str>) -> usize {
+    names.map(|n| n.chars().count()).max().unwrap_or(4).max(4) + 2
+}
+
 /// One row per axis, as `home` prints it; errors and warnings on a line below.
 pub fn axis_results(rows: &[AxisResult]) -> String {
-    let w = rows
-        .iter()
-        .map(|r| r.name.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4)
-        + 2;
+    let w = name_width(rows.iter().map(|r| r.name.as_str()));
     let mut s = format!(
         "{:<w$}{:<8}{:<20}{:<24}{:>4}{:>4}{:>10}{:>7}{:>12}{:>12}{:>12}{:>9}\n",
         "axis",
@@ -147,31 +147,25 @@ pub fn axis_results(rows: &[AxisResult]) -> String {
     s
 }
 
-/// `status` as text: one line per axis, one per I/O process.
+/// `status` as text: one line per axis, one per I/O process. The flags
+/// column is the status table's marks (`motion_status::axis`: each marked
+/// flag's mark when set, dots when not; the legend is `docs/status.md`).
 pub fn status(r: &crate::StatusReport) -> String {
-    let w = r
-        .axes
-        .iter()
-        .map(|a| a.name.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4)
-        + 2;
-    let b = |x: bool, c: &'static str| if x { c } else { "." };
+    let w = name_width(r.axes.iter().map(|a| a.name.as_str()));
+    let every = crate::AxisStatus::marks_header();
+    let fw = every.chars().count() + 2;
     let mut s = format!(
-        "{:<w$}{:<8}{:<13}{:<15}{:<9}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8} {:<3}{:>17} {:>19}\n",
+        "{:<w$}{:<8}{:<13}{:<fw$}{:>7}{:>10}{:>12}{:>12}{:>10}{:>8}{:>18} {:>19}\n",
         "axis",
         "io",
         "phase",
-        "EN DN ER IP PC",
-        "SJMTxF-+",
+        every,
         "homed",
         "ERR/EXERR",
         "position",
         "raw",
         "velocity",
         "torque",
-        "in",
         "elapsed/timeout s",
         "travel/limit"
     );
@@ -180,16 +174,11 @@ pub fn status(r: &crate::StatusReport) -> String {
             x.map_or(format!("{:>width$}", "-"), |v| format!("{v:>width$.p$}"))
         };
         s += &format!(
-            "{:<w$}{:<8}{:<13}{} {} {} {} {}  {:<9}{:>7}{:>10}{}{}{}{} {}{}{:>17} {:>19}\n",
+            "{:<w$}{:<8}{:<13}{:<fw$}{:>7}{:>10}{}{}{}{}{:>18} {:>19}\n",
             a.name,
             a.io,
             a.phase,
-            b(a.en, "EN"),
-            b(a.dn, "DN"),
-            b(a.er, "ER"),
-            b(a.ip, "IP"),
-            b(a.pc, "PC"),
-            motion_flags(a),
+            a.marks(),
             match (a.homed, a.restored) {
                 (true, true) => "stored",
                 (true, false) => "yes",
@@ -200,8 +189,6 @@ pub fn status(r: &crate::StatusReport) -> String {
             f(a.raw, 4, 12),
             f(a.velocity, 3, 10),
             f(a.torque, 1, 8),
-            if a.switch { "S" } else { "." },
-            if a.marker { "M " } else { ". " },
             format!(
                 "{:.2}/{}",
                 a.elapsed_s,
@@ -227,31 +214,32 @@ pub fn status(r: &crate::StatusReport) -> String {
         if let Some(o) = &a.owner {
             s += &format!("  └ owned by {o} (setpoint stream)\n");
         }
-        if a.op.err != 0 {
+        if a.op_err != 0 {
             s += &format!(
                 "  └ last operation refused: ERR {} EXERR {}: {}\n",
-                a.op.err,
-                a.op.exerr,
-                crate::codes::explain(a.op.err, a.op.exerr)
+                a.op_err,
+                a.op_exerr,
+                crate::codes::explain(a.op_err, a.op_exerr)
             );
         }
     }
     for io in &r.io {
+        let c = &io.counters;
         s += &format!(
             "I/O {}: {}; frames {} received, {} missing, {} refused; attached {} time(s); gaps 1: {}, 2-3: {}, 4-10: {}, >10: {}, longest {} cycles{}\n",
             io.name,
             if io.attached { "attached" } else { "NOT attached" },
-            io.frames_received,
-            io.frames_missing,
-            io.frames_refused,
-            io.attachments,
-            io.gaps.one,
-            io.gaps.two_to_three,
-            io.gaps.four_to_ten,
-            io.gaps.over_ten,
-            io.gaps.longest_cycles,
-            if io.gap_cycles > 0 {
-                format!(", now {} cycles without an answer", io.gap_cycles)
+            c.frames_received,
+            c.frames_missing,
+            c.frames_refused,
+            c.attachments,
+            c.gaps.one,
+            c.gaps.two_to_three,
+            c.gaps.four_to_ten,
+            c.gaps.over_ten,
+            c.gaps.longest_cycles,
+            if c.gap_cycles > 0 {
+                format!(", now {} cycles without an answer", c.gap_cycles)
             } else {
                 String::new()
             }
@@ -262,13 +250,7 @@ pub fn status(r: &crate::StatusReport) -> String {
 
 /// One row per axis, as `move`, `jog` and `stream` print how they ended.
 pub fn motion_rows(rows: &[crate::MotionRow]) -> String {
-    let w = rows
-        .iter()
-        .map(|r| r.name.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4)
-        + 2;
+    let w = name_width(rows.iter().map(|r| r.name.as_str()));
     let mut s = format!(
         "{:<w$}{:>4}{:>4}{:>10}{:>12}{:>14}{:>12}\n",
         "axis", "PC", "ER", "ERR/EXERR", "position", "follow err max", "final err"
@@ -290,25 +272,6 @@ pub fn motion_rows(rows: &[crate::MotionRow]) -> String {
         }
     }
     s
-}
-
-/// The operation bits of an axis in eight characters (`.` = off):
-/// ServoActionStatus `S`, jogging `J`, moving `M`, streaming `T`, stopping
-/// `x`, faulted `F`, negative / positive limit switch `-` / `+`.
-fn motion_flags(a: &crate::AxisStatus) -> String {
-    [
-        (a.servo_action, 'S'),
-        (a.jogging, 'J'),
-        (a.moving, 'M'),
-        (a.streaming, 'T'),
-        (a.stopping, 'x'),
-        (a.faulted, 'F'),
-        (a.limit_negative, '-'),
-        (a.limit_positive, '+'),
-    ]
-    .iter()
-    .map(|&(on, c)| if on { c } else { '.' })
-    .collect()
 }
 
 #[cfg(test)]

@@ -14,8 +14,6 @@
 use crate::stats::HistSet;
 use crossbeam::queue::ArrayQueue;
 use motion_frames::MAX_AXES;
-use motion_homing::Status;
-use motion_report::GapCounts;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 
 /// Most I/O processes (the config's limit).
@@ -169,93 +167,9 @@ pub struct TraceRecord {
     pub exerr: u16,
 }
 
-/// Why HomedStatus was lost after a homing had set it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LostCause {
-    /// Another reason (invalid or implausible feedback, a shutdown), or
-    /// none known.
-    #[default]
-    Other,
-    /// The feedback-loss rule tripped (or the I/O process detached).
-    Feedback,
-    /// The I/O process reconnected (restarted or attached again).
-    Reconnect,
-}
-
-/// One axis as the reporting side sees it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct AxisSnap {
-    pub status: motion_homing::Status,
-    /// Raw and axis position from the newest valid feedback.
-    pub raw: Option<f64>,
-    pub axis: Option<f64>,
-    /// From the newest valid feedback.
-    pub velocity: f64,
-    pub torque: f64,
-    pub switch: bool,
-    pub marker: bool,
-    pub enabled: bool,
-    pub fault: bool,
-    pub drive_error_code: u16,
-    /// Fresh feedback this cycle.
-    pub fresh: bool,
-    pub cmd_position: f64,
-    pub cmd_velocity: f64,
-    pub enable: bool,
-    /// Home requests the engine has been given (rising edges applied).
-    pub homes_started: u32,
-    /// The home sequence this axis was part of was aborted because this
-    /// axis (index) failed.
-    pub aborted_by: Option<u8>,
-    /// The sequence's `timeout_ns` ran out and the axis was stopped.
-    pub timed_out: bool,
-    /// A gantry side: the largest skew of its gantry's last homing, units.
-    pub skew: Option<f64>,
-    /// A sequence has started, or will start, this axis.
-    pub in_sequence: bool,
-    /// A trace of this axis's next homing is armed or recording.
-    pub traced: bool,
-    /// HomedStatus was lost after the last homing succeeded: when (ns), and
-    /// why.
-    pub lost_homed_ns: Option<u64>,
-    pub lost_cause: LostCause,
-    /// The raw → axis offset while homed.
-    pub offset: Option<f64>,
-    /// HomedStatus comes from a stored reference (absolute axis, restored
-    /// without motion), not from a homing run since start-up.
-    pub restored: bool,
-    /// The owner token of the setpoint stream that owns the axis (0: none).
-    pub owner: u64,
-    /// This cycle's command position in axis coordinates.
-    pub cmd_axis: Option<f64>,
-}
-
-impl AxisSnap {
-    /// Homing finished (either way) and the axis is at rest.
-    pub fn settled(&self) -> bool {
-        let s: &Status = &self.status;
-        !s.ip && !s.stopping && (s.dn || s.er) && self.cmd_velocity == 0.0
-    }
-}
-
-/// One I/O process as the reporting side sees it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct IoSnap {
-    pub attached: bool,
-    /// Cycles with a fresh, accepted frame / without one.
-    pub frames_received: u64,
-    pub frames_missing: u64,
-    /// Refused: layout, axis count, key, answer from the future.
-    pub frames_refused: u64,
-    /// Answered a command outside the accepted window.
-    pub frames_too_old: u64,
-    pub attachments: u64,
-    /// Times a new incarnation (restart) of the process was seen.
-    pub restarts: u64,
-    pub gaps: GapCounts,
-    /// Current gap, cycles.
-    pub gap_cycles: u64,
-}
+// What the status shows of an axis and of an I/O process: the status
+// table's source types (`motion-status`), next to the table they feed.
+pub use motion_status::{AxisSnap, IoSnap, LostCause, StreamCounts};
 
 #[derive(Clone, Debug)]
 pub struct Snapshot {
@@ -269,9 +183,8 @@ pub struct Snapshot {
     pub all_at_rest: bool,
     /// The supervisor is leaving (axes stopped, drives disabled).
     pub exiting: bool,
-    /// The setpoint stream's intake: frames, setpoints, refusals; owners.
+    /// The setpoint stream's intake: frames, setpoints, refusals, owners.
     pub stream: StreamCounts,
-    pub owners: u32,
 }
 
 impl Default for Snapshot {
@@ -286,7 +199,6 @@ impl Default for Snapshot {
             all_at_rest: true,
             exiting: false,
             stream: Default::default(),
-            owners: 0,
         }
     }
 }
@@ -296,24 +208,6 @@ impl Snapshot {
     pub fn all_attached(&self) -> bool {
         self.ios[..self.io_count].iter().all(|i| i.attached)
     }
-}
-
-/// The setpoint stream's intake counters (since start), kept by the
-/// cycle's intake (`core::stream`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct StreamCounts {
-    /// Frames that reached the checks.
-    pub frames: u64,
-    /// Setpoints handed to engines (a gantry's counts once).
-    pub setpoints: u64,
-    pub refused_layout: u64,
-    pub refused_key: u64,
-    pub refused_count: u64,
-    pub refused_token: u64,
-    pub refused_sequence: u64,
-    pub refused_axis: u64,
-    /// Streams granted since start.
-    pub acquired: u32,
 }
 
 /// Lifecycle of the real-time thread.

@@ -13,7 +13,7 @@ use motion_bench::drive::{self, Binaries};
 use motion_bench::machine::{streamed_names, streamed_with};
 use motion_bench::outcome::Bench;
 use motion_bench::stream::{home_and_enable, Streamer};
-use motion_control::{Client, MS_COMMAND, MS_STREAMING, ST_FEEDBACK};
+use motion_control::Client;
 use motion_report::nearest_rank as pct;
 use serde::Serialize;
 use std::time::{Duration, Instant};
@@ -87,17 +87,16 @@ fn measure(o: &Opts, prefix: &str) -> Result<Circle, String> {
             continue;
         }
         last = st.sequence;
-        let a = &st.axes()[..2];
-        let ok = a
-            .iter()
-            .all(|e| e.has(ST_FEEDBACK) && e.motion_has(MS_COMMAND) && e.motion_has(MS_STREAMING));
-        if !ok {
+        // (command, actual) of an axis while it streams.
+        let pair = |e: &motion_control::AxisStatusEntry| {
+            e.cmd_position().zip(e.position()).filter(|_| e.streaming())
+        };
+        let (Some((c0, p0)), Some((c1, p1))) = (pair(&st.axes()[0]), pair(&st.axes()[1])) else {
             continue;
-        }
-        for k in 0..2 {
-            fe[k].push((a[k].cmd_position - a[k].position).abs());
-        }
-        let (x, y) = (a[0].position + r, a[1].position);
+        };
+        fe[0].push((c0 - p0).abs());
+        fe[1].push((c1 - p1).abs());
+        let (x, y) = (p0 + r, p1);
         contour.push(((x * x + y * y).sqrt() - r).abs());
     }
     streamer.finish()?;

@@ -77,7 +77,7 @@ fn hold(
             let over = axes.iter().all(|x| {
                 st.axes()
                     .get(x.index)
-                    .is_none_or(|e| e.op_id != x.op_id || !e.motion_has(MS_JOGGING))
+                    .is_none_or(|e| e.op_id() != x.op_id || !e.in_motion())
             });
             if over {
                 return Ok(());

@@ -183,13 +183,10 @@ impl Play {
             let Some(e) = st.axes().get(f.index) else {
                 continue;
             };
-            if e.has(ST_FEEDBACK) && e.motion_has(MS_COMMAND) {
-                let err = (e.cmd_position - e.position).abs();
-                if err.is_finite() {
-                    self.max_error[k] = self.max_error[k].max(err);
-                }
+            if let (Some(cmd), Some(pos)) = (e.cmd_position(), e.position()) {
+                self.max_error[k] = self.max_error[k].max((cmd - pos).abs());
             }
-            if st.cycle > s.answer().cycle && !e.motion_has(MS_STREAMING) {
+            if st.cycle > s.answer().cycle && !e.streaming() {
                 streaming = false;
             }
         }

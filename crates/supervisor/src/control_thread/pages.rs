@@ -130,23 +130,8 @@ impl ControlThread {
 
 /// Per I/O process, for the reports.
 pub fn io_reports(m: &MachineConfig, s: &crate::shared::Snapshot) -> Vec<IoReport> {
-    let cycle_ms = f64::from(m.supervisor.cycle_us) / 1000.0;
-    m.ios
-        .iter()
-        .enumerate()
-        .map(|(k, io)| {
-            let x = s.ios[k];
-            IoReport {
-                name: io.name.clone(),
-                attached: x.attached,
-                frames_received: x.frames_received,
-                frames_missing: x.frames_missing,
-                frames_refused: x.frames_refused,
-                frames_too_old: x.frames_too_old,
-                attachments: x.attachments,
-                longest_gap_ms: x.gaps.longest_cycles as f64 * cycle_ms,
-                gaps: x.gaps,
-            }
-        })
+    let named = m.ios.iter().zip(&s.ios);
+    named
+        .map(|(io, x)| IoReport::new(&io.name, x, m.supervisor.cycle_us))
         .collect()
 }

@@ -75,7 +75,7 @@ impl IoWatch {
             let now = snap.ios[k].attached;
             // Attachments counted, not just the state seen: a detach and
             // re-attach between two snapshots is reported too.
-            let attachments = snap.ios[k].attachments;
+            let attachments = snap.ios[k].counters.attachments;
             let bounced = now && self.attached[k] && attachments > self.attachments[k];
             self.attachments[k] = attachments;
             if now == self.attached[k] && !bounced {
@@ -86,13 +86,13 @@ impl IoWatch {
                 let names: Vec<&str> = (m.axes_of(k).iter())
                     .map(|&i| m.axes[i].name.as_str())
                     .collect();
-                if snap.ios[k].attachments > 1 {
+                if snap.ios[k].counters.attachments > 1 {
                     log::warn!(
                         "I/O process {} attached again (attachment {}, restarts {}): \
                          HomedStatus of {} cleared",
                         io.name,
-                        snap.ios[k].attachments,
-                        snap.ios[k].restarts,
+                        snap.ios[k].counters.attachments,
+                        snap.ios[k].counters.incarnations,
                         names.join(", ")
                     );
                 } else {
@@ -105,7 +105,7 @@ impl IoWatch {
                     "I/O process {} detached: no fresh feedback for {} cycles; its \
                      axes' homing aborts (ERR 12/40)",
                     io.name,
-                    snap.ios[k].gap_cycles
+                    snap.ios[k].counters.gap_cycles
                 );
             }
         }

@@ -28,6 +28,7 @@ use motion_homing::FeedbackLoss;
 use motion_report::GapCounts;
 
 use crate::shared::IoSnap;
+use motion_status::IoCounters;
 
 /// Send times kept for the round trip (cycles).
 const SENT_RING: usize = 32;
@@ -53,7 +54,7 @@ pub struct IoLink {
     limit_ns: u64,
     drain: f64,
     gap: u64,
-    snap: IoSnap,
+    counts: IoCounters,
 }
 
 /// What one cycle's frame of a link amounts to.
@@ -91,7 +92,7 @@ impl IoLink {
                 0.25
             },
             gap: 0,
-            snap: IoSnap::default(),
+            counts: IoCounters::default(),
         }
     }
 
@@ -107,7 +108,7 @@ impl IoLink {
 
     /// A received frame the ports refused (layout, key).
     pub fn refused(&mut self) {
-        self.snap.frames_refused += 1;
+        self.counts.frames_refused += 1;
     }
 
     /// One cycle: `frame` is the newest frame received this cycle, if any;
@@ -124,9 +125,9 @@ impl IoLink {
             if f.header.axis_count as usize != self.axes.len() || answers > self.last_sent {
                 // Another machine's process, or an answer to a command never
                 // sent: not ours to use.
-                self.snap.frames_refused += 1;
+                self.counts.frames_refused += 1;
             } else if self.last_sent - answers >= self.window || answers == 0 {
-                self.snap.frames_too_old += 1;
+                self.counts.frames_too_old += 1;
             } else {
                 usable = Some(f);
             }
@@ -144,26 +145,26 @@ impl IoLink {
                     out.roundtrip_ns = Some(f.header.timestamp_ns - t0);
                 }
                 if self.gap > 0 {
-                    self.snap.gaps.add(self.gap);
+                    self.counts.gaps.add(self.gap);
                     self.gap = 0;
                 }
-                self.snap.frames_received += 1;
+                self.counts.frames_received += 1;
                 self.loss.fresh(now_ns, elapsed, self.drain);
                 let new_origin = f.header.origin != self.origin;
                 if !self.attached || new_origin {
                     if self.ever_attached && new_origin {
-                        self.snap.restarts += 1;
+                        self.counts.incarnations += 1;
                     }
                     self.attached = true;
                     self.ever_attached = true;
                     self.origin = f.header.origin;
                     self.loss.connected(now_ns);
-                    self.snap.attachments += 1;
+                    self.counts.attachments += 1;
                     out.reconnected = true;
                 }
             }
             None => {
-                self.snap.frames_missing += 1;
+                self.counts.frames_missing += 1;
                 // Before the process first attached there is no gap to count.
                 if self.ever_attached {
                     self.gap += 1;
@@ -175,21 +176,23 @@ impl IoLink {
                 }
             }
         }
-        self.snap.attached = self.attached;
-        self.snap.gap_cycles = self.gap;
+        self.counts.gap_cycles = self.gap;
         out
     }
 
     /// For the snapshot; the current gap is counted as if it ended now.
     pub fn snap(&self) -> IoSnap {
-        let mut s = self.snap;
-        s.gaps.longest_cycles = s.gaps.longest_cycles.max(self.gap);
+        let mut s = IoSnap {
+            attached: self.attached,
+            counters: self.counts,
+        };
+        s.counters.gaps.longest_cycles = s.counters.gaps.longest_cycles.max(self.gap);
         s
     }
 
     /// Gaps counted so far (only finished gaps).
     pub fn gaps(&self) -> &GapCounts {
-        &self.snap.gaps
+        &self.counts.gaps
     }
 }
 
@@ -234,8 +237,8 @@ mod tests {
         }
         assert!(l.attached());
         assert!(run(&mut l, 55, true, 7).fresh);
-        assert_eq!(l.snap().gaps.four_to_ten, 1);
-        assert_eq!(l.snap().gaps.longest_cycles, 5);
+        assert_eq!(l.snap().counters.gaps.four_to_ten, 1);
+        assert_eq!(l.snap().counters.gaps.longest_cycles, 5);
     }
 
     #[test]
@@ -255,7 +258,7 @@ mod tests {
         assert_eq!(detached_at, Some(30));
         let c = run(&mut l, 40, true, 7);
         assert!(c.reconnected && l.attached());
-        assert_eq!(l.snap().attachments, 2);
+        assert_eq!(l.snap().counters.attachments, 2);
     }
 
     #[test]
@@ -285,7 +288,7 @@ mod tests {
             l.sent(k, k * MS);
             assert!(k < 3 || l.attached(), "{k}");
         }
-        assert_eq!(l.snap().gaps.one, 998);
+        assert_eq!(l.snap().counters.gaps.one, 998);
     }
 
     #[test]
@@ -296,7 +299,7 @@ mod tests {
         }
         let c = run(&mut l, 10, true, 8);
         assert!(c.reconnected);
-        assert_eq!(l.snap().restarts, 1);
+        assert_eq!(l.snap().counters.incarnations, 1);
     }
 
     #[test]
@@ -307,14 +310,14 @@ mod tests {
         }
         let forged = frame(u64::MAX, 7);
         assert!(!l.step(20 * MS, Some(&forged), false).fresh);
-        assert_eq!(l.snap().frames_refused, 1);
+        assert_eq!(l.snap().counters.frames_refused, 1);
         let old = frame(5, 7); // 14 commands old, window 10
         assert!(!l.step(21 * MS, Some(&old), false).fresh);
-        assert_eq!(l.snap().frames_too_old, 1);
+        assert_eq!(l.snap().counters.frames_too_old, 1);
         let mut wrong = frame(19, 7);
         wrong.header.axis_count = 3;
         assert!(!l.step(22 * MS, Some(&wrong), false).fresh);
-        assert_eq!(l.snap().frames_refused, 2);
+        assert_eq!(l.snap().counters.frames_refused, 2);
     }
 
     #[test]

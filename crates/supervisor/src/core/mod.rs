@@ -31,7 +31,7 @@ pub mod slot;
 pub mod stream;
 pub mod trace;
 
-use crate::shared::{Snapshot, TraceRecord};
+use crate::shared::{Snapshot, StreamCounts, TraceRecord};
 use gantry::GantryCoord;
 use link::IoLink;
 use motion_config::MachineConfig;
@@ -346,8 +346,10 @@ impl Core {
                 ..slot.snap()
             };
         }
-        s.stream = self.stream.counts;
-        s.owners = self.stream.owner_count();
+        s.stream = StreamCounts {
+            owners: self.stream.owner_count(),
+            ..self.stream.counts
+        };
         s.io_count = self.links.len();
         for (k, l) in self.links.iter().enumerate() {
             s.ios[k] = l.snap();

@@ -110,9 +110,9 @@ fn losing_one_io_process_aborts_only_its_axes() {
     b.run(5);
     let s = b.snap();
     assert!(s.ios[1].attached);
-    assert_eq!(s.ios[1].attachments, 2);
+    assert_eq!(s.ios[1].counters.attachments, 2);
     assert!(s.axes[0].status.homed, "bus0's axis keeps its reference");
-    assert!(s.ios[1].gaps.over_ten == 1);
+    assert!(s.ios[1].counters.gaps.over_ten == 1);
 }
 
 /// A restarted I/O process (new origin, no gap long enough to detach)
@@ -130,7 +130,7 @@ fn a_restarted_io_process_unhomes_its_axes() {
     let s = b.snap();
     assert!(!s.axes[0].status.homed, "reconnection clears HomedStatus");
     assert!(s.axes[1].status.homed);
-    assert_eq!(s.ios[0].restarts, 1);
+    assert_eq!(s.ios[0].counters.incarnations, 1);
     assert!(s.axes[0].lost_homed_ns.is_some());
 }
 

@@ -21,28 +21,14 @@ mod outcome;
 use crate::shared::{Ack, Snapshot};
 use absolute::Absolute;
 use motion_config::MachineConfig;
-use motion_control::{W_DRIFT, W_SWITCH_DRIFT};
 use motion_state::{DriftHistory, HomingRecord, RecordEntry, StateDir};
+use motion_status::snap::{W_DRIFT, W_SWITCH_DRIFT};
 
 pub use identity::identity;
 
-/// What the status frame shows of the keeper, per axis.
-#[derive(Clone, Copy, Debug)]
-pub struct AxisNote {
-    /// `motion_control::W_*` beyond what the engine reports itself.
-    pub warnings: u8,
-    /// With `W_DRIFT` / `W_SWITCH_DRIFT`: distance from the recent median.
-    pub drift: f64,
-}
-
-impl Default for AxisNote {
-    fn default() -> Self {
-        Self {
-            warnings: 0,
-            drift: f64::NAN,
-        }
-    }
-}
+/// What the keeper says of an axis beyond its engine (warnings, drift):
+/// a source of the status table, declared next to it.
+pub use motion_status::AxisNote;
 
 /// Per axis: what the keeper remembers between snapshots.
 #[derive(Default)]
@@ -171,7 +157,7 @@ impl Keeper {
             if let Some(abs) = keep.absolute.as_mut() {
                 abs.maybe_restore(m, i, snap, &mut restore);
                 if abs.invalidated() {
-                    self.notes[i].warnings |= motion_control::W_REFERENCE_INVALIDATED;
+                    self.notes[i].warnings |= motion_status::snap::W_REFERENCE_INVALIDATED;
                 }
             }
         }

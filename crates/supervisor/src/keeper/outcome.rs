@@ -6,9 +6,9 @@
 use super::{AxisKeep, AxisNote};
 use crate::shared::Snapshot;
 use motion_config::MachineConfig;
-use motion_control::{W_DRIFT, W_SWITCH_DRIFT};
 use motion_homing::{HomeMode, HomeSequence};
 use motion_state::{RecordEntry, RecordKind};
+use motion_status::snap::{W_DRIFT, W_SWITCH_DRIFT};
 
 /// Rounds to 1 nm-ish (µunit) so the record reads cleanly.
 fn r6(x: f64) -> f64 {

@@ -372,7 +372,7 @@ fn a_changed_axis_configuration_invalidates_the_stored_reference() {
         Some("axis configuration changed: home_position 10 → 20")
     );
     assert_ne!(
-        k.keeper.notes()[0].warnings & motion_control::W_REFERENCE_INVALIDATED,
+        k.keeper.notes()[0].warnings & motion_status::snap::W_REFERENCE_INVALIDATED,
         0
     );
     // Homing stores a fresh one: offset 20 - 113.4 = -93.4.
