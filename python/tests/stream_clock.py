@@ -17,7 +17,7 @@ import json
 import sys
 import time
 
-from motion_supervisor_client import MS_COMMAND, MS_STREAMING, Supervisor, accepted, text
+from motion_supervisor_client import Supervisor, accepted, text
 
 HOUR_NS = 3600 * 10**9
 
@@ -47,7 +47,7 @@ def main() -> int:
     until = time.monotonic() + 0.3
     while time.monotonic() < until:
         e = sup.status().axes[i]
-        if e.motion & MS_COMMAND:
+        if e.cmd_position is not None:
             worst = max(worst, abs(e.cmd_position - p0))
         time.sleep(0.002)
     e = sup.status().axes[i]
@@ -59,7 +59,7 @@ def main() -> int:
                 "largest_excursion": worst,
                 "err": e.err,
                 "exerr": e.exerr,
-                "streaming": bool(e.motion & MS_STREAMING),
+                "streaming": bool(e.streaming),
             }
         )
     )

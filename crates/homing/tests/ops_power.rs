@@ -524,10 +524,11 @@ fn a_fault_during_a_reset_is_a_fault() {
 
 #[test]
 fn a_lost_drive_or_a_restarted_io_process_withdraws_the_enable_in_every_state() {
-    // The drive is gone (the I/O process says so) or its I/O process was
-    // restarted (its drives start off): in every state the enable request
-    // is withdrawn at once and not raised again when the drive is back — a
-    // new process would otherwise switch the drive on by itself.
+    // The drive is gone (the I/O process says so, for longer than the
+    // feedback-loss rule tolerates) or its I/O process was restarted (its
+    // drives start off): in every state the enable request is withdrawn
+    // and not raised again when the drive is back — a drive coming back
+    // would otherwise be switched on by a request left standing.
     type Setup = fn() -> Rig;
     let states: [(&str, Setup); 5] = [
         ("idle, enabled", || {
@@ -554,8 +555,9 @@ fn a_lost_drive_or_a_restarted_io_process_withdraws_the_enable_in_every_state() 
                 let now = r.now();
                 r.axis.reconnected(now);
             } else {
+                // lost for longer than feedback_timeout (10 ms) tolerates
                 r.frame = |_, _| None;
-                for _ in 0..3 {
+                for _ in 0..20 {
                     r.step(Request {
                         home,
                         drive_lost: true,

@@ -259,9 +259,6 @@ impl Axis {
 
     pub fn step(&mut self, now_ns: u64, feedback: Option<&Feedback>, request: &Request) -> Command {
         self.drive_presence(request.drive_lost);
-        if request.drive_lost {
-            self.drive_gone_away(now_ns, EX_DRIVE_LOST);
-        }
         let fresh = self.intake(now_ns, feedback, request.stalled);
         self.requests(now_ns, request);
         // A fresh sample is the newest one (requests never drop it).

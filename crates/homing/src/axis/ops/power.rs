@@ -275,8 +275,9 @@ impl Axis {
         }
     }
 
-    /// The drive is gone — lost (`Request::drive_lost`), or its I/O
-    /// process restarted (whose drives start off): as a dropped power stage,
+    /// The drive is gone — reported lost (`Request::drive_lost`) for
+    /// longer than the feedback-loss rule tolerates, or its I/O process
+    /// restarted (whose drives start off): as a dropped power stage,
     /// in every state the enable request is withdrawn at once (a drive that
     /// comes back is never switched on by a request left standing); an
     /// operation's motion ends as an axis fault (12 / `exerr`), homing that
