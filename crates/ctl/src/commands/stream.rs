@@ -4,8 +4,10 @@
 //! axes are acquired (owner "motionctl"), the rows published at their times
 //! — filled in on the line between rows further apart than 5 ms, because
 //! an axis stops (1019 / 5) when no setpoint has arrived for its
-//! `stream_timeout_ms`, however far ahead the last one lay —, the axes
-//! released once the last setpoint is reached, and followed to rest. Progress on
+//! `stream_timeout_ms`, however far ahead the last one lay —, the last row
+//! held (published again) until every axis's command is on it, the axes
+//! released (a release stops them at once, where they are: on the last
+//! row), and followed to rest. Progress on
 //! stderr; at the end one row per axis with the largest following error
 //! seen (command − actual, from the 100 Hz status) and the final error
 //! (last row − final position).
@@ -47,7 +49,7 @@ pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
     let cycle = s.answer().cycle;
     let mut play = Play::new(axes.len());
     let mut progress = Progress::new();
-    if let Err(e) = play.run(&mut s, &rows, &axes, &mut progress) {
+    if let Err(e) = play.run(&mut s, &rows, (&axes, &column), &mut progress) {
         drop(s);
         return client_error(a.json, &e);
     }
@@ -106,6 +108,39 @@ fn with_errors(mut r: MotionRow, last: Option<f64>, max: f64) -> MotionRow {
     r
 }
 
+/// Longest the program holds at its last row for the axes to get there.
+const HOLD_S: f64 = 2.0;
+
+/// Sleeps until `t` (CLOCK_MONOTONIC, ns), in slices of at most 2 ms.
+fn sleep_until(t: u64) {
+    while motion_rt::now_ns() < t {
+        std::thread::sleep(Duration::from_nanos(
+            (t - motion_rt::now_ns()).min(2_000_000),
+        ));
+    }
+}
+
+/// Every followed axis's command is on its column of `last` (or the axis
+/// no longer streams: nothing to wait for).
+fn on_last(
+    s: &mut Stream,
+    axes: &[Followed],
+    column: &[usize],
+    last: &Row,
+) -> Result<bool, ClientError> {
+    let st = s.client().status(Duration::from_secs(2))?;
+    Ok(axes.iter().zip(column).all(|(f, &k)| {
+        let Some(e) = st.axes().get(f.index) else {
+            return true;
+        };
+        let target = last.p.get(k).copied().unwrap_or(f64::NAN);
+        let there = e
+            .cmd_position()
+            .is_some_and(|c| (c - target).abs() <= 1e-9 * (1.0 + target.abs()));
+        there || (st.cycle > s.answer().cycle && !e.streaming())
+    }))
+}
+
 /// Playing the points.
 struct Play {
     /// Per followed axis, the largest |command − actual| seen.
@@ -122,27 +157,21 @@ impl Play {
     /// Publishes every point of `rows` ([`csv::points`]) at its time (the
     /// program's clock: CLOCK_MONOTONIC from the first row), watching the
     /// status between points; stops early on a signal or when an axis no
-    /// longer streams. Then waits until the last setpoint is commanded.
+    /// longer streams. Then holds on the last row until the axes are there.
     fn run(
         &mut self,
         s: &mut Stream,
         rows: &[Row],
-        axes: &[Followed],
+        (axes, column): (&[Followed], &[usize]),
         progress: &mut Progress,
     ) -> Result<(), ClientError> {
         let t0 = motion_rt::now_ns();
         let first = rows[0].t;
         let at = |p: &Row| t0 + ((p.t - first) * 1e9) as u64;
         let mut next_look = t0;
-        let mut last_gap = 0.0;
-        let mut before = first;
         for p in csv::points(rows) {
             let t = at(&p);
-            while motion_rt::now_ns() < t {
-                std::thread::sleep(Duration::from_nanos(
-                    (t - motion_rt::now_ns()).min(2_000_000),
-                ));
-            }
+            sleep_until(t);
             if motion_rt::termination::received().is_some() {
                 return Ok(());
             }
@@ -150,7 +179,6 @@ impl Play {
                 log::error!("{e}");
                 return Ok(());
             }
-            (last_gap, before) = (p.t - before, p.t);
             if motion_rt::now_ns() >= next_look {
                 next_look = motion_rt::now_ns() + 50_000_000;
                 if !self.look(s, axes, progress)? {
@@ -158,12 +186,35 @@ impl Play {
                 }
             }
         }
-        // The last segment takes its own length (at most 5 ms) to be
-        // reached: then the stream is released (a program at rest on its
-        // last setpoint finds the axis there). Not longer: a stream silent
-        // longer than the axis's stream_timeout_ms (default 50) after its
-        // last setpoint arrived stops the axis with an error.
-        std::thread::sleep(Duration::from_secs_f64(last_gap.min(csv::FILL_S)));
+        let last = &rows[rows.len() - 1];
+        self.hold(s, at(last), last, (axes, column))
+    }
+
+    /// The program holds at its last row — publishing it again, later,
+    /// every [`csv::FILL_S`] (a program silent for `stream_timeout_ms` is
+    /// stopped) — until every axis's command is on it, for at most
+    /// [`HOLD_S`]: a release stops the axes at once, where their command
+    /// is, and a loaded host may have published the last rows late.
+    fn hold(
+        &mut self,
+        s: &mut Stream,
+        mut t: u64,
+        last: &Row,
+        (axes, column): (&[Followed], &[usize]),
+    ) -> Result<(), ClientError> {
+        let until = motion_rt::now_ns() + (HOLD_S * 1e9) as u64;
+        let step = (csv::FILL_S * 1e9) as u64;
+        while motion_rt::now_ns() < until && motion_rt::termination::received().is_none() {
+            t += step;
+            sleep_until(t);
+            if let Err(e) = s.publish(t, &last.p, None) {
+                log::error!("{e}");
+                return Ok(());
+            }
+            if on_last(s, axes, column, last)? {
+                break;
+            }
+        }
         Ok(())
     }
 
