@@ -227,9 +227,9 @@ impl Axis {
 
     /// The drive reports a fault (not the one a reset is clearing): an
     /// axis fault in every state, and the power stage requested off in
-    /// every state; a reset in progress ends without PC. Homing in process aborts
-    /// with 12 / 16 (a passive watch goes on: someone else moves the axis);
-    /// homing's abort ramp is abandoned.
+    /// every state; a reset in progress ends without PC. Homing in process
+    /// aborts with 12 / 16 (a passive watch goes on: someone else moves the
+    /// axis); homing's abort ramp is abandoned.
     fn drive_fault(&mut self, now: u64) {
         let code = (ERR_SERVO_MESSAGE, EX_DRIVE_FAULT);
         if let Some(r) = self.ops.power.reset.take() {
