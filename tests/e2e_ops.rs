@@ -614,7 +614,8 @@ fn a_setpoint_far_ahead_in_time_buys_no_motion() {
             // in cycles of their own (the cycle takes the newest of a cycle)
             std::thread::sleep(Duration::from_millis(5));
         }
-        let x = wait_axis(&d, "X", 5, |a| !a.streaming && at_rest(a));
+        // (the status trails the cycle: wait for the refusal itself)
+        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
         assert_eq!((x.err, x.exerr), (1019, 4), "{x:#?}");
         assert!((pos(&x) - x0).abs() <= 2.0 * COUNT, "moved: {x:#?}");
         let _ = s.release();
@@ -642,7 +643,7 @@ fn a_hung_program_is_stopped_from_its_last_setpoints_arrival() {
         put(&mut s, 5_000, x0);
         std::thread::sleep(Duration::from_millis(5));
         put(&mut s, 15_000, x0 + 9.0);
-        let x = wait_axis(&d, "X", 5, |a| !a.streaming && at_rest(a));
+        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
         assert_eq!((x.err, x.exerr), (1019, 5), "{x:#?}");
         let went = pos(&x) - x0;
         let bound = 0.9 * 0.051 + 0.81 / 2000.0 + 2.0 * COUNT;
@@ -680,7 +681,7 @@ fn an_unhomed_stream_obeys_unhomed_speed_and_no_speed_bound_moves_nothing() {
             put(&mut s, 1_000 + k, p);
             std::thread::sleep(Duration::from_millis(1));
         }
-        let x = wait_axis(&d, "X", 5, |a| !a.streaming && at_rest(a));
+        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
         assert_eq!((x.err, x.exerr), (1019, 3), "{x:#?}");
         let _ = s.release();
     }
