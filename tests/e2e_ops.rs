@@ -39,6 +39,11 @@ fn pos(a: &AxisStatus) -> f64 {
     value(a.position, &a.name)
 }
 
+/// The commanded position (axis coordinates).
+fn cmd(a: &AxisStatus) -> f64 {
+    value(a.cmd_position, &a.name)
+}
+
 /// `motionctl ARGS --json` refused (exit 1) with ERR `err` / EXERR `exerr`.
 #[track_caller]
 fn refused_with(d: &Daemon, args: &[&str], err: u16, exerr: u16) {
@@ -258,7 +263,11 @@ fn a_stream_played_from_csv_ends_at_the_expected_position() {
 #[test]
 fn the_owner_killed_mid_stream_stops_the_axis_within_the_bound() {
     let _serial = serial();
-    let cfg = ops("ops_ownerkill");
+    // stream_timeout_ms 200 (not 50): motionctl descheduled for 50 ms on a
+    // loaded machine must not end the stream before the kill
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_timeout_ms", 200)
+        .write("ops_ownerkill");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "X"]).expect_code(0);
     d.ctl(&["enable", "X"]).expect_code(0);
@@ -284,11 +293,12 @@ fn the_owner_killed_mid_stream_stops_the_axis_within_the_bound() {
     let at_kill = pos(&d.axis("X"));
     let x = wait_axis(&d, "X", 5, at_rest);
     // Whichever comes first: the stream silent longer than
-    // stream_timeout_ms (50) after the last setpoint (10 ms apart) was
-    // reached — ERR 1019 / EXERR 5, a stop at max_deceleration
-    // (home_deceleration 100) — or the owner's node found gone (checked
-    // every 100 ms) — released, a normal stop. Bound: the first, plus a
-    // cycle and the stop.
+    // stream_timeout_ms (200) after the last setpoint arrived (motionctl
+    // publishes every 5 ms) — ERR 1019 / EXERR 5 — or the owner's node
+    // found gone (checked every 100 ms) — released, a normal stop; both
+    // stop at once, at the stream's deceleration (the larger of
+    // max_deceleration 100 and stream_acceleration 1000). Bound: the
+    // first, plus a cycle and the stop.
     if x.er {
         assert!(x.faulted, "{x:#?}");
         assert_eq!((x.err, x.exerr), (1019, 5), "{x:#?}");
@@ -296,8 +306,8 @@ fn the_owner_killed_mid_stream_stops_the_axis_within_the_bound() {
     } else {
         assert_eq!(x.last_stop, "released", "{x:#?}");
     }
-    let (v, decel) = (1.0, 100.0);
-    let bound = v * (0.05 + 0.01 + 0.001) + v * v / (2.0 * decel);
+    let (v, decel) = (1.0, 1000.0);
+    let bound = v * (0.2 + 0.001) + v * v / (2.0 * decel) + 2.0 * COUNT;
     let went = pos(&x) - at_kill;
     assert!(went <= bound, "went {went} after the kill, bound {bound}");
     // the ownership ended with it
@@ -336,13 +346,17 @@ fn ready(d: &Daemon) {
 /// never past the travel limit, and be reset.
 #[track_caller]
 fn stops_with(d: &Daemon, c: &mut Client, exerr: u16, bad: impl FnOnce(&mut Stream, u64, f64)) {
-    let start = pos(&d.axis("X"));
+    // from the command (the first setpoint is judged against it; the
+    // position read back is rounded to counts)
+    let start = cmd(&d.axis("X"));
     {
         let mut s = stream(c, &["X"]);
         let (mut t, mut p) = (1_000, start);
-        for _ in 1..=50 {
+        // up to 1 u/s in two steps (500 u/s², half the stream's 1000: the
+        // start read back from the status is rounded to 1e-6)
+        for k in 1..=50 {
             t += 1;
-            p += 0.001;
+            p += if k == 1 { 0.0005 } else { 0.001 };
             put(&mut s, t, p);
             std::thread::sleep(Duration::from_millis(1));
         }
@@ -361,11 +375,11 @@ fn stops_with(d: &Daemon, c: &mut Client, exerr: u16, bad: impl FnOnce(&mut Stre
 #[test]
 fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
     let _serial = serial();
-    // stream_timeout_ms 300 (not 50): the test's own pauses (a status
-    // read, a descheduled thread) must not read as a silent program; the
-    // silence has its case below.
+    // stream_timeout_ms 1000 (not 50): the test's own pauses (status
+    // reads, a descheduled thread on a loaded machine) must not read as a
+    // silent program; the silence has its case below.
     let cfg = Machine::fixture("ops")
-        .set("axis.X.stream_timeout_ms", 300)
+        .set("axis.X.stream_timeout_ms", 1000)
         .write("ops_bad");
     let d = Daemon::start(&cfg, &["io"]);
     ready(&d);
@@ -380,7 +394,7 @@ fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
     stops_with(&d, &mut c, 3, |s, t, p| put(s, t + 1, p + 1.0));
     // silent: 1019 / 5
     stops_with(&d, &mut c, 5, |_, _, _| {
-        std::thread::sleep(Duration::from_millis(600))
+        std::thread::sleep(Duration::from_millis(1500))
     });
     // out of order (a time not after the previous): 1019 / 6
     stops_with(&d, &mut c, 6, |s, t, p| put(s, t - 5, p));
@@ -646,4 +660,168 @@ fn a_request_the_stalled_cycle_did_not_take_is_never_applied() {
         "{after:#?}"
     );
     d.stop();
+}
+
+#[test]
+fn a_setpoint_far_ahead_in_time_buys_no_motion() {
+    let _serial = serial();
+    // stream_timeout_ms 1000: the test's own pauses between its setpoints
+    // on a loaded machine must not read as silence (not the subject here)
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_timeout_ms", 1000)
+        .write("ops_clock");
+    let d = Daemon::start(&cfg, &["io"]);
+    ready(&d);
+    let mut c = Client::connect(&cfg.prefix, None).expect("client");
+
+    // The program's clock says an hour from x0 to x0 + 9, then 1 ms at
+    // rest there: each passes on the program's timeline; on the cycle's
+    // the last asks for 9 units in one cycle. Refused (1019 / 4) before
+    // anything of it reaches the drive.
+    let x0 = cmd(&d.axis("X"));
+    {
+        let mut s = stream(&mut c, &["X"]);
+        const HOUR_MS: u64 = 3_600_000;
+        for (t, p) in [
+            (1_000, x0),
+            (1_000 + HOUR_MS, x0 + 9.0),
+            (1_001 + HOUR_MS, x0 + 9.0),
+        ] {
+            put(&mut s, t, p);
+            // in cycles of their own (the cycle takes the newest of a cycle)
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        // (the status trails the cycle: wait for the refusal itself)
+        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
+        assert_eq!((x.err, x.exerr), (1019, 4), "{x:#?}");
+        assert!((pos(&x) - x0).abs() <= 2.0 * COUNT, "moved: {x:#?}");
+        let _ = s.release();
+    }
+    drop(c);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn a_hung_program_is_stopped_from_its_last_setpoints_arrival() {
+    let _serial = serial();
+    let cfg = ops("ops_hung");
+    let d = Daemon::start(&cfg, &["io"]);
+    ready(&d);
+    let mut c = Client::connect(&cfg.prefix, None).expect("client");
+    // A program that hangs (alive, its node and ownership intact, silent)
+    // after a setpoint 10 s ahead (0.9 u/s): stopped stream_timeout_ms
+    // (50) after that setpoint arrived — 1019 / 5 — not 10 s later at its
+    // end. Travel at most 0.9 × 51 ms plus the stop (0.9² / 2000) and two
+    // counts of the sim's rounding.
+    let x0 = cmd(&d.axis("X"));
+    {
+        let mut s = stream(&mut c, &["X"]);
+        put(&mut s, 5_000, x0);
+        std::thread::sleep(Duration::from_millis(5));
+        put(&mut s, 15_000, x0 + 9.0);
+        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
+        assert_eq!((x.err, x.exerr), (1019, 5), "{x:#?}");
+        let went = pos(&x) - x0;
+        let bound = 0.9 * 0.051 + 0.81 / 2000.0 + 2.0 * COUNT;
+        assert!(went <= bound, "went {went}, bound {bound}");
+        let _ = s.release();
+    }
+    drop(c);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn an_unhomed_stream_obeys_unhomed_speed_and_no_speed_bound_moves_nothing() {
+    let _serial = serial();
+    // X unhomed with stream_unhomed: capped at unhomed_speed (home_speed
+    // 10), as jog and move are — not at max_speed (20). Z has no speed
+    // bound at all (no max_speed, immediate homing derives none).
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_unhomed", true)
+        .set("axis.X.stream_timeout_ms", 1000)
+        .set("axis.Z.max_speed", 0.0)
+        .write("ops_caps");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["enable", "X", "Z"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.servo_action && !a.homed);
+    wait_axis(&d, "Z", 5, |a| a.servo_action);
+    let mut c = Client::connect(&cfg.prefix, None).expect("client");
+    {
+        // up at 500 u/s² (1 ms apart on the program's clock) to 15 u/s
+        let mut s = stream(&mut c, &["X"]);
+        let (mut p, mut v) = (cmd(&d.axis("X")), 0.0);
+        for k in 0..60u64 {
+            v = f64::min(v + 0.5, 15.0);
+            p += v * 0.001;
+            put(&mut s, 1_000 + k, p);
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
+        assert_eq!((x.err, x.exerr), (1019, 3), "{x:#?}");
+        let _ = s.release();
+    }
+    // Z: jog, move and stream refused naming max_speed (13 / 7) ...
+    refused_with(&d, &["move", "Z", "--to", "5", "--speed", "1000"], 13, 7);
+    refused_with(&d, &["jog", "Z", "--speed", "1"], 13, 7);
+    let r = d.ctl(&["move", "Z", "--to", "5"]);
+    assert!(
+        r.expect_code(1).stderr.contains("max_speed"),
+        "{}",
+        r.stderr
+    );
+    match c.stream("e2e", &["Z".to_string()]) {
+        Err(motion_control::stream::StreamError::Op(motion_control::OpError::Refused(r))) => {
+            assert!(r.answers().iter().any(|a| (a.err, a.exerr) == (13, 7)));
+        }
+        other => panic!("streamed without a speed bound: {:?}", other.err()),
+    }
+    // ... while it still homes, and `check` says why it cannot move
+    d.ctl(&["home", "Z"]).expect_code(0);
+    wait_axis(&d, "Z", 5, |a| a.homed);
+    let check = supervisor(&["check", "--config", cfg.path.to_str().expect("UTF-8")]);
+    let out = check.expect_code(0);
+    assert!(out.stdout.contains("max_speed: none set"), "{}", out.stdout);
+    drop(c);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}
+
+#[test]
+fn a_restarted_motion_io_switches_no_drive_on_by_itself() {
+    let _serial = serial();
+    // X enabled at rest; its motion-io is killed and the supervisor starts
+    // it again (after its back-off). The new process's sim drive starts
+    // off, and nothing asks for it on: the request was withdrawn when the
+    // feedback was lost (nothing was left to stop) and again when the new
+    // process attached. Only `enable` switches it on.
+    let cfg = ops("ops_iorestart");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.servo_action && a.enabled);
+    let pid = find_process("motion-io", &cfg.prefix).expect("its motion-io");
+    signal_pid(pid, Signal::SIGKILL);
+    let attached_again = wait_for(Duration::from_secs(20), || {
+        let st = d.status();
+        st.io.iter().any(|io| io.restarts >= 1 && io.attached)
+            && st
+                .axes
+                .iter()
+                .any(|a| a.name == "X" && a.position.is_some())
+    });
+    assert!(attached_again, "{:#?}", d.status().io);
+    // a while of the new process's cycles: never enabled
+    for _ in 0..20 {
+        let x = d.axis("X");
+        assert!(
+            !x.enabled && !x.servo_action,
+            "switched on by itself: {x:#?}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    d.ctl(&["enable", "X"]).expect_code(0);
+    wait_axis(&d, "X", 5, |a| a.servo_action && a.enabled);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
 }

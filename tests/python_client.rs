@@ -206,3 +206,56 @@ fn the_installed_client_reads_status_homes_and_operates() {
     d.stop();
     assert_clean(&cfg.prefix);
 }
+
+/// Through the package, a program whose setpoint timestamps claim an hour
+/// from p0 to p0 + 15 and then 1 ms at rest there (`python/tests/
+/// stream_clock.py`): on the cycle's timeline 15 units in one cycle. The
+/// axis follows nothing of it faster or harder than its limits
+/// (stream_acceleration 1000 allows 0.06 in 11 ms from rest): it cannot
+/// follow within them, so the stream is refused (1019 / 4) before its
+/// command moved.
+#[test]
+fn a_python_program_cannot_buy_speed_with_its_timestamps() {
+    let Some(python) = python("import iceoryx2, pip", "the iceoryx2 package", false) else {
+        return;
+    };
+    let pkg = install(&python);
+    let site = pkg.path().join("site");
+    let _serial = serial();
+    // X: immediate homing, max_speed 20, stream_acceleration 1000
+    // stream_timeout_ms 1000: a Python descheduled between its setpoints
+    // on a loaded machine must not read as silence (not the subject here)
+    let cfg = Machine::fixture("ops")
+        .set("axis.X.stream_acceleration", 1000.0)
+        .set("axis.X.stream_timeout_ms", 1000)
+        .write("py_clock");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["home", "X"]).expect_code(0);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || {
+        let x = d.axis("X");
+        x.homed && x.servo_action
+    }));
+    let script = Path::new(PACKAGE_DIR).join("tests/stream_clock.py");
+    let mut cmd = Command::new(&python);
+    cmd.arg(&script)
+        .args(["--prefix", &cfg.prefix, "--axis", "X", "--distance", "15"])
+        .env("PYTHONPATH", &site)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .current_dir(pkg.path());
+    let out = Running::start(&mut cmd, "stream_clock.py").finish();
+    out.expect_code(0);
+    let r: serde_json::Value = serde_json::from_str(out.stdout.trim()).expect("one JSON line");
+    assert_eq!(r["acquired"], true, "{r}");
+    assert_eq!(
+        (r["err"].as_u64(), r["exerr"].as_u64()),
+        (Some(1019), Some(4)),
+        "{r}"
+    );
+    assert_eq!(r["streaming"], false, "{r}");
+    let moved = r["largest_excursion"].as_f64().expect("a number");
+    assert!(moved <= 2.0 * COUNT, "the command moved {moved}: {r}");
+    d.ctl(&["reset", "X"]).expect_code(0);
+    d.stop();
+    assert_clean(&cfg.prefix);
+}

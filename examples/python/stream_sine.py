@@ -11,11 +11,14 @@ through `Supervisor.stream` of the package:
 2. take the axis over (REQ_STREAM_ACQUIRE, naming this program's node): the
    answer carries the owner token and the index setpoints address;
 3. publish SetpointFrames (layout 1: key, token, an increasing seq, its own
-   time t_ns) — here at --rate Hz; the supervisor interpolates between them
-   to its cycle and checks every one (finite, inside the travel limits,
-   within max_speed and stream_acceleration, in time order, not older than
-   stream_timeout_ms);
-4. give the axis back (REQ_STREAM_RELEASE): the stream ends, the axis stops.
+   time t_ns) — here at --rate Hz, and at least every stream_timeout_ms
+   (default 50 ms: the axis stops when nothing arrived for that long); the
+   supervisor interpolates between them to its cycle, checks every one
+   (finite, inside the travel limits, within max_speed and
+   stream_acceleration, in time order) and follows them within those
+   limits on its own clock;
+4. give the axis back (REQ_STREAM_RELEASE): the stream ends, the axis stops
+   at once (here at rest on the last setpoint).
 
 The sine starts at the axis's position and at rest (p = p0 + A (1 - cos
 2 pi f t)). If this program dies, the supervisor stops the axis.
@@ -81,7 +84,10 @@ def main() -> int:
         s.release()
         return refused("stream", s.answer)
     ok, worst, p0 = stream(sup, a, s.index[a.axis], s)
-    time.sleep(0.05)
+    # The last segment's length, for the axis to reach the last setpoint
+    # (the release stops it at once) — not longer: nothing published for
+    # stream_timeout_ms stops it with an error.
+    time.sleep(1.0 / a.rate)
     # Released: follow the stream ends' operations (their ids are in the
     # answer) to rest; refused: the stream was over already (an error).
     rel = s.release()

@@ -319,9 +319,13 @@ class Jog:
 
 class SetpointStream:
     """Axes taken over for the supervised setpoint stream: `publish`
-    setpoints (the supervisor interpolates between them and checks each),
-    `release()` (or leaving the `with` block) gives the axes back. If the
-    program dies, the supervisor stops the axes."""
+    setpoints (the supervisor interpolates between them, checks each, and
+    follows them within the axis's max_speed and stream_acceleration on its
+    own clock, whatever `t_ns` claims), `release()` (or leaving the `with`
+    block) gives the axes back: they stop at once. Publish at least every
+    stream_timeout_ms (default 50 ms): an axis stops (ERR 1019 / EXERR 5)
+    when no setpoint has arrived for that long, however far ahead the last
+    one lay. If the program dies or hangs, the supervisor stops the axes."""
 
     def __init__(self, sup: Supervisor, axes, owner: str):
         self.sup = sup
@@ -357,7 +361,8 @@ class SetpointStream:
 
     def publish(self, setpoints, t_ns: int = None) -> None:
         """One frame: `setpoints` are (index, position, velocity or None)
-        of owned axes, at time `t_ns` of this program's monotonic clock."""
+        of owned axes, at time `t_ns` of this program's monotonic clock
+        (only differences count; a later time buys no speed)."""
         frame = SetpointFrame()
         frame.layout_version = SETPOINT_LAYOUT
         frame.session = self.sup.session

@@ -72,6 +72,15 @@ pub enum Command {
     Move(MoveArgs),
     /// Play a CSV file of timed setpoints ("t,p1[,p2...]": s, units; one
     /// column per AXIS, in order) through the supervised setpoint stream.
+    ///
+    /// Rows may be far apart: a setpoint goes out at least every 5 ms,
+    /// filled in on the line between rows; the last row is held until the
+    /// axes are on it, then they are released. An axis stops with ERR 1019 /
+    /// EXERR 5 when no setpoint has arrived for its stream_timeout_ms
+    /// (default 50; keep it at 10 or more for this command), however far
+    /// ahead the last one lay. Each axis follows the rows within its
+    /// max_speed and stream_acceleration on the supervisor's own clock; a
+    /// file it cannot follow within them stops it (1019 / 3 or 4).
     Stream(StreamArgs),
 }
 

@@ -78,17 +78,18 @@
 //! | 13   | 4     | parameter out of range, target: outside `travel_limits` (homed, linear), beyond ±`max_position`, a jog towards a travel limit already reached, or a motion that could not stop inside the travel limits from where the axis is |
 //! | 13   | 5     | parameter out of range, target not finite |
 //! | 13   | 6     | parameter out of range, jog lease outside 50 ms ..= 5 s |
+//! | 13   | 7     | no speed bound: jog, move or stream on an axis without `max_speed` whose homing derives none (immediate, absolute, passive) |
 //! | 16   | 0     | home in process: enable, reset, jog, move or stream on an axis that is homing (stop it first; `disable` and `stop` are always accepted) |
 //! | 20   | 0     | axis in faulted state: home, enable, jog, move or stream while the axis has an axis fault (`Status::faulted`): `reset` first |
 //! | 12   | 16    | axis fault: the drive faulted (or dropped its power stage) — during homing, a jog, move or stream, or at rest |
-//! | 12   | 40    | axis fault: feedback lost during a jog, move or stream (41 invalid, 44 implausible likewise) |
+//! | 12   | 40    | axis fault: feedback lost during a jog, move or stream (41 invalid, 44 implausible likewise; 45 the drive reported lost) |
 //! | 12   | 42    | axis fault: the drive did not report enabled within `enable_timeout` after an enable |
 //! | 12   | 43    | axis fault: a jog, move or stream moved towards a tripped limit switch (stopped at `max_deceleration`) |
-//! | 1019 | 1     | *ours* setpoint refused (the stream stops the axis at `max_deceleration`): position or velocity not finite |
+//! | 1019 | 1     | *ours* setpoint refused (the stream stops the axis at the larger of `max_deceleration` and `stream_acceleration`): position or velocity not finite |
 //! | 1019 | 2     | *ours* setpoint refused: outside `travel_limits` (homed, linear) or beyond ±`max_position` |
-//! | 1019 | 3     | *ours* setpoint refused: step faster than `max_speed` (or a velocity feed-forward above it) |
-//! | 1019 | 4     | *ours* setpoint refused: change of segment velocity faster than `stream_acceleration` |
-//! | 1019 | 5     | *ours* stream silent: no new setpoint for `stream_timeout_ms` after the last one was reached |
+//! | 1019 | 3     | *ours* setpoint refused: step faster than the speed cap (`max_speed`; `unhomed_speed` while not homed), a velocity feed-forward above it, or a command the cap holds back further than it can follow |
+//! | 1019 | 4     | *ours* setpoint refused: change of segment velocity faster than `stream_acceleration`, or a command that acceleration holds back further than it can follow (whatever the timestamps) |
+//! | 1019 | 5     | *ours* stream silent: no new setpoint for `stream_timeout_ms` after the last one arrived |
 //! | 1019 | 6     | *ours* setpoint out of order: its time is not after the previous one's |
 //! | 1019 | 7     | *ours* axis not homed (cleared while streaming) and `stream_unhomed` false |
 //! | 1020 | 0     | *ours* jog lease expired (hold to run): NOT an error — the jog stops normally, ER stays false; only logged and shown as `StopCause::LeaseExpired` |
@@ -178,6 +179,9 @@ pub const EX_PARAM_DECELERATION: u16 = 3;
 pub const EX_PARAM_TARGET: u16 = 4;
 pub const EX_PARAM_NOT_FINITE: u16 = 5;
 pub const EX_PARAM_LEASE: u16 = 6;
+/// No speed bound: `max_speed` is not set and the homing derives none
+/// (an immediate, absolute or passive homing): nothing may move the axis.
+pub const EX_PARAM_NO_MAX_SPEED: u16 = 7;
 
 // EXERR under ERR 1019.
 pub const EX_SETPOINT_NOT_FINITE: u16 = 1;

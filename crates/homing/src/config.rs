@@ -249,7 +249,9 @@ pub struct AxisConfig {
     /// implies more is implausible (a forged or corrupt frame), never an
     /// event. `0.0` = derive 2 × the fastest homing speed the configured
     /// sequence commands; a sequence that commands none (passive, immediate)
-    /// then gets no plausibility check. See `validate::effective_max_speed`.
+    /// then gets no plausibility check. Also the speed bound of jog, move
+    /// and stream: without one they are refused (13 / 7). See
+    /// `validate::effective_max_speed`.
     pub max_speed: f64,
     /// Switch-then-marker: a marker closer than this (units) to the switch
     /// edge is ambiguous — with the edge's sampling error (and switch
@@ -272,15 +274,17 @@ pub struct AxisConfig {
     /// ignored, also by homing (an EtherCAT drive then need not map them).
     pub limit_switches: bool,
     /// Logix "Maximum Deceleration", units/s²: the deceleration of a stop
-    /// at a limit switch and of the stops the stream makes, and the most an
-    /// operation may ask for. `0.0` = the largest deceleration configured
+    /// at a limit switch or after a fault (a stream's stops: at least
+    /// `stream_acceleration`), and the most an operation may ask for. `0.0` = the largest deceleration configured
     /// (`home_deceleration`). See `validate::effective_max_deceleration`.
     pub max_deceleration: f64,
-    /// Largest change of segment velocity the supervised stream may ask
-    /// for, units/s² (ERR 1019 / 4 above it). `0.0` = 10 × `home_acceleration`.
+    /// Largest change of velocity of the supervised stream, units/s²: of
+    /// its segments on the program's timeline (ERR 1019 / 4 above it), and
+    /// of the command between two cycles, whatever the timestamps say.
+    /// `0.0` = 10 × `home_acceleration`.
     pub stream_acceleration: f64,
     /// The stream stops the axis (ERR 1019 / 5) after this long without a
-    /// new setpoint once the last one was reached, ns. `0` = 50 ms.
+    /// new setpoint since the last one arrived, ns. `0` = 50 ms.
     pub stream_timeout_ns: u64,
     /// The stream may drive an axis that is not homed (no soft limits then).
     pub stream_unhomed: bool,

@@ -59,8 +59,8 @@ pub fn effective_stream_timeout_ns(cfg: &AxisConfig) -> u64 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OpLimits {
     /// `max_speed` or the one derived from the homing speeds; `None`: no
-    /// speed bound is known (jogs and moves are bounded by their own
-    /// speed; a stream is refused).
+    /// speed bound is known — jog, move and stream are refused (13 / 7);
+    /// homing, which has its own speeds, still works.
     pub max_speed: Option<f64>,
     pub unhomed_speed: f64,
     pub max_deceleration: f64,
@@ -91,8 +91,9 @@ pub fn advisories(cfg: &AxisConfig) -> Vec<String> {
     }
     if l.max_speed.is_none() {
         out.push(
-            "max_speed: none set and no homing speed to derive one: the setpoint stream is \
-             refused (ERR 13 / EXERR 1); jogs and moves are bounded by their own speed only"
+            "max_speed: none set and no homing speed to derive one (immediate, absolute or \
+             passive homing): jog, move and the setpoint stream are refused (ERR 13 / EXERR 7); \
+             homing works. Set max_speed to move the axis."
                 .into(),
         );
     }
@@ -160,5 +161,25 @@ mod tests {
         let none = OpLimits::new(&AxisConfig::default());
         assert_eq!((none.unhomed_speed, none.max_deceleration), (0.0, 0.0));
         assert_eq!(none.max_speed, None);
+    }
+
+    #[test]
+    fn check_says_when_nothing_may_move_for_want_of_a_speed_bound() {
+        let immediate = AxisConfig {
+            home_sequence: crate::config::HomeSequence::Immediate,
+            home_deceleration: 500.0,
+            ..AxisConfig::default()
+        };
+        let said = advisories(&immediate);
+        assert!(
+            said.iter()
+                .any(|a| a.starts_with("max_speed:") && a.contains("EXERR 7")),
+            "{said:?}"
+        );
+        let set = AxisConfig {
+            max_speed: 10.0,
+            ..immediate
+        };
+        assert!(!advisories(&set).iter().any(|a| a.starts_with("max_speed:")));
     }
 }

@@ -365,8 +365,9 @@ operations! {
         summary: "the supervised setpoint stream starts",
     }
     /// The stream ends (released by its owner, or the owner is gone): the
-    /// axis comes to rest, landing on the last setpoint when the
-    /// deceleration allows. Always accepted.
+    /// axis stops at once from where its command is (a program that
+    /// releases at rest on its last setpoint finds it there). Always
+    /// accepted.
     StreamEnd = 7 {
         name: "stream_end",
         title: "StreamEnd",

@@ -248,3 +248,37 @@ fn cyclic_axes_move_the_shortest_way_and_have_no_travel_limits() {
     assert!(r.axis.status().jogging && r.axis.status().homed);
     assert!(r.cmds.last().unwrap().position > 1000.0);
 }
+
+#[test]
+fn without_a_speed_bound_nothing_moves_but_homing_still_works() {
+    // No max_speed and an immediate homing, which derives none: homed, a
+    // move at 1e6 u/s would be taken at its word. Jog, move and stream are
+    // refused, naming max_speed (13 / 7); homing works as before.
+    let cfg = AxisConfig {
+        max_speed: 0.0,
+        ..op_axis()
+    };
+    let mut r = Rig::new(cfg, op_plant(0.0));
+    r.enable_and_home();
+    let none = Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NO_MAX_SPEED));
+    let fast = Operation::Move(MoveSpec {
+        target: 5.0,
+        relative: false,
+        speed: Some(1e6),
+        accel: Some(1e9),
+        decel: Some(500.0),
+        supersede: false,
+    });
+    assert_eq!(r.op(fast), none);
+    assert_eq!(r.op(move_to(5.0)), none);
+    assert_eq!(r.op(jog(1.0)), none);
+    assert_eq!(r.op(Operation::StreamStart), none);
+    assert!(r.cmds.iter().all(|c| c.position == 0.0));
+    // Unhomed too (the unhomed cap is not a bound of its own).
+    assert!(r.axis.clear_homed());
+    assert_eq!(r.op(jog(1.0)), none);
+    // Homing still works.
+    r.step(home());
+    r.step(Request::default());
+    assert!(r.axis.status().homed && r.axis.status().pc);
+}

@@ -320,3 +320,296 @@ fn a_virtual_axis_is_enabled_and_jogged_without_a_drive() {
     r.run(100);
     assert!(r.axis.status().jogging && r.cmd_axis() > 0.5);
 }
+
+/// A switch homing on the test machine, with a speed bound.
+fn switch_homing() -> AxisConfig {
+    AxisConfig {
+        max_speed: 50.0,
+        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
+    }
+}
+
+/// Homing, 100 steps in: seeking at 20 u/s.
+fn seeking() -> Rig {
+    let mut r = Rig::new(switch_homing(), machine());
+    for _ in 0..100 {
+        r.step(home());
+    }
+    assert_eq!(r.axis.status().phase, Phase::Seek);
+    r
+}
+
+/// Enabled at 0, jogging at 10 u/s for 50 steps.
+fn jogging() -> Rig {
+    let mut r = Rig::at(0.0);
+    r.enable();
+    r.op(jog(10.0)).unwrap();
+    r.run(50);
+    r
+}
+
+/// Homing's seek at 20 u/s stopped at step 100: its abort ramp (Home
+/// Deceleration 500: 40 ms) runs from there.
+fn ramping_after_a_stopped_homing() -> Rig {
+    let mut r = seeking();
+    r.step(Request {
+        home: true,
+        stop: true,
+        ..Request::default()
+    });
+    let s = *r.axis.status();
+    assert!(s.stopping && !s.ip && (s.err, s.exerr) == (12, 1), "{s:?}");
+    assert!(r.cmds.last().unwrap().enable, "ramping down, on");
+    r
+}
+
+#[test]
+fn a_fault_during_homings_abort_ramp_withdraws_the_enable_and_a_reset_never_restores_it() {
+    // The drive faults 5 ms into the ramp, and a reset comes 3 ms later,
+    // while the ramp would still run: the enable request is withdrawn in
+    // the step the fault is seen, for good (a CiA 402 drive walked from
+    // Fault back to Operation enabled would be pulled to where the ramp's
+    // command ended).
+    let mut r = ramping_after_a_stopped_homing();
+    r.run(5);
+    r.plant.inject_fault();
+    r.fb = r.plant.feedback();
+    let seen = r.k;
+    r.run(3);
+    r.op(Operation::Reset).unwrap();
+    r.run(100);
+    assert!(
+        r.since(seen).iter().all(|c| !c.enable),
+        "{:?}",
+        r.since(seen).iter().map(|c| c.enable).collect::<Vec<_>>()
+    );
+    let s = *r.axis.status();
+    assert!(
+        !s.stopping && s.phase == Phase::Idle && !s.servo_action,
+        "{s:?}"
+    );
+    // Held where the axis stood, not where the ramp's command would end.
+    let at = r.plant.position();
+    assert!((r.cmds.last().unwrap().position - at).abs() < 1e-12);
+}
+
+#[test]
+fn a_power_stage_dropped_during_homings_abort_ramp_withdraws_the_enable() {
+    // STO 5 ms into the ramp (no fault): the request goes with it.
+    let mut r = ramping_after_a_stopped_homing();
+    r.frame = |k, mut fb| {
+        if k >= 106 {
+            fb.drive.enabled = false;
+        }
+        Some(fb)
+    };
+    r.run(100);
+    assert!(r.since(106).iter().all(|c| !c.enable));
+    let s = *r.axis.status();
+    assert!(!s.stopping && !s.servo_action && !s.faulted, "{s:?}");
+}
+
+#[test]
+fn a_fault_or_dropped_power_stage_withdraws_the_enable_in_every_state() {
+    // Each state the engine can be in with the power stage requested on,
+    // and each way the drive can go: the next command asks for it off.
+    type Setup = fn() -> Rig;
+    let states: [(&str, Setup); 7] = [
+        ("idle", || {
+            let mut r = Rig::at(0.0);
+            r.enable();
+            r
+        }),
+        ("enabling", || {
+            let plant = PlantConfig {
+                enable_delay_cycles: 100_000,
+                ..op_plant(0.0)
+            };
+            let mut r = Rig::new(op_axis(), plant);
+            r.run(1);
+            r.op(Operation::Enable).unwrap();
+            r.run(5);
+            r
+        }),
+        ("seek", seeking),
+        ("homing's abort ramp", ramping_after_a_stopped_homing),
+        ("jogging", jogging),
+        ("stopping a jog", || {
+            let mut r = jogging();
+            r.op(Operation::Stop).unwrap();
+            r
+        }),
+        ("streaming", || {
+            let mut r = Rig::at(0.0);
+            r.enable_and_home();
+            r.op(Operation::StreamStart).unwrap();
+            for k in 0..20u64 {
+                r.setpoint(k * MS, k as f64 * 0.001, None);
+            }
+            r
+        }),
+    ];
+    for (name, setup) in states {
+        for fault in [true, false] {
+            if !fault && name == "enabling" {
+                // Not on yet: nothing to drop.
+                continue;
+            }
+            let mut r = setup();
+            let home = r.axis.status().ip;
+            let req = Request {
+                home,
+                ..Request::default()
+            };
+            if fault {
+                r.plant.inject_fault();
+                r.fb = r.plant.feedback();
+            } else {
+                r.fb.drive.enabled = false;
+            }
+            let cmd = r.step(req);
+            assert!(!cmd.enable, "{name}, fault {fault}: {:?}", r.axis.status());
+            for _ in 0..50 {
+                let cmd = r.step(req);
+                assert!(!cmd.enable, "{name}, fault {fault}: enabled again");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_fault_during_a_reset_is_a_fault() {
+    // Jogging at 10 u/s, a reset is accepted (nothing to clear): a drive
+    // fault in the next cycle is an axis fault at once — the jog ends and
+    // the power stage is requested off — not hidden for enable_timeout
+    // while the command runs away from a drive that no longer follows.
+    for late in [0u64, 1, 5, 300] {
+        let mut r = Rig::at(0.0);
+        r.enable();
+        r.op(jog(10.0)).unwrap();
+        r.run(50);
+        let reset = r.op(Operation::Reset).unwrap();
+        r.run(late);
+        r.plant.inject_fault();
+        r.fb = r.plant.feedback();
+        r.run(1);
+        let s = *r.axis.status();
+        assert!(s.faulted && s.er && !s.jogging, "{late}: {s:?}");
+        assert_eq!((s.err, s.exerr), (12, EX_DRIVE_FAULT), "{late}");
+        assert_eq!(s.last_stop, StopCause::DriveFault);
+        if late <= 1 {
+            // A reset still pulsing ends with it (not PC): the new fault
+            // needs one of its own.
+            assert_eq!((s.op.id, s.op.ip, s.op.pc), (reset, false, false));
+        }
+        assert!(!r.cmds.last().unwrap().enable, "{late}");
+        // The command holds where the axis stood.
+        r.run(100);
+        let gap = (r.cmds.last().unwrap().position - r.plant.position()).abs();
+        assert!(gap < 1e-9, "{late}: {gap}");
+    }
+    // Resets one after the other do not hide it either.
+    let mut r = Rig::at(0.0);
+    r.enable();
+    r.op(jog(10.0)).unwrap();
+    for _ in 0..3 {
+        r.run(20);
+        r.op(Operation::Reset).unwrap();
+    }
+    r.plant.inject_fault();
+    r.fb = r.plant.feedback();
+    r.run(1);
+    assert!(r.axis.status().faulted && !r.axis.status().jogging);
+}
+
+#[test]
+fn a_lost_drive_or_a_restarted_io_process_withdraws_the_enable_in_every_state() {
+    // The drive is gone (the I/O process says so, for longer than the
+    // feedback-loss rule tolerates) or its I/O process was restarted (its
+    // drives start off): in every state the enable request is withdrawn
+    // and not raised again when the drive is back — a drive coming back
+    // would otherwise be switched on by a request left standing.
+    type Setup = fn() -> Rig;
+    let states: [(&str, Setup); 5] = [
+        ("idle, enabled", || {
+            let mut r = Rig::at(0.0);
+            r.enable();
+            r
+        }),
+        ("homed by an active homing", || {
+            let mut r = Rig::new(switch_homing(), machine());
+            r.step(home());
+            assert!(r.run_until(60_000, |s| s.dn));
+            assert!(r.axis.status().homed && r.cmds.last().unwrap().enable);
+            r
+        }),
+        ("seek", seeking),
+        ("homing's abort ramp", ramping_after_a_stopped_homing),
+        ("jogging", jogging),
+    ];
+    for (name, setup) in states {
+        for restart in [false, true] {
+            let mut r = setup();
+            let home = r.axis.status().ip;
+            if restart {
+                let now = r.now();
+                r.axis.reconnected(now);
+            } else {
+                // lost for longer than feedback_timeout (10 ms) tolerates
+                r.frame = |_, _| None;
+                for _ in 0..20 {
+                    r.step(Request {
+                        home,
+                        drive_lost: true,
+                        ..Request::default()
+                    });
+                }
+                r.frame = |_, fb| Some(fb);
+            }
+            let from = r.k;
+            for _ in 0..50 {
+                r.step(Request {
+                    home,
+                    ..Request::default()
+                });
+            }
+            assert!(
+                r.since(from).iter().all(|c| !c.enable),
+                "{name}, restart {restart}: {:?}",
+                r.axis.status()
+            );
+            let s = r.axis.status();
+            assert!(
+                !s.jogging && !s.stopping && !s.servo_action,
+                "{name}: {s:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn lost_feedback_withdraws_the_enable_once_nothing_is_left_to_stop() {
+    // The I/O process goes silent (killed, hung): at rest the enable
+    // request is withdrawn as soon as the loss rule trips; in motion the
+    // stop at max_deceleration runs first (the drive may still follow),
+    // then it is withdrawn. A new I/O process never gets a standing
+    // request.
+    for moving in [false, true] {
+        let mut r = Rig::at(0.0);
+        r.enable();
+        if moving {
+            r.op(jog(10.0)).unwrap();
+            r.run(50);
+        }
+        r.frame = |_, _| None;
+        assert!(r.run_until(200, |s| !s.feedback_ok), "lost");
+        assert!(r.run_until(200, |s| !s.stopping && !s.jogging));
+        r.run(1);
+        assert!(!r.cmds.last().unwrap().enable, "moving {moving}");
+        r.frame = |_, fb| Some(fb);
+        let from = r.k;
+        r.run(50);
+        assert!(r.since(from).iter().all(|c| !c.enable), "moving {moving}");
+        assert!(!r.axis.status().servo_action);
+    }
+}

@@ -380,3 +380,73 @@ fn every_command_stays_finite_for_any_operation_or_setpoint() {
         )
         .unwrap();
 }
+
+/// A program's setpoint with its own idea of time: the program-time step
+/// (any: a microsecond, a cycle, an hour), where it lies (a random walk
+/// or a jump), and how many cycles pass before the next one arrives.
+#[derive(Clone, Debug)]
+struct Timed {
+    dt_ns: u64,
+    step: f64,
+    jump: Option<f64>,
+    wait: u8,
+}
+
+fn timed() -> impl Strategy<Value = Timed> {
+    let dt = prop_oneof![
+        4 => (1u64..30).prop_map(|ms| ms * MS),
+        1 => Just(1_000u64),
+        1 => Just(3_600_000 * MS),
+        1 => 1u64..10_000_000_000,
+    ];
+    (
+        dt,
+        -0.08..0.08f64,
+        prop::option::weighted(0.05, -9.9..9.9f64),
+        0u8..30,
+    )
+        .prop_map(|(dt_ns, step, jump, wait)| Timed {
+            dt_ns,
+            step,
+            jump,
+            wait,
+        })
+}
+
+#[test]
+fn a_stream_is_never_followed_faster_or_harder_than_its_limits_whatever_its_timestamps() {
+    // Whatever the timestamps say, the command sampled each cycle keeps
+    // |Δv| ≤ stream_acceleration × cycle and |v| ≤ max_speed — also while
+    // it stops (a fault's stop brakes at the larger of max_deceleration
+    // and stream_acceleration: here both 5000) — and stays inside the
+    // travel limits.
+    runner(512)
+        .run(&prop::collection::vec(timed(), 1..80), |inputs| {
+            let cfg = AxisConfig {
+                max_deceleration: 5000.0,
+                ..op_axis()
+            };
+            let mut r = Rig::new(cfg, op_plant(0.0));
+            r.enable_and_home();
+            r.op(Operation::StreamStart).unwrap();
+            let from = r.k as usize - 1;
+            let (mut t, mut p) = (0u64, 0.0f64);
+            for s in &inputs {
+                t = t.saturating_add(s.dt_ns);
+                p = s.jump.unwrap_or((p + s.step).clamp(-9.9, 9.9));
+                r.setpoint(t, p, None);
+                r.run(u64::from(s.wait));
+            }
+            r.run(300);
+            let cmds = &r.cmds[from..];
+            let v = max_speed(cmds, 1e-3);
+            prop_assert!(v <= 50.0 * (1.0 + 1e-9), "speed {v}");
+            let a = max_accel(cmds, 1e-3);
+            prop_assert!(a <= 5000.0 * (1.0 + 1e-6), "acceleration {a}");
+            for c in cmds {
+                prop_assert!(c.position.abs() <= 10.0 + 1e-9, "{}", c.position);
+            }
+            Ok(())
+        })
+        .unwrap();
+}

@@ -25,6 +25,18 @@ fn sine(t_s: f64) -> f64 {
     1.0 - (2.0 * std::f64::consts::PI * t_s).cos()
 }
 
+/// Enabled, not homed, streaming (`stream_unhomed`).
+fn unhomed_streaming() -> Rig {
+    let cfg = AxisConfig {
+        stream_unhomed: true,
+        ..op_axis()
+    };
+    let mut r = Rig::new(cfg, op_plant(0.0));
+    r.enable();
+    r.op(Operation::StreamStart).unwrap();
+    r
+}
+
 /// A bad setpoint made from the good one's time and position.
 type Bad = fn(u64, f64) -> (u64, f64, Option<f64>);
 
@@ -130,8 +142,8 @@ fn the_first_setpoint_is_judged_against_the_command_one_cycle_later() {
 #[test]
 fn every_refusal_stops_the_axis_with_its_code() {
     // Moving at 5 u/s (0.005 per 1 ms setpoint) when the bad one comes: the
-    // stop continues the last command at max_deceleration 500:
-    // 5² / (2·500) = 0.025 beyond it.
+    // stop continues the last command at the larger of max_deceleration
+    // (500) and stream_acceleration (5000): 5² / (2·5000) = 0.0025 beyond.
     let cases: [(&str, Bad, u16); 6] = [
         (
             "not finite",
@@ -176,7 +188,7 @@ fn every_refusal_stops_the_axis_with_its_code() {
         assert!(r.run_until(100, |s| !s.stopping), "{name}");
         let end = r.cmds.last().unwrap().position;
         assert!(
-            (end - (last + 0.025)).abs() < 1e-9,
+            (end - (last + 0.0025)).abs() < 1e-9,
             "{name}: {end} vs {last}"
         );
         assert!(r.cmds.last().unwrap().enable, "{name}: a controlled stop");
@@ -196,20 +208,26 @@ fn every_refusal_stops_the_axis_with_its_code() {
 
 #[test]
 fn a_silent_stream_stops_after_stream_timeout() {
-    // stream_timeout 50 ms, counted from when the command reached the last
-    // setpoint: a 100 ms segment does not time out while it runs.
+    // stream_timeout 50 ms, counted from when the last setpoint arrived —
+    // not from the end of its segment: a 100 ms segment with nothing after
+    // it stops half-way (at 0.05, then its stop: 1² / (2·5000)).
     let mut r = streaming();
     r.setpoint(0, 0.0, None);
     r.setpoint(100 * MS, 0.1, None);
-    let reached = r.k - 1 + 99;
+    let arrived = r.k - 1;
     assert!(r.run_until(1000, |s| s.faulted));
-    assert_eq!(r.k - 1, reached + 51, "the first step after 50 ms of rest");
+    assert_eq!(r.k - 1, arrived + 51, "the first step after 50 ms");
     refused(&r, EX_SETPOINT_STALE);
-    assert_eq!(
-        r.cmds.last().unwrap().position,
-        0.1,
-        "already at rest there"
-    );
+    assert!(r.run_until(100, |s| !s.stopping));
+    let end = r.cmds.last().unwrap().position;
+    assert!((end - (0.051 + 1.0 / 10_000.0)).abs() < 1e-9, "{end}");
+    // Setpoints every 40 ms (less than 50) keep it going, at rest too.
+    let mut r = streaming();
+    for k in 0..10u64 {
+        r.setpoint(k * 40 * MS, 0.0, None);
+        r.run(39);
+    }
+    assert!(r.axis.status().streaming && !r.axis.status().er);
     // A stream that never sends anything stops as well.
     let mut r = streaming();
     assert!(r.run_until(100, |s| s.faulted));
@@ -226,13 +244,7 @@ fn clearing_the_reference_stops_the_stream_unless_stream_unhomed() {
     r.setpoint(50 * MS, 0.0, None);
     refused(&r, EX_SETPOINT_NOT_HOMED);
     // stream_unhomed: the stream goes on; it may even start unhomed.
-    let cfg = AxisConfig {
-        stream_unhomed: true,
-        ..op_axis()
-    };
-    let mut r = Rig::new(cfg, op_plant(0.0));
-    r.enable();
-    r.op(Operation::StreamStart).unwrap();
+    let mut r = unhomed_streaming();
     for k in 0..50u64 {
         r.setpoint(k * MS, k as f64 * 0.001, None);
     }
@@ -241,19 +253,20 @@ fn clearing_the_reference_stops_the_stream_unless_stream_unhomed() {
 }
 
 #[test]
-fn release_lands_on_the_last_setpoint_and_stop_stops_at_once() {
-    // 100 Hz ramp to 2 u/s, then a last setpoint; released right after it
-    // arrived (its segment just begun): the axis lands on it exactly, at
-    // rest, normally.
+fn release_stops_at_once_and_a_program_at_rest_ends_on_its_last_setpoint() {
+    // 100 Hz ramp to 2 u/s, then down to rest on a last setpoint; the
+    // program waits for its segment (10 ms) and releases: the axis is on
+    // it, at rest, normally.
     let mut r = streaming();
     let mut p = 0.0;
-    for k in 0..50u64 {
-        p += 0.02 * f64::min(k as f64 / 10.0, 1.0);
-        r.setpoint(k * 10 * MS, p, None);
+    let speeds: Vec<f64> = (0..60)
+        .map(|k: i32| 0.02 * f64::min(f64::from(k.min(59 - k)) / 10.0, 1.0))
+        .collect();
+    for (k, dp) in speeds.iter().enumerate() {
+        p += dp;
+        r.setpoint(k as u64 * 10 * MS, p, None);
         r.run(9);
     }
-    p += 0.02;
-    r.setpoint(50 * 10 * MS, p, None);
     let id = r.op(Operation::StreamEnd).unwrap();
     assert!(r.run_until(100, |s| !s.stopping));
     let s = *r.axis.status();
@@ -261,7 +274,23 @@ fn release_lands_on_the_last_setpoint_and_stop_stops_at_once() {
     assert_eq!((s.op.id, s.op.kind, s.op.pc), (id, OpKind::StreamEnd, true));
     assert!(!s.er && !s.streaming && s.servo_action);
     assert_eq!(s.last_stop, StopCause::Released);
-    assert!(max_accel(&r.cmds, CYCLE_S) <= 500.0 + 1e-3);
+    assert!(max_accel(&r.cmds, CYCLE_S) <= 5000.0 + 1e-3);
+    // Released while moving (2 u/s, its last setpoint 0.02 ahead): it stops
+    // from where the command is at the stream's deceleration (5000),
+    // 2² / 10 000 = 0.0004 on — not at the setpoint.
+    let mut r = streaming();
+    let mut p = 0.0;
+    for k in 0..50u64 {
+        p += 0.02 * f64::min(k as f64 / 10.0, 1.0);
+        r.setpoint(k * 10 * MS, p, None);
+        r.run(9);
+    }
+    r.setpoint(50 * 10 * MS, p + 0.02, None);
+    let at = r.cmds.last().unwrap().position;
+    r.op(Operation::StreamEnd).unwrap();
+    assert!(r.run_until(100, |s| !s.stopping));
+    let end = r.cmds.last().unwrap().position;
+    assert!((end - (at + 0.0004)).abs() < 1e-9, "{at} → {end}");
     // A stream end with nothing streaming: accepted, nothing to do.
     let id = r.op(Operation::StreamEnd).unwrap();
     assert_eq!(
@@ -274,7 +303,7 @@ fn release_lands_on_the_last_setpoint_and_stop_stops_at_once() {
             refused: None,
         }
     );
-    // Stop: at max_deceleration from the last command, normally.
+    // Stop: at the stream's deceleration from the last command, normally.
     let mut r = streaming();
     for k in 0..100u64 {
         r.setpoint(k * MS, k as f64 * 0.005, None);
@@ -283,7 +312,7 @@ fn release_lands_on_the_last_setpoint_and_stop_stops_at_once() {
     let stop = r.op(Operation::Stop).unwrap();
     assert!(r.run_until(100, |s| !s.stopping));
     let s = *r.axis.status();
-    assert!((r.cmds.last().unwrap().position - (last + 0.025)).abs() < 1e-9);
+    assert!((r.cmds.last().unwrap().position - (last + 0.0025)).abs() < 1e-9);
     assert_eq!((s.op.id, s.op.pc, s.er), (stop, true, false));
     assert_eq!(s.last_stop, StopCause::Operator);
 }
@@ -332,6 +361,19 @@ fn a_stream_start_needs_an_idle_enabled_homed_axis() {
     r.enable_and_home();
     assert_eq!(
         r.op(Operation::StreamStart),
+        Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NO_MAX_SPEED))
+    );
+    // Unhomed with stream_unhomed but no unhomed cap (no unhomed_speed, no
+    // home_speed): nothing could move it.
+    let cfg = AxisConfig {
+        stream_unhomed: true,
+        home_speed: 0.0,
+        ..op_axis()
+    };
+    let mut r = Rig::new(cfg, op_plant(0.0));
+    r.enable();
+    assert_eq!(
+        r.op(Operation::StreamStart),
         Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_SPEED))
     );
 }
@@ -362,4 +404,218 @@ fn a_cyclic_stream_wraps_the_shortest_way() {
     assert!(r.cmds.last().unwrap().position > 360.0, "unwrapped raw");
     assert!((r.cmd_axis() - a).abs() < 1e-6);
     assert!(max_speed(&r.cmds, CYCLE_S) <= 200.0 + 1e-6);
+}
+
+/// One hour, ns.
+const HOUR: u64 = 3_600_000 * MS;
+
+/// The commands from step `from` on obey the stream's limits on the
+/// cycle's timeline: speed within `vmax`, change of velocity between two
+/// cycles within `accel` × cycle.
+fn within_limits(r: &Rig, from: u64, vmax: f64, accel: f64) {
+    let cmds = r.since(from);
+    let v = max_speed(cmds, CYCLE_S);
+    assert!(v <= vmax * (1.0 + 1e-9), "speed {v} > {vmax}");
+    let a = max_accel(cmds, CYCLE_S);
+    assert!(a <= accel * (1.0 + 1e-6), "acceleration {a} > {accel}");
+}
+
+#[test]
+fn a_setpoint_is_never_followed_faster_or_harder_than_the_limits_whatever_its_timestamps() {
+    // The program's clock says an hour from 0 to 9, then 1 ms at rest on
+    // 9: each passes the checks on the program's timeline; on the cycle's
+    // the last asks for 9 units in one cycle. Nothing of it reaches the
+    // drive: the axis would lag it by far more than it can stop in.
+    let mut r = streaming();
+    let from = r.k - 1;
+    r.setpoint(0, 0.0, None);
+    r.setpoint(HOUR, 9.0, None);
+    r.setpoint(HOUR + MS, 9.0, None);
+    refused(&r, EX_SETPOINT_ACCELERATION);
+    assert!(r.run_until(100, |s| !s.stopping));
+    within_limits(&r, from, 50.0, 5000.0);
+    assert!(r.cmds.last().unwrap().position.abs() < 1e-4, "did not move");
+    // The same trick in two steps, and a catch-up faster than max_speed:
+    // followed within the limits, or refused — never faster or harder.
+    for (t, p) in [(2 * MS, 0.003), (30 * MS, 0.9), (31 * MS, 2.0)] {
+        let mut r = streaming();
+        let from = r.k - 1;
+        r.setpoint(0, 0.0, None);
+        r.run(5);
+        r.setpoint(t, p, None);
+        r.run(300);
+        within_limits(&r, from, 50.0, 5000.0);
+    }
+}
+
+#[test]
+fn an_honest_stream_with_sparse_setpoints_is_followed_within_the_limits() {
+    // Setpoints 20 ms apart, reversing at full speed: 50 → −50 u/s in one
+    // setpoint, 5000 u/s² on the program's timeline (within the bound) but
+    // one cycle on the linear interpolation. The command rounds the corner
+    // at 5000 u/s² — or refuses if it cannot keep up — never harder.
+    let mut r = streaming();
+    let from = r.k - 1;
+    let path = [0.0, 0.5, 1.5, 2.5, 1.5, 0.5, -0.5, -1.5, -0.5, 0.5];
+    for (k, &p) in path.iter().enumerate() {
+        r.setpoint(k as u64 * 20 * MS, p, None);
+        r.run(19);
+    }
+    r.run(200);
+    within_limits(&r, from, 50.0, 5000.0);
+    // A 1 Hz (1 − cos) at 50 Hz: corners of 0.8 u/s, which the command
+    // takes in one cycle (5 u/s allowed): on every setpoint exactly.
+    let mut r = streaming();
+    let from = r.k - 1;
+    for k in 0..=50u64 {
+        let p = sine(k as f64 * 0.02);
+        r.setpoint(k * 20 * MS, p, None);
+        r.run(19);
+        assert_eq!(r.cmds.last().unwrap().position, p, "{k}");
+    }
+    let s = r.axis.status();
+    assert!(s.streaming && !s.er, "{s:?}");
+    within_limits(&r, from, 50.0, 5000.0);
+}
+
+#[test]
+fn a_late_setpoint_brakes_the_command_within_the_limits() {
+    // 1 kHz at 30 u/s, then one setpoint 5 cycles late: the command does
+    // not stop dead on the last one (30 000 u/s² in one cycle); it brakes
+    // at stream_acceleration and catches up when the stream resumes.
+    let mut r = streaming();
+    let from = r.k - 1;
+    let (mut p, mut v) = (0.0, 0.0);
+    for k in 0..200u64 {
+        if k == 100 {
+            r.run(5);
+        }
+        v = f64::min(v + 2.0, 30.0);
+        p += v * CYCLE_S;
+        r.setpoint(k * MS, p, None);
+    }
+    let s = r.axis.status();
+    assert!(s.streaming && !s.er, "{s:?}");
+    within_limits(&r, from, 50.0, 5000.0);
+}
+
+/// Streaming, a setpoint at 0, then one 10 s ahead at 9 (0.9 u/s).
+fn far_ahead() -> Rig {
+    let mut r = streaming();
+    r.setpoint(0, 0.0, None);
+    r.setpoint(10_000 * MS, 9.0, None);
+    r
+}
+
+#[test]
+fn a_program_that_falls_silent_is_stopped_from_its_last_setpoints_arrival() {
+    // A setpoint 10 s ahead (0.9 u/s), then nothing: the axis stops
+    // stream_timeout (50 ms) after it arrived, not at the end of its
+    // segment — a hung program runs out nothing.
+    let mut r = far_ahead();
+    let arrived = r.k - 1;
+    assert!(r.run_until(1000, |s| s.faulted), "{:?}", r.axis.status());
+    assert_eq!(r.k - 1, arrived + 51, "the first step after 50 ms");
+    refused(&r, EX_SETPOINT_STALE);
+    assert!(r.run_until(100, |s| !s.stopping));
+    // 0.9 u/s for 51 ms, then 0.9² / (2 × 5000) to stop.
+    let end = r.cmds.last().unwrap().position;
+    assert!(end <= 0.9 * 0.051 + 1e-4 && end > 0.0, "{end}");
+}
+
+#[test]
+fn a_released_stream_stops_at_once_however_far_its_last_setpoint_lies() {
+    // The owner asks for 9 units 10 s away and is gone (released, or its
+    // death noticed): the axis stops now, at the stream's deceleration.
+    let mut r = far_ahead();
+    r.run(20);
+    let id = r.op(Operation::StreamEnd).unwrap();
+    let at = r.cmds[r.cmds.len() - 2].position;
+    assert!(r.run_until(100, |s| !s.stopping), "{:?}", r.axis.status());
+    let s = *r.axis.status();
+    assert_eq!((s.op.id, s.op.pc, s.er), (id, true, false));
+    assert_eq!(s.last_stop, StopCause::Released);
+    let end = r.cmds.last().unwrap().position;
+    assert!(end - at <= 0.9 * CYCLE_S + 1e-4, "{at} → {end}");
+}
+
+#[test]
+fn a_fault_mid_stream_stops_inside_the_travel_limits_at_a_deceleration_that_can() {
+    // The program cruises at 40 u/s towards the limit at 10 and brakes at
+    // stream_acceleration (5000) to rest on it: 0.16 from 9.84 (a
+    // trapezoid sampled every cycle). Feedback goes bad while it brakes —
+    // not a number, lost (noticed feedback_timeout later: from 9.45 on),
+    // or a jump — which clears HomedStatus in the same step. The stop keeps
+    // the travel limits that applied when it began and brakes hard enough:
+    // at max_deceleration (500) it would end 1.4 beyond the limit.
+    type Frame = fn(u64, Feedback) -> Option<Feedback>;
+    let bad: [(&str, f64, Frame, u16); 3] = [
+        (
+            "not a number",
+            9.85,
+            |_, mut fb| {
+                fb.position = f64::NAN;
+                Some(fb)
+            },
+            EX_FEEDBACK_INVALID,
+        ),
+        ("lost", 9.45, |_, _| None, EX_FEEDBACK_LOST),
+        (
+            "a jump",
+            9.85,
+            |_, mut fb| {
+                fb.position += 5.0;
+                Some(fb)
+            },
+            EX_FEEDBACK_IMPLAUSIBLE,
+        ),
+    ];
+    let path = profile::Profile::move_to(0, 0.0, 0.0, 10.0, 40.0, 5000.0, 5000.0);
+    for (name, from, frame, exerr) in bad {
+        let mut r = streaming();
+        let mut t = 0;
+        while !r.axis.status().faulted && t < 1000 * MS {
+            let p = path.sample(t).0;
+            r.setpoint(t, p, None);
+            if p >= from {
+                r.frame = frame;
+            }
+            t += MS;
+        }
+        let s = *r.axis.status();
+        assert!(s.faulted && !s.homed, "{name}: {s:?}");
+        assert_eq!((s.err, s.exerr), (12, exerr), "{name}");
+        let at = r.cmds.last().unwrap().position;
+        assert!(at < 9.99, "{name}: faulted at {at}, still braking");
+        r.run(300);
+        // What the drive was asked to follow (once the feedback is lost and
+        // the axis at rest, the power stage is requested off and the
+        // command shows where the feedback, bad or not, says it is).
+        let on: Vec<Command> = r.cmds.iter().filter(|c| c.enable).copied().collect();
+        let most = on.iter().map(|c| c.position).fold(f64::MIN, f64::max);
+        assert!(most <= 10.0 + 1e-9, "{name}: commanded {most}");
+        let a = max_accel(&on, CYCLE_S);
+        assert!(a <= 5000.0 * (1.0 + 1e-6), "{name}: acceleration {a}");
+    }
+}
+
+#[test]
+fn an_unhomed_stream_obeys_unhomed_speed() {
+    // stream_unhomed: not homed, the cap is unhomed_speed (20 here, from
+    // home_speed) as for jog and move, not max_speed (50).
+    let mut r = unhomed_streaming();
+    let from = r.k - 1;
+    let (mut p, mut v) = (0.0, 0.0);
+    for k in 0..100u64 {
+        v = f64::min(v + 1.0, 30.0);
+        p += v * CYCLE_S;
+        r.setpoint(k * MS, p, None);
+    }
+    refused(&r, EX_SETPOINT_SPEED);
+    assert!(r.run_until(100, |s| !s.stopping));
+    within_limits(&r, from, 20.0, 5000.0);
+    // A setpoint's feed-forward above the cap is refused as well.
+    let mut r = unhomed_streaming();
+    r.setpoint(0, 0.0, Some(25.0));
+    refused(&r, EX_SETPOINT_SPEED);
 }

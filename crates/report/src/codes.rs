@@ -72,6 +72,9 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
             "parameter out of range: target not finite"
         }
         (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_LEASE) => "parameter out of range: jog lease",
+        (ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NO_MAX_SPEED) => {
+            "no speed bound: max_speed is not set and the homing derives none (set max_speed)"
+        }
         (ERR_PARAMETER_OUT_OF_RANGE, _) => "parameter out of range",
         (ERR_HOME_IN_PROCESS, _) => "home in process: stop homing first",
         (ERR_AXIS_FAULTED, _) => "axis in faulted state: reset first",
@@ -79,11 +82,15 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         (ERR_SETPOINT_REFUSED, EX_SETPOINT_OUTSIDE_LIMITS) => {
             "setpoint refused: outside the travel limits"
         }
-        (ERR_SETPOINT_REFUSED, EX_SETPOINT_SPEED) => "setpoint refused: step above max_speed",
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_SPEED) => {
+            "setpoint refused: faster than max_speed (unhomed: unhomed_speed)"
+        }
         (ERR_SETPOINT_REFUSED, EX_SETPOINT_ACCELERATION) => {
             "setpoint refused: change of velocity above stream_acceleration"
         }
-        (ERR_SETPOINT_REFUSED, EX_SETPOINT_STALE) => "stream silent longer than stream_timeout_ms",
+        (ERR_SETPOINT_REFUSED, EX_SETPOINT_STALE) => {
+            "stream silent: no setpoint for stream_timeout_ms since the last one arrived"
+        }
         (ERR_SETPOINT_REFUSED, EX_SETPOINT_OUT_OF_ORDER) => {
             "setpoint out of order: its time is not after the previous one's"
         }

@@ -164,7 +164,7 @@ pub struct AxisOperationLimits {
     /// cyclic axis).
     pub soft_limits: Option<[f64; 2]>,
     /// `max_speed`, or the one derived from the homing speeds; `None`:
-    /// none known (the stream is refused).
+    /// none known (jog, move and stream are refused: 13 / 7).
     pub max_speed: Option<f64>,
     pub unhomed_speed: f64,
     pub max_deceleration: f64,

@@ -10,11 +10,15 @@ pub struct Row {
     pub p: Vec<f64>,
 }
 
-/// Longest time between two published points: a stream silent longer than
-/// the axis's `stream_timeout_ms` (default 50) stops it, so rows further
-/// apart are filled in by linear interpolation — the very line the
-/// supervisor would interpolate anyway.
-pub const FILL_S: f64 = 0.010;
+/// Longest time between two published points. An axis stops (ERR 1019 /
+/// EXERR 5) when no setpoint has arrived for its `stream_timeout_ms`
+/// (default 50, at least 1) — however far ahead the last one lay: a row
+/// seconds away is not a promise that keeps the axis moving. So rows
+/// further apart are filled in by linear interpolation (the very line the
+/// supervisor would interpolate anyway) and a point goes out at least
+/// every 5 ms: enough for any `stream_timeout_ms` of 10 or more, with room
+/// for a descheduled moment of this process.
+pub const FILL_S: f64 = 0.005;
 
 /// Reads `path` (a regular file of at most 1 MiB): rows `t,p1[,p2...]`,
 /// one position per axis, `t` increasing; blank lines and `#` comments are
@@ -67,24 +71,22 @@ pub fn parse(text: &str, axes: usize) -> Result<Vec<Row>, String> {
     Ok(rows)
 }
 
-/// The points to publish: every row, plus points on the line between rows
-/// further apart than [`FILL_S`].
-pub fn points(rows: &[Row]) -> Vec<Row> {
-    let mut out = Vec::with_capacity(rows.len());
-    for w in rows.windows(2) {
+/// The points to publish, in order: every row, plus points on the line
+/// between rows further apart than [`FILL_S`] — made as they are asked
+/// for (a long file at 200 points a second is never held in memory).
+pub fn points(rows: &[Row]) -> impl Iterator<Item = Row> + '_ {
+    let filled = rows.windows(2).flat_map(|w| {
         let (a, b) = (&w[0], &w[1]);
-        out.push(a.clone());
-        let n = ((b.t - a.t) / FILL_S).ceil() as usize;
-        for k in 1..n.min(1_000_000) {
+        let n = ((b.t - a.t) / FILL_S).ceil().max(1.0) as usize;
+        (0..n).map(move |k| {
             let f = k as f64 / n as f64;
-            out.push(Row {
+            Row {
                 t: a.t + f * (b.t - a.t),
                 p: a.p.iter().zip(&b.p).map(|(x, y)| x + f * (y - x)).collect(),
-            });
-        }
-    }
-    out.extend(rows.last().cloned());
-    out
+            }
+        })
+    });
+    filled.chain(rows.last().cloned())
 }
 
 #[cfg(test)]
@@ -93,11 +95,14 @@ mod tests {
 
     #[test]
     fn rows_are_checked_and_gaps_filled() {
-        let r = parse("t,x\n0,0\n# c\n\n0.025,1\n", 1).unwrap();
-        assert_eq!(r.len(), 2);
-        let p = points(&r);
-        assert_eq!(p.len(), 4, "{p:?}");
+        let r = parse("t,x\n0,0\n# c\n\n0.012,1\n1.0,1\n", 1).unwrap();
+        assert_eq!(r.len(), 3);
+        let p: Vec<Row> = points(&r).collect();
+        // 0.012 s in 3 pieces, 0.988 s in 198, and the last row
+        assert_eq!(p.len(), 3 + 198 + 1, "{p:?}");
         assert!((p[1].p[0] - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!((p[3].t, p[3].p[0]), (0.012, 1.0), "every row itself");
+        assert_eq!(p.last(), r.last());
         assert!(p.windows(2).all(|w| w[1].t - w[0].t <= FILL_S + 1e-12));
         for bad in [
             "0,0\n0,1\n",

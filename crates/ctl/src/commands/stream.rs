@@ -2,8 +2,12 @@
 //! through the supervised setpoint stream — the commissioning tool and the
 //! reference client of the stream. The file is checked first; then the
 //! axes are acquired (owner "motionctl"), the rows published at their times
-//! (filled in where rows are further apart than 10 ms), the axes released
-//! once the last setpoint is reached, and followed to rest. Progress on
+//! — filled in on the line between rows further apart than 5 ms, because
+//! an axis stops (1019 / 5) when no setpoint has arrived for its
+//! `stream_timeout_ms`, however far ahead the last one lay —, the last row
+//! held (published again) until every axis's command is on it, the axes
+//! released (a release stops them at once, where they are: on the last
+//! row), and followed to rest. Progress on
 //! stderr; at the end one row per axis with the largest following error
 //! seen (command − actual, from the 100 Hz status) and the final error
 //! (last row − final position).
@@ -29,7 +33,6 @@ pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
         Ok(r) => r,
         Err(e) => return fail(a.json, vec![ErrorEntry::message(e)], super::EXIT_USAGE),
     };
-    let points = csv::points(&rows);
     let mut s = match client.stream("motionctl", &a.axes) {
         Ok(s) => s,
         Err(StreamError::Op(e)) => return op_error(a.json, "stream", &e),
@@ -46,7 +49,7 @@ pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
     let cycle = s.answer().cycle;
     let mut play = Play::new(axes.len());
     let mut progress = Progress::new();
-    if let Err(e) = play.run(&mut s, &points, &axes, &mut progress) {
+    if let Err(e) = play.run(&mut s, &rows, (&axes, &column), &mut progress) {
         drop(s);
         return client_error(a.json, &e);
     }
@@ -105,6 +108,39 @@ fn with_errors(mut r: MotionRow, last: Option<f64>, max: f64) -> MotionRow {
     r
 }
 
+/// Longest the program holds at its last row for the axes to get there.
+const HOLD_S: f64 = 2.0;
+
+/// Sleeps until `t` (CLOCK_MONOTONIC, ns), in slices of at most 2 ms.
+fn sleep_until(t: u64) {
+    while motion_rt::now_ns() < t {
+        std::thread::sleep(Duration::from_nanos(
+            (t - motion_rt::now_ns()).min(2_000_000),
+        ));
+    }
+}
+
+/// Every followed axis's command is on its column of `last` (or the axis
+/// no longer streams: nothing to wait for).
+fn on_last(
+    s: &mut Stream,
+    axes: &[Followed],
+    column: &[usize],
+    last: &Row,
+) -> Result<bool, ClientError> {
+    let st = s.client().status(Duration::from_secs(2))?;
+    Ok(axes.iter().zip(column).all(|(f, &k)| {
+        let Some(e) = st.axes().get(f.index) else {
+            return true;
+        };
+        let target = last.p.get(k).copied().unwrap_or(f64::NAN);
+        let there = e
+            .cmd_position()
+            .is_some_and(|c| (c - target).abs() <= 1e-9 * (1.0 + target.abs()));
+        there || (st.cycle > s.answer().cycle && !e.streaming())
+    }))
+}
+
 /// Playing the points.
 struct Play {
     /// Per followed axis, the largest |command − actual| seen.
@@ -118,28 +154,24 @@ impl Play {
         }
     }
 
-    /// Publishes every point at its time (the program's clock:
-    /// CLOCK_MONOTONIC from the first point), watching the status between
-    /// points; stops early on a signal or when an axis no longer streams.
-    /// Then waits until the last setpoint is commanded.
+    /// Publishes every point of `rows` ([`csv::points`]) at its time (the
+    /// program's clock: CLOCK_MONOTONIC from the first row), watching the
+    /// status between points; stops early on a signal or when an axis no
+    /// longer streams. Then holds on the last row until the axes are there.
     fn run(
         &mut self,
         s: &mut Stream,
-        points: &[Row],
-        axes: &[Followed],
+        rows: &[Row],
+        (axes, column): (&[Followed], &[usize]),
         progress: &mut Progress,
     ) -> Result<(), ClientError> {
         let t0 = motion_rt::now_ns();
-        let first = points[0].t;
+        let first = rows[0].t;
         let at = |p: &Row| t0 + ((p.t - first) * 1e9) as u64;
         let mut next_look = t0;
-        for p in points {
-            let t = at(p);
-            while motion_rt::now_ns() < t {
-                std::thread::sleep(Duration::from_nanos(
-                    (t - motion_rt::now_ns()).min(2_000_000),
-                ));
-            }
+        for p in csv::points(rows) {
+            let t = at(&p);
+            sleep_until(t);
             if motion_rt::termination::received().is_some() {
                 return Ok(());
             }
@@ -154,16 +186,35 @@ impl Play {
                 }
             }
         }
-        // The last segment takes its own length to be reached: then the
-        // stream is released (the engine lands the axis on the last
-        // setpoint). Not longer: a stream silent longer than the axis's
-        // stream_timeout_ms (default 50) after its last setpoint stops the
-        // axis with an error.
-        let last = points
-            .len()
-            .checked_sub(2)
-            .map_or(0.0, |k| points[k + 1].t - points[k].t);
-        std::thread::sleep(Duration::from_secs_f64(last.min(csv::FILL_S)));
+        let last = &rows[rows.len() - 1];
+        self.hold(s, at(last), last, (axes, column))
+    }
+
+    /// The program holds at its last row — publishing it again, later,
+    /// every [`csv::FILL_S`] (a program silent for `stream_timeout_ms` is
+    /// stopped) — until every axis's command is on it, for at most
+    /// [`HOLD_S`]: a release stops the axes at once, where their command
+    /// is, and a loaded host may have published the last rows late.
+    fn hold(
+        &mut self,
+        s: &mut Stream,
+        mut t: u64,
+        last: &Row,
+        (axes, column): (&[Followed], &[usize]),
+    ) -> Result<(), ClientError> {
+        let until = motion_rt::now_ns() + (HOLD_S * 1e9) as u64;
+        let step = (csv::FILL_S * 1e9) as u64;
+        while motion_rt::now_ns() < until && motion_rt::termination::received().is_none() {
+            t += step;
+            sleep_until(t);
+            if let Err(e) = s.publish(t, &last.p, None) {
+                log::error!("{e}");
+                return Ok(());
+            }
+            if on_last(s, axes, column, last)? {
+                break;
+            }
+        }
         Ok(())
     }
 

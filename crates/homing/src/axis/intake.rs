@@ -134,13 +134,16 @@ impl Axis {
             // Edges across a gap of unknown length mean nothing.
             self.prev = None;
             self.last = None;
-            // a lost drive is named as such, not as its I/O process
-            let exerr = if self.status.drive_lost {
-                EX_DRIVE_LOST
+            // a lost drive is named as such, not as its I/O process; it no
+            // longer follows: nothing is asked of it any more (the enable
+            // request withdrawn in every state), so it is never switched on
+            // by a request left standing when it comes back
+            if self.status.drive_lost {
+                self.drive_gone_away(now, EX_DRIVE_LOST);
+                self.feedback_trouble(now, EX_DRIVE_LOST);
             } else {
-                EX_FEEDBACK_LOST
-            };
-            self.feedback_trouble(now, exerr);
+                self.feedback_trouble(now, EX_FEEDBACK_LOST);
+            }
         }
     }
 

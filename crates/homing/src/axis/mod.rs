@@ -34,8 +34,10 @@
 //! * **Aborts** (stop, timeout, search limit, lost, invalid or implausible
 //!   feedback, an ambiguous marker when refused) stop
 //!   the axis at Home Deceleration with the overrides still in force, release
-//!   if needed, then restore. A drive fault or shutdown cannot be stopped by
-//!   us: the drive is disabled and the overrides restored at once.
+//!   if needed, then restore. A drive fault, a dropped power stage, a lost
+//!   drive, a restarted I/O process or shutdown cannot be stopped by us: the
+//!   drive is disabled and the overrides restored at once — also during an
+//!   abort's stop, which is then abandoned (`ops::power`).
 
 mod at_limit;
 mod detect;
@@ -229,23 +231,23 @@ impl Axis {
 
     /// The drive connection was re-established (its I/O process restarted
     /// or re-attached): HomedStatus is cleared (CIP: reconnection clears it),
-    /// samples and the plausibility anchor from before are forgotten, and
-    /// homing in process is aborted with ERR 12 / EXERR 40 — the feedback it
-    /// relied on was interrupted.
+    /// samples and the plausibility anchor from before are forgotten, the
+    /// enable request is withdrawn (the new process's drives are off and
+    /// stay off until someone enables them), and homing in process is
+    /// aborted with ERR 12 / EXERR 40 — the feedback it relied on was
+    /// interrupted.
     pub fn reconnected(&mut self, now_ns: u64) {
         self.prev = None;
         self.last = None;
         self.last_sample_ns = None;
         self.plausible = Plausibility::new(&self.cfg);
         self.status.homed = false;
-        // The drives of a new I/O process are off: a motion ends with them.
-        self.op_fault(
-            now_ns,
-            (ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST),
-            StopCause::FeedbackLost,
-            true,
-        );
+        // The drives of a new I/O process are off: a motion ends with them,
+        // and nothing asks for them on again by itself.
+        self.drive_gone_away(now_ns, EX_FEEDBACK_LOST);
         if self.status.ip {
+            // Homing that only watched the axis: the feedback it relied on
+            // was interrupted.
             self.fail(
                 now_ns,
                 ERR_SERVO_MESSAGE,
@@ -268,6 +270,7 @@ impl Axis {
         self.report(now_ns);
         let cmd = self.output(now_ns);
         self.ops.prev_step_ns = Some(now_ns);
+        self.ops.limits_before = self.soft_limits_raw();
         cmd
     }
 
@@ -497,6 +500,11 @@ impl Axis {
     /// A cycle without valid feedback: profiles run on, nothing is detected.
     /// An abort's stop still finishes; a release (which needs the actual
     /// position) waits for feedback, keeping the reduced torque limits.
+    /// Once the feedback is lost (the loss rule forgot the samples) and
+    /// nothing is left to stop, the enable request is withdrawn: no request
+    /// stands for a drive whose state is unknown — a drive that comes back
+    /// (a restarted I/O process, a power-cycled drive) is never switched on
+    /// by it.
     fn advance_blind(&mut self, now: u64) {
         self.power_tick(now);
         self.advance_motion(now, None);
@@ -506,6 +514,9 @@ impl Axis {
             && self.profile.is_done(now)
         {
             self.state = State::Idle;
+        }
+        if self.enable && self.last.is_none() && matches!(self.state, State::Idle) {
+            self.power_off();
         }
     }
 

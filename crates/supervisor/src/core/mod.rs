@@ -365,6 +365,8 @@ impl Core {
 #[cfg(test)]
 mod fuzz;
 #[cfg(test)]
+mod ops_tests;
+#[cfg(test)]
 mod stream_fuzz;
 #[cfg(test)]
 pub(crate) mod testbench;

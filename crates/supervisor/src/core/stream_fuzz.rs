@@ -12,7 +12,11 @@
 //!   token's last, addressed to its lead (a gantry's first side) — anything
 //!   else reaches no engine;
 //! * what is taken is exactly the frame's value (the engine judges it:
-//!   `motion-homing`'s stream checks and the core's fuzz below).
+//!   `motion-homing`'s stream checks and the core's fuzz below);
+//! * through the whole cycle, whatever a program's timestamps claim (a
+//!   microsecond, an hour, a jump), the commands the cycle publishes never
+//!   move faster than `max_speed` nor change velocity by more than
+//!   `stream_acceleration` × cycle, and stay inside the travel limits.
 
 use super::stream::StreamIntake;
 use motion_frames::{SetpointAxis, SetpointFrame, MAX_AXES, SETPOINT_LAYOUT, SP_VELOCITY};
@@ -157,6 +161,83 @@ fn any_setpoint_frame_moves_only_what_its_owner_owns() {
                         o.1 = f.seq;
                     }
                 }
+            }
+            Ok(())
+        })
+        .unwrap();
+}
+
+/// A program's setpoint through the cycle: the program-time step (any),
+/// where (a walk or a jump), and cycles until the next.
+#[derive(Clone, Debug)]
+struct Timed {
+    dt_ns: u64,
+    step: f64,
+    jump: Option<f64>,
+    wait: u8,
+}
+
+fn timed() -> impl Strategy<Value = Timed> {
+    let dt = prop_oneof![
+        4 => (1u64..40).prop_map(|ms| ms * 1_000_000),
+        1 => Just(1_000u64),
+        1 => Just(3_600_000_000_000u64),
+        1 => 1u64..100_000_000_000,
+    ];
+    (
+        dt,
+        -0.04..0.04f64,
+        prop::option::weighted(0.05, -19.0..19.0f64),
+        0u8..40,
+    )
+        .prop_map(|(dt_ns, step, jump, wait)| Timed {
+            dt_ns,
+            step,
+            jump,
+            wait,
+        })
+}
+
+#[test]
+fn no_timestamp_buys_a_faster_or_harder_command_through_the_cycle() {
+    use super::ops_tests::{cmd, streaming, TOKEN};
+    use super::testbench::Bench;
+    let mut runner = TestRunner::new(Config {
+        cases: 64,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    runner
+        .run(&prop::collection::vec(timed(), 1..40), |inputs| {
+            // X: max_speed 20, stream_acceleration 1000 (its stops brake
+            // at that too: max_deceleration is 100), limits ±20, 1 ms.
+            let mut b = streaming();
+            let mut x = vec![cmd(&b)];
+            let (mut t, mut p, mut seq) = (0u64, 0.0f64, 0u64);
+            let one = |b: &mut Bench, x: &mut Vec<f64>| {
+                b.cycle();
+                x.push(cmd(b));
+            };
+            for s in &inputs {
+                t = t.saturating_add(s.dt_ns);
+                p = s.jump.unwrap_or((p + s.step).clamp(-19.0, 19.0));
+                seq += 1;
+                b.setpoint(TOKEN, seq, t, 0, p);
+                one(&mut b, &mut x);
+                for _ in 0..s.wait {
+                    one(&mut b, &mut x);
+                }
+            }
+            for _ in 0..100 {
+                one(&mut b, &mut x);
+            }
+            let dt = 1e-3;
+            for w in x.windows(3) {
+                let (v0, v1) = ((w[1] - w[0]) / dt, (w[2] - w[1]) / dt);
+                prop_assert!(v1.abs() <= 20.0 * (1.0 + 1e-9), "speed {v1}");
+                let a = (v1 - v0).abs() / dt;
+                prop_assert!(a <= 1000.0 * (1.0 + 1e-6), "acceleration {a}");
+                prop_assert!(w[2].abs() <= 20.0 + 1e-9, "outside: {}", w[2]);
             }
             Ok(())
         })

@@ -22,14 +22,19 @@ pub struct Bench {
     pub alive: Vec<bool>,
     pub k: u64,
     pub acks: Vec<Ack>,
+    /// Setpoint frames for the next cycle's intake.
+    pub setpoints: Vec<motion_frames::SetpointFrame>,
 }
+
+/// The session key of a [`Bench`]'s core (its setpoint frames carry it).
+pub const KEY: [u64; 2] = [0x5eed, 0xcafe];
 
 impl Bench {
     pub fn new(toml: &str) -> Self {
         let m = motion_config::parse(toml).unwrap_or_else(|p| panic!("{p:#?}"));
         let ios = m.ios.len();
         Self {
-            core: Core::new(&m),
+            core: Core::new(&m).with_session_key(KEY),
             plants: m.axes.iter().map(|a| Plant::new(a.sim)).collect(),
             cmd: vec![CommandFrame::ZERO; ios],
             fb: vec![FeedbackFrame::ZERO; ios],
@@ -38,6 +43,7 @@ impl Bench {
             alive: vec![true; ios],
             k: 0,
             acks: Vec::new(),
+            setpoints: Vec::new(),
             m,
         }
     }
@@ -53,10 +59,15 @@ impl Bench {
         self.control(Control::undated(id, ask));
     }
 
-    /// One cycle: the core steps on last cycle's answers, publishes, and
-    /// every live I/O process answers (its plants advance one cycle).
+    /// One cycle: the setpoint frames queued are taken, the core steps on
+    /// last cycle's answers, publishes, answers the operations of the step,
+    /// and every live I/O process answers (its plants advance one cycle).
     pub fn cycle(&mut self) {
         let now = self.k * MS;
+        self.core.setpoints_begin();
+        for f in std::mem::take(&mut self.setpoints) {
+            self.core.setpoints_take(&f);
+        }
         let frames: Vec<Option<&FeedbackFrame>> = (0..self.fb.len())
             .map(|k| (self.alive[k] && self.seq[k] > 0).then_some(&self.fb[k]))
             .collect();
@@ -98,6 +109,32 @@ impl Bench {
         let mut s = Snapshot::default();
         self.core.snapshot(self.k * MS, &mut s);
         s
+    }
+
+    /// A setpoint frame of `token` for the next cycle: `seq`, program time
+    /// `t_ns`, one entry (`axis`, `position`).
+    pub fn setpoint(&mut self, token: u64, seq: u64, t_ns: u64, axis: u32, position: f64) {
+        let mut f = motion_frames::SetpointFrame {
+            layout_version: motion_frames::SETPOINT_LAYOUT,
+            key: KEY,
+            token,
+            seq,
+            t_ns,
+            count: 1,
+            ..motion_frames::SetpointFrame::ZERO
+        };
+        f.axes[0] = motion_frames::SetpointAxis {
+            axis,
+            position,
+            ..motion_frames::SetpointAxis::ZERO
+        };
+        self.setpoints.push(f);
+    }
+
+    /// An operation for the axes of `mask` (`token`: a jog's), applied in
+    /// the next cycle; its answer comes after that cycle's step.
+    pub fn op(&mut self, mask: u64, op: motion_homing::Operation, token: u64) {
+        self.ask(9, Ask::Op { mask, op, token });
     }
 
     pub fn home(&mut self, mask: u64, parallel: bool) -> Ack {

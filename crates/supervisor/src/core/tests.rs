@@ -53,7 +53,7 @@ fn demo_homes_through_frames_in_config_order() {
 
 /// A switch-homing axis (`extra`: its I/O process or home order): seek at
 /// 20 from -10 onto the switch [0, 5], return at 2 until it clears.
-fn switch_axis(name: &str, extra: &str) -> String {
+pub(super) fn switch_axis(name: &str, extra: &str) -> String {
     format!(
         r#"
 [[axis]]

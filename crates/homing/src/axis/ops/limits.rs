@@ -9,7 +9,10 @@
 //!   rest on the limit in its direction, a setpoint outside is refused, and
 //!   every stop of an operation's motion ends at or inside the limits: where
 //!   its deceleration would carry it past one, it decelerates harder (as
-//!   hard as it must) and ends on the limit. A cyclic axis has none.
+//!   hard as it must) and ends on the limit. A stop keeps the limits that
+//!   applied when it began: a fault that clears HomedStatus (invalid, lost
+//!   or implausible feedback) plans its stop inside the limits that applied
+//!   before it, and the stop keeps them to its end. A cyclic axis has none.
 //! * **Hardware overtravel** (`limit_switches`, default on): motion towards
 //!   a tripped limit switch is refused (ERR 9) and, when it happens, stopped
 //!   at `max_deceleration` as an axis fault (ER 12 / 43); motion away is
@@ -27,7 +30,7 @@ use crate::profile::Profile;
 impl Axis {
     /// The travel limits as raw positions, while they are enforced: homed,
     /// linear, configured.
-    pub(super) fn soft_limits_raw(&self) -> Option<(f64, f64)> {
+    pub(in crate::axis) fn soft_limits_raw(&self) -> Option<(f64, f64)> {
         match (self.status.homed, self.cfg.travel, self.cfg.travel_limits) {
             (true, TravelMode::Linear, Some((lo, hi))) => {
                 Some((lo - self.offset, hi - self.offset))
@@ -47,13 +50,27 @@ impl Axis {
         }
     }
 
-    /// A stop from `(p, v)` at time `t` at `decel`, ending at or inside the
-    /// travel limits when they are enforced: past the end a stop at `decel`
-    /// would reach, it ends exactly on the limit (decelerating harder); an
-    /// axis already at or beyond the limit it moves towards stops at once.
-    pub(super) fn stop_inside(&self, t: u64, p: f64, v: f64, decel: f64) -> Profile {
+    /// The travel limits a stop beginning now stays inside: those in force,
+    /// or — when the reference was lost in this very step (invalid, lost or
+    /// implausible feedback clears HomedStatus before the stop is planned)
+    /// — those that were in force after the previous step.
+    pub(super) fn stop_limits(&self) -> Option<(f64, f64)> {
+        self.soft_limits_raw().or(self.ops.limits_before)
+    }
+
+    /// A stop from `(p, v)` at time `t` at `decel`, ending at or inside
+    /// `limits` (raw): past the end a stop at `decel` would reach, it ends
+    /// exactly on the limit (decelerating harder); an axis already at or
+    /// beyond the limit it moves towards stops at once.
+    pub(super) fn stop_within(
+        t: u64,
+        p: f64,
+        v: f64,
+        decel: f64,
+        limits: Option<(f64, f64)>,
+    ) -> Profile {
         let plain = Profile::stop(t, p, v, decel);
-        let Some((lo, hi)) = self.soft_limits_raw() else {
+        let Some((lo, hi)) = limits else {
             return plain;
         };
         let limit = if v > 0.0 {

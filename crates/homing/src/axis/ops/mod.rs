@@ -10,6 +10,7 @@
 //!   axis 5/1, no feedback 12/40, servo off 5) and the operand checks (13);
 //! * `power`: enable, disable, reset, the drive's faults and power stage;
 //! * `jog`, `moves`, `stream`: each motion, its start and its progress;
+//!   `follower`: the stream's bounded follower (one cycle of arithmetic);
 //! * `limits`: software travel limits (homed, linear) and the hardware
 //!   limit switches;
 //! * `motion`: the data a motion carries from step to step;
@@ -23,17 +24,35 @@
 //!   planned path, never past what was planned. A jog on a homed linear
 //!   axis is planned as a move to the travel limit in its direction, so its
 //!   stop at the limit is part of the profile (it comes to rest on the
-//!   limit, never beyond, whatever the step timing).
+//!   limit, never beyond, whatever the step timing). The stream is the one
+//!   motion made step by step: its setpoints make a reference path (a
+//!   profile of linear segments), which the command follows within the
+//!   speed cap and `stream_acceleration` on the cycle's own timeline
+//!   (`follower`), whatever the setpoints' timestamps claim.
+//! * **Every motion has a speed bound.** `max_speed`, or the one the
+//!   homing speeds give; without one jog, move and stream are refused
+//!   (13 / 7). Not homed, `unhomed_speed` caps all three.
 //! * **Stops stay inside.** Every stop of an operation's motion on a homed
-//!   linear axis ends at or inside the travel limits (`limits::stop_inside`):
+//!   linear axis ends at or inside the travel limits (`limits::stop_within`):
 //!   where its deceleration would carry it past a limit, it decelerates
-//!   harder and ends on the limit. A motion that could not be stopped
-//!   inside from where it is (a reversal, a supersede) is refused.
+//!   harder and ends on the limit. A stop keeps the limits that applied
+//!   when it began, also when the fault that caused it cleared HomedStatus
+//!   in the same step. A motion that could not be stopped inside from where
+//!   it is (a reversal, a supersede) is refused.
+//! * **A stop can stop what was commanded.** A fault's stop brakes at
+//!   `max_deceleration` or harder: a stream's at the larger of
+//!   `max_deceleration` and `stream_acceleration` (no configuration rule
+//!   ties the two, so the stop takes what the stream was allowed); a fault
+//!   during a stop never brakes it less hard.
 //! * **A refusal is not a fault.** An operation refused leaves everything
 //!   as it was. An axis fault (drive fault, limit switch, refused setpoint,
 //!   lost feedback while moving, enable timeout) sets ER and `faulted`;
 //!   only `Reset` clears them.
+//! * **The drive decides the power stage's fate, never a reset.** A drive
+//!   fault or a dropped power stage withdraws the enable request in every
+//!   state; a reset excuses only the fault it was asked to clear (`power`).
 
+mod follower;
 mod jog;
 mod limits;
 pub(super) mod motion;
@@ -62,6 +81,9 @@ pub(in crate::axis) struct Ops {
     /// of homing or of a stop in progress): its id, and whether the power
     /// stage goes off then.
     pub await_rest: Option<(u32, bool)>,
+    /// The travel limits (raw) in force after the previous step: a stop
+    /// planned in a step that lost the reference keeps them.
+    pub limits_before: Option<(f64, f64)>,
 }
 
 impl Axis {
@@ -140,10 +162,10 @@ impl Axis {
     }
 
     /// The command state a motion continues from: time, raw position,
-    /// velocity. A stream's segment may end before `now` (the command then
-    /// rests on its setpoint until the next one), so a stream continues
-    /// from the last command, at the previous step: a stop planned from
-    /// there continues the motion the drive was last given.
+    /// velocity. A stream's command is made step by step (`follower`), so
+    /// a stream continues from the last command, at the previous step,
+    /// with the velocity it had then: a stop planned from there continues
+    /// the motion the drive was last given.
     fn motion_state(&mut self, now: u64) -> (u64, f64, f64) {
         if let State::Motion(Motion {
             run: Run::Stream(st),
@@ -151,20 +173,25 @@ impl Axis {
         }) = self.state
         {
             if let Some(t) = self.ops.prev_step_ns {
-                let v = if t <= st.seg_end_ns {
-                    st.seg_velocity
-                } else {
-                    0.0
-                };
-                return (t, self.last_command.position, v);
+                return (t, self.last_command.position, st.velocity);
             }
         }
         let (p, v) = self.profile.at(now);
         (now, p, v)
     }
 
-    /// The deceleration of the running motion (a stream's, or a stop's:
-    /// `max_deceleration`).
+    /// A stream's stops brake at the larger of `max_deceleration` and
+    /// `stream_acceleration`: the stream may approach a travel limit
+    /// braking at `stream_acceleration`, and its stop must be able to stop
+    /// what it was commanded (no configuration rule ties the two).
+    fn stream_decel(&self) -> f64 {
+        self.limits
+            .max_deceleration
+            .max(self.limits.stream_acceleration)
+    }
+
+    /// The deceleration of the running motion (a jog's or move's own, a
+    /// stream's stop's, a stop's; else `max_deceleration`).
     fn running_decel(&self) -> f64 {
         match self.state {
             State::Motion(Motion {
@@ -173,20 +200,37 @@ impl Axis {
             State::Motion(Motion {
                 run: Run::Move(m), ..
             }) => m.decel,
+            State::Motion(Motion {
+                run: Run::Stream(_),
+                ..
+            }) => self.stream_decel(),
+            State::Motion(Motion {
+                run: Run::Halt(h), ..
+            }) => h.decel,
             _ => self.limits.max_deceleration,
         }
     }
 
-    /// Brings the motion to rest at `decel`, inside the travel limits,
+    /// Brings the motion to rest at `decel`, inside the travel limits that
+    /// apply now (or that applied when a stop in progress began),
     /// answering for operation `op`; `normal`: PC at rest.
     fn halt(&mut self, now: u64, op: u32, decel: f64, cause: StopCause, normal: bool) {
+        let limits = match self.state {
+            State::Motion(Motion {
+                run: Run::Halt(h), ..
+            }) => h.limits,
+            _ => self.stop_limits(),
+        };
         let (t, p, v) = self.motion_state(now);
-        let stop = self.stop_inside(t, p, v, decel);
-        self.profile.set(stop);
+        self.profile.set(Self::stop_within(t, p, v, decel, limits));
         self.status.last_stop = cause;
         self.state = State::Motion(Motion {
             op,
-            run: Run::Halt(Halt { normal }),
+            run: Run::Halt(Halt {
+                normal,
+                decel,
+                limits,
+            }),
         });
     }
 
@@ -207,9 +251,11 @@ impl Axis {
 
     /// An axis fault while an operation moves the axis: ER with its code,
     /// `faulted`, the cause shown, the operation ended without PC; the axis
-    /// stops at `max_deceleration` (inside the travel limits) — or, with
-    /// `power_off`, the drive no longer follows: the power stage is
-    /// switched off and the command holds where the axis is.
+    /// stops at `max_deceleration` or harder (a stream's: see
+    /// `stream_decel`; a stop in progress goes on if it brakes at least as
+    /// hard), inside the travel limits that applied when the stop began —
+    /// or, with `power_off`, the drive no longer follows: the power stage
+    /// is switched off and the command holds where the axis is.
     pub(super) fn op_fault(
         &mut self,
         now: u64,
@@ -226,9 +272,20 @@ impl Axis {
             self.status.last_stop = cause;
             self.power_off_here(now);
             self.state = State::Idle;
-        } else {
-            let decel = self.limits.max_deceleration;
-            self.halt(now, m.op, decel, cause, false);
+            return true;
+        }
+        let decel = self.limits.max_deceleration.max(self.running_decel());
+        match m.run {
+            Run::Halt(h) if h.decel >= decel => {
+                // The stop under way already brakes that hard: it goes on,
+                // as a fault's.
+                self.status.last_stop = cause;
+                self.state = State::Motion(Motion {
+                    op: m.op,
+                    run: Run::Halt(Halt { normal: false, ..h }),
+                });
+            }
+            _ => self.halt(now, m.op, decel, cause, false),
         }
         true
     }
@@ -302,9 +359,10 @@ impl Axis {
         self.status.limit_positive = pos;
     }
 
-    /// The velocity the command carries while streaming (the feed-forward,
-    /// or the segment's), instead of the profile's: the profile rests on
-    /// each setpoint at the end of its segment.
+    /// The velocity the command carries while streaming, instead of the
+    /// profile's (which holds each step's command): the feed-forward while
+    /// the command is on the reference's segment, else the command's own
+    /// velocity over the step.
     pub(super) fn stream_velocity(&self, now: u64) -> Option<f64> {
         let State::Motion(Motion {
             run: Run::Stream(st),
@@ -313,10 +371,9 @@ impl Axis {
         else {
             return None;
         };
-        Some(if now <= st.seg_end_ns {
-            st.feed_forward.unwrap_or(st.seg_velocity)
-        } else {
-            0.0
+        Some(match st.feed_forward {
+            Some(ff) if st.on_reference && now <= st.seg_end_ns => ff,
+            _ => st.velocity,
         })
     }
 

@@ -3,6 +3,8 @@
 //! behaviour (which lives in the files beside this one). Why a stop
 //! began is in `Status::last_stop`, set when it began.
 
+use crate::profile::Profile;
+
 /// An operation's motion in progress: which operation it answers for, and
 /// what it is doing.
 #[derive(Clone, Copy, Debug)]
@@ -50,21 +52,42 @@ pub(in crate::axis) struct MoveRun {
     pub planned_speed: f64,
 }
 
-/// The supervised stream: the last setpoint taken, and the segment the
-/// command follows towards it.
+/// The supervised stream: the last setpoint taken, the reference path the
+/// setpoints make (linear from one to the next, on the cycle's timeline),
+/// and the command following it (`follower`).
 #[derive(Clone, Copy, Debug)]
 pub(in crate::axis) struct Stream {
     /// The last setpoint accepted: program time, raw position (unwrapped
     /// on a cyclic axis) and its segment velocity on the program's
     /// timeline (for the acceleration check). `None` before the first.
     pub prev: Option<Taken>,
-    /// When the command reaches the last setpoint (ns, engine time);
-    /// silence is counted from here.
+    /// The reference's segment: from `seg_from` at `seg_start_ns` to the
+    /// last setpoint (`seg_to`, raw) at `seg_end_ns`, then resting on it
+    /// (engine time).
+    pub seg_start_ns: u64,
+    pub seg_from: f64,
+    pub seg_to: f64,
     pub seg_end_ns: u64,
-    /// Velocity of the segment the command follows, units/s.
+    /// Velocity of the reference's segment, units/s.
     pub seg_velocity: f64,
+    /// The command's velocity over the last step, units/s.
+    pub velocity: f64,
+    /// The last step's command landed exactly on the reference.
+    pub on_reference: bool,
     /// The setpoint's velocity feed-forward, if it had one.
     pub feed_forward: Option<f64>,
+    /// When the last setpoint arrived (the stream's start before the
+    /// first), ns, engine time: silence counts from here.
+    pub arrived_ns: u64,
+}
+
+impl Stream {
+    /// The reference at `t`: position and velocity (linear along the
+    /// segment, exactly `seg_to` at its end and after).
+    pub fn reference(&self, t: u64) -> (f64, f64) {
+        let length = self.seg_end_ns.saturating_sub(self.seg_start_ns);
+        Profile::segment(self.seg_start_ns, self.seg_from, self.seg_to, length).sample(t)
+    }
 }
 
 /// A setpoint as the stream took it.
@@ -81,4 +104,9 @@ pub(in crate::axis) struct Halt {
     /// A normal end (stop, lease, release, disable, soft limit): PC when at
     /// rest. A fault's stop is not normal.
     pub normal: bool,
+    /// Its deceleration: a fault during the stop brakes at least as hard.
+    pub decel: f64,
+    /// The travel limits (raw) it stays inside: those that applied when it
+    /// began, whatever happens to the reference while it runs.
+    pub limits: Option<(f64, f64)>,
 }

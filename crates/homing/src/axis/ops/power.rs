@@ -14,11 +14,23 @@
 //!   drive sees a rising edge whatever the frame timing. A fault the
 //!   drive still reports after that (a wire break, an overload that
 //!   persists) is an axis fault again. Reset never enables, never moves.
+//! * **A fault during a reset is a fault.** The reset excuses only the
+//!   fault it was asked to clear: the drive's fault bit is not judged
+//!   while the drive still reports the fault it reported when the reset
+//!   was accepted, and only until it first reports none. A reset accepted
+//!   on a drive without a fault (a jogging axis) excuses nothing: a fault
+//!   in the next cycle ends the motion at once, however many resets came.
 //! * **The power stage never comes on by itself.** The engine requests it
-//!   on only for an `Enable` or a homing start; when the drive drops it
-//!   (STO, a power return, an I/O process restart) the request is
-//!   withdrawn, so the drive stays off until someone enables it again
-//!   (EN 60204-1 §7.5). In motion that is an axis fault (12 / 16).
+//!   on only for an `Enable` or a homing start; when the drive faults or
+//!   drops it (STO, a power return, an I/O process restart) the request is
+//!   withdrawn in the step that sees it, in every state — idle, enabling,
+//!   every homing leg, homing's abort ramp, an operation's motion or its
+//!   stop — so the drive stays off until someone enables it again
+//!   (EN 60204-1 §7.5), and a reset can never walk it back on. A drive
+//!   the I/O process reports lost, and the drives of a restarted I/O
+//!   process, are treated alike (`drive_gone_away`). A stop in
+//!   progress is abandoned (the drive no longer follows it: the command
+//!   holds where the axis is). In motion that is an axis fault (12 / 16).
 //! * **Enable** holds the actual position: while the power stage is off
 //!   the command follows the actual position, so it comes on without a
 //!   jump. The drive must report enabled within `enable_timeout`, else ER
@@ -54,6 +66,9 @@ pub(in crate::axis) struct Reset {
     since: u64,
     /// Commands sent with `fault_reset` set.
     sent: u8,
+    /// The drive still reports the fault it reported when the reset was
+    /// accepted (never reported none since): that fault is not judged.
+    excused: bool,
 }
 
 impl Axis {
@@ -116,6 +131,7 @@ impl Axis {
             op,
             since: now,
             sent: 0,
+            excused: self.last.is_some_and(|s| s.fb.drive.fault),
         });
         Ok(())
     }
@@ -123,7 +139,7 @@ impl Axis {
     /// The power stage off now (an enable waiting for it fails). The
     /// command stays where it is: at rest, the axis is there; from the next
     /// sample on it follows the actual position.
-    pub(super) fn power_off(&mut self) {
+    pub(in crate::axis) fn power_off(&mut self) {
         self.enable = false;
         self.ops.power.confirmed = false;
         if let Some((id, _)) = self.ops.power.enabling.take() {
@@ -141,10 +157,11 @@ impl Axis {
         self.profile.set(Profile::hold(now, hold));
     }
 
-    /// A fault reset is in progress: the drive's fault bit is not judged
-    /// (it may take a few cycles to clear).
+    /// A fault reset is clearing the fault the drive reported when it was
+    /// accepted: that fault bit is not judged (it may take a few cycles to
+    /// clear). Any other fault is.
     pub(in crate::axis) fn in_reset(&self) -> bool {
-        self.ops.power.reset.is_some()
+        self.ops.power.reset.is_some_and(|r| r.excused)
     }
 
     /// `Command::fault_reset` of this step's command.
@@ -184,10 +201,13 @@ impl Axis {
     /// enable confirmed, a fault, a power stage dropped by the drive.
     pub(in crate::axis) fn watch_drive(&mut self, now: u64, s: &Sample) {
         let d = s.fb.drive;
-        if let Some(r) = self.ops.power.reset {
+        if let Some(r) = &mut self.ops.power.reset {
+            // Cleared once: a fault from now on is a new one.
+            r.excused &= d.fault;
             if r.sent >= RESET_MIN_STEPS && !d.fault {
+                let op = r.op;
                 self.ops.power.reset = None;
-                self.op_done(r.op, true);
+                self.op_done(op, true);
             }
         }
         if !self.enable {
@@ -205,26 +225,36 @@ impl Axis {
         }
     }
 
-    /// The drive reports a fault. Homing reports it by its own rules (its
-    /// moving legs abort with 12 / 16, also the wait for the enable); the
-    /// axis is faulted in every case.
+    /// The drive reports a fault (not the one a reset is clearing): an
+    /// axis fault in every state, and the power stage requested off in
+    /// every state; a reset in progress ends without PC. Homing in process
+    /// aborts with 12 / 16 (a passive watch goes on: someone else moves the
+    /// axis); homing's abort ramp is abandoned.
     fn drive_fault(&mut self, now: u64) {
         let code = (ERR_SERVO_MESSAGE, EX_DRIVE_FAULT);
-        match self.state {
-            State::Motion(_) => {
-                self.op_fault(now, code, StopCause::DriveFault, true);
-            }
-            State::Idle if !self.status.faulted => {
-                self.set_fault(code);
-                self.power_off_here(now);
-            }
-            _ => self.status.faulted = true,
+        if let Some(r) = self.ops.power.reset.take() {
+            // Not the fault it was asked to clear: it needs a reset of its
+            // own (a new rising edge of the drive's fault reset).
+            self.op_done(r.op, false);
         }
+        if let State::Motion(_) = self.state {
+            self.op_fault(now, code, StopCause::DriveFault, true);
+            return;
+        }
+        if self.status.ip && self.homing_drives_the_axis() {
+            self.fail(now, code.0, code.1, Abort::Disable);
+            return;
+        }
+        if !self.status.faulted {
+            self.set_fault(code);
+        }
+        self.drive_gone(now);
     }
 
     /// The drive switched its power stage off by itself (no fault): the
-    /// request is withdrawn (it never comes back on by itself); in motion
-    /// that is an axis fault. Homing has its own rule (12 / 1).
+    /// request is withdrawn in every state (it never comes back on by
+    /// itself); in motion that is an axis fault; homing's moving legs end
+    /// with 12 / 1 (`Axis::advance`), its abort ramp is abandoned.
     fn drive_dropped(&mut self, now: u64) {
         match self.state {
             State::Motion(_) => {
@@ -235,9 +265,57 @@ impl Axis {
                     true,
                 );
             }
-            State::Idle => self.power_off_here(now),
-            _ => {}
+            _ if self.status.ip && self.homing_drives_the_axis() => self.fail(
+                now,
+                ERR_SERVO_MESSAGE,
+                EX_TERMINATED_ON_REQUEST,
+                Abort::Disable,
+            ),
+            _ => self.drive_gone(now),
         }
+    }
+
+    /// The drive is gone — reported lost (`Request::drive_lost`) for
+    /// longer than the feedback-loss rule tolerates, or its I/O process
+    /// restarted (whose drives start off): as a dropped power stage,
+    /// in every state the enable request is withdrawn at once (a drive that
+    /// comes back is never switched on by a request left standing); an
+    /// operation's motion ends as an axis fault (12 / `exerr`), homing that
+    /// drives the axis aborts with it, homing's abort ramp is abandoned.
+    pub(in crate::axis) fn drive_gone_away(&mut self, now: u64, exerr: u16) {
+        match self.state {
+            State::Motion(_) => {
+                self.op_fault(
+                    now,
+                    (ERR_SERVO_MESSAGE, exerr),
+                    StopCause::FeedbackLost,
+                    true,
+                );
+            }
+            _ if self.status.ip && self.homing_drives_the_axis() => {
+                self.fail(now, ERR_SERVO_MESSAGE, exerr, Abort::Disable);
+            }
+            State::Idle if !self.enable => {}
+            _ => self.drive_gone(now),
+        }
+    }
+
+    /// Homing in process commands the drive (a leg that moves, the wait
+    /// for the enable), as opposed to watching an axis someone else moves.
+    fn homing_drives_the_axis(&self) -> bool {
+        matches!(self.state, State::Enabling { .. }) || self.state.commands_motion()
+    }
+
+    /// The drive no longer follows, outside an operation's motion or a
+    /// homing that commands it: the power stage off, the command holding
+    /// where the axis is; homing's abort ramp (which the drive no longer
+    /// follows) is abandoned, the overrides restored.
+    fn drive_gone(&mut self, now: u64) {
+        if let State::Stopping { .. } = self.state {
+            self.overrides = false;
+            self.state = State::Idle;
+        }
+        self.power_off_here(now);
     }
 
     /// `Request::shutdown` (MASD), a level: the power stage off at once;

@@ -6,9 +6,11 @@
 //! |---|---|
 //! | enable, jog, move, stream start | 16 homing in process · 20 faulted · 12/12 shutdown · 5/1 not a servo axis · 12/40 no valid feedback |
 //! | jog, move, stream start | also 5 servo off (not enabled, or a disable in progress) |
+//! | jog, move, stream start | 13/7 no speed bound (no `max_speed`, none derived from the homing speeds) |
 //! | jog | 3 on a moving or streaming axis (a jog on a jogging axis replaces it) · 13/1..3, 13/6 operands · 9 towards a tripped limit switch · 13/4 towards a travel limit already reached, or a stop that would end outside |
 //! | move | 3 on a jogging or moving axis without `supersede`, on a streaming axis · 13/5 target not finite · 13/1..3 operands · 13/4 target outside the travel limits (or ±`max_position`), or a stop that would end outside · 9 towards a tripped limit switch |
-//! | stream start | 3 on an axis in motion (stopping too) · 1019/7 not homed (unless `stream_unhomed`) · 13/1 no speed bound · 13/3 no `max_deceleration` |
+//! | stream start | 3 on an axis in motion (stopping too) · then 13/7 as above · 1019/7 not homed (unless `stream_unhomed`) · 13/1 a speed cap of 0 (unhomed, no `unhomed_speed`) · 13/3 no `max_deceleration` |
+//! | setpoint (an axis fault, 1019) | 1 not finite · 2 outside the travel limits · 3 faster than the speed cap (unhomed: `unhomed_speed`) on the program's timeline, or the command held back by it further than it can follow · 4 a change of velocity above `stream_acceleration` on the program's timeline, or the command held back by it further than it can follow · 5 nothing for `stream_timeout_ms` since the last one arrived · 6 out of order · 7 not homed |
 //! | reset | 16 homing in process |
 //! | disable, stop, stream end | never |
 //!
@@ -89,10 +91,20 @@ impl Axis {
         }
     }
 
-    /// The fastest an operation may ask for now: `max_speed` (when any is
-    /// known), and `unhomed_speed` while not homed.
+    /// Every motion has a speed bound: `max_speed`, or the one the homing
+    /// speeds give (`effective_max_speed`). Without one nothing moves the
+    /// axis (13 / 7, naming `max_speed`); homing still works.
+    pub(super) fn speed_bound(&self) -> Result<f64, Code> {
+        self.limits
+            .max_speed
+            .ok_or((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NO_MAX_SPEED))
+    }
+
+    /// The fastest an operation may ask for now: `max_speed` (0 when none
+    /// is known: nothing may move), and `unhomed_speed` while not homed —
+    /// for jog, move and stream alike.
     pub(super) fn speed_cap(&self) -> f64 {
-        let max = self.limits.max_speed.unwrap_or(f64::INFINITY);
+        let max = self.limits.max_speed.unwrap_or(0.0);
         if self.status.homed {
             max
         } else {
@@ -103,6 +115,7 @@ impl Axis {
     /// Speed, acceleration and deceleration of a jog or move (the speed's
     /// magnitude; its sign is a jog's direction).
     pub(super) fn check_dynamics(&self, speed: f64, accel: f64, decel: f64) -> Result<(), Code> {
+        self.speed_bound()?;
         let s = speed.abs();
         if !(s.is_finite() && s > 0.0 && s <= self.speed_cap()) {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_SPEED));

@@ -1,42 +1,80 @@
 //! The supervised setpoint stream: a program's positions, checked one by
-//! one and interpolated to the cycle.
+//! one, made into a reference path on the cycle's timeline, and followed
+//! by a command that is never faster or harder than the limits, whatever
+//! the setpoints' timestamps say.
 //!
-//! **Interpolation.** When setpoint k arrives (program time t_k, previous
-//! t_{k−1}), the command runs linearly from the previous step's command
-//! position to p_k, reaching it Δ = t_k − t_{k−1} later, rounded to whole
-//! cycles (at least one): a stream at the cycle rate is commanded exactly,
-//! in the step it arrives (one cycle after it was published); a 100 Hz
-//! stream on a 1 kHz cycle becomes ten equal steps per setpoint. A
-//! setpoint that comes early restarts the interpolation from where the
-//! command is; one that comes late leaves the command resting on the
-//! previous one — the command never extrapolates, so it only ever passes
-//! positions between accepted setpoints. Should a catch-up segment be
-//! faster than `max_speed` (the command lagging behind the program), it is
-//! stretched to `max_speed`.
+//! **The reference.** When setpoint k arrives (program time t_k, previous
+//! t_{k−1}), the reference runs linearly from where it is to p_k, reaching
+//! it Δ = t_k − t_{k−1} later, rounded to whole cycles (at least one), and
+//! rests on it until the next one. A 100 Hz stream on a 1 kHz cycle
+//! becomes ten equal steps per setpoint; one that comes early restarts
+//! from where the reference is.
 //!
-//! **Checks** of every setpoint, each an axis fault that stops the axis at
-//! `max_deceleration` (inside the travel limits) and ends the stream
-//! (ER 1019 / EXERR): 1 position or feed-forward not finite; 2 outside
-//! `travel_limits` (homed, linear) or beyond ±`max_position`; 3 segment
-//! speed |p_k − p_{k−1}| / Δ (or the feed-forward) above `max_speed`;
-//! 4 change of segment velocity |v_k − v_{k−1}| / Δ above
-//! `stream_acceleration`; 6 t_k not after t_{k−1}; 7 not homed and
-//! `stream_unhomed` false. The first setpoint is judged against the
-//! current command position as if it came one cycle after it, from rest.
-//! Δ here is the program's own (exact, not rounded): the checks judge the
-//! program's trajectory, not the transport's jitter. Speeds and
-//! accelerations get a relative tolerance of 1e-9 (a trajectory exactly at
-//! the bound passes despite rounding).
+//! **The command follows the reference, within the limits** (`follower`):
+//! sampled each cycle, its velocity never changes by more than
+//! `stream_acceleration` × cycle between two cycles, and it is never faster
+//! than the speed cap that applies — `max_speed`, and `unhomed_speed` while
+//! not homed (`stream_unhomed`), as for jog and move — nor carried past a
+//! travel limit. Where the reference is reachable within those bounds (a
+//! stream at the cycle rate, a sparse stream whose corners need no more
+//! than `stream_acceleration` × cycle) the command is on it exactly, in the
+//! step the setpoint arrives (one cycle after it was published). Where it
+//! is not — a corner too sharp for one cycle, a setpoint that comes late
+//! (the command brakes past the last one instead of stopping dead on it),
+//! timestamps that claim more time than the cycle gives — the command
+//! closes in at the bounds. If it would lag the reference by more than
+//! `max_speed`² / (2 `stream_acceleration`) + one cycle at `max_speed`
+//! (the cap that applies, in fact: see `follower::lag_bound`), the stream
+//! cannot be followed: refused with 1019 / 3 (held back by the speed cap)
+//! or 1019 / 4 (by the acceleration), from the command of the step before —
+//! nothing of that step reaches the drive. The guarantee is on the
+//! commanded positions as the cycle samples them: no timestamp can buy a
+//! faster or harder command.
 //!
-//! **Silence.** No new setpoint for `stream_timeout_ms` after the command
-//! reached the last one → 1019 / 5 (the axis already rests on it).
+//! Why shape rather than only refuse: judged on the cycle's timeline
+//! alone, a 100 Hz stream on a 1 kHz cycle could change its velocity per
+//! setpoint by no more than `stream_acceleration` × one cycle — a tenth of
+//! what its own timeline honestly allows — and a setpoint one cycle late
+//! would still stop the command dead on the one before. Shaping keeps
+//! every honest stream (the bench's circles at the cycle rate and at
+//! 100 Hz, the 100 Hz Python programs) within the bounds, on its
+//! setpoints wherever they are reachable; refusing what cannot be followed
+//! within a stop's distance keeps a hostile stream from dragging the
+//! command far from the path it asked for.
+//!
+//! **Checks** of every setpoint on the program's own timeline (a program's
+//! trajectory that is nonsense is refused before it is followed), each an
+//! axis fault that stops the axis and ends the stream (ER 1019 / EXERR): 1
+//! position or feed-forward not finite; 2 outside `travel_limits` (homed,
+//! linear) or beyond ±`max_position`; 3 segment speed |p_k − p_{k−1}| / Δ
+//! (or the feed-forward) above the speed cap; 4 change of segment velocity
+//! |v_k − v_{k−1}| / Δ above `stream_acceleration`; 6 t_k not after
+//! t_{k−1}; 7 not homed and `stream_unhomed` false. The first setpoint is
+//! judged against the current command position as if it came one cycle
+//! after it, from rest. Δ here is the program's own (exact, not rounded).
+//! Speeds and accelerations get a relative tolerance of 1e-9 (a trajectory
+//! exactly at the bound passes despite rounding).
+//!
+//! **Silence.** No new setpoint for `stream_timeout_ms` after the last one
+//! *arrived* → 1019 / 5, however far ahead that setpoint lay: a program
+//! that hangs or dies runs out nothing. A program must publish at least
+//! every `stream_timeout_ms` (a setpoint far ahead in time is not a promise
+//! to keep the axis moving).
 //! **Not homed** (the reference cleared while streaming) → 1019 / 7.
 //!
-//! **End.** `StreamEnd` (released, or the owner gone): the axis lands on
-//! the last setpoint when it can stop there at `max_deceleration`, else it
-//! stops at `max_deceleration`; normal (`StopCause::Released`, PC at rest).
-//! A `stop` stops it at `max_deceleration` at once.
+//! **Stops.** A stream's stops — a refusal, silence, a fault, `stop`, the
+//! release — brake from the command's state at the larger of
+//! `max_deceleration` and `stream_acceleration` (what the stream was
+//! allowed, it can stop), inside the travel limits. `StreamEnd` (released,
+//! or the owner gone) stops at once (normal: `StopCause::Released`, PC at
+//! rest); a program that releases at rest on its last setpoint — the
+//! normal end — finds the axis there. The bound for a program that stops
+//! sending (released, dead or hung): at rest within `stream_timeout_ms`
+//! of its last setpoint's arrival (plus a cycle), travelling at most
+//! v × (`stream_timeout_ms` + cycle) + v² / (2 d) (v its speed, d that
+//! deceleration).
 
+use super::follower::{self, Bounds};
 use super::motion::{Halt, Motion, Run, Stream, Taken};
 use super::{within, Code};
 use crate::axis::state::State;
@@ -45,7 +83,7 @@ use crate::codes::*;
 use crate::config::TravelMode;
 use crate::operation::{OpKind, Setpoint, StopCause};
 use crate::position::nearest_cyclic;
-use crate::profile::{reaches_without_reversing, Profile};
+use crate::profile::Profile;
 use crate::time::{f64_as_ns, ns_to_s};
 
 /// Relative tolerance of the speed and acceleration checks.
@@ -59,10 +97,11 @@ impl Axis {
         if matches!(self.state, State::Motion(_) | State::Stopping { .. }) {
             return Err(super::rules::COLLISION);
         }
+        self.speed_bound()?;
         if !self.status.homed && !self.cfg.stream_unhomed {
             return Err((ERR_SETPOINT_REFUSED, EX_SETPOINT_NOT_HOMED));
         }
-        if self.limits.max_speed.is_none() {
+        if self.speed_cap() <= 0.0 {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_SPEED));
         }
         if self.limits.max_deceleration <= 0.0 || self.limits.max_deceleration.is_nan() {
@@ -75,19 +114,27 @@ impl Axis {
             op,
             run: Run::Stream(Stream {
                 prev: None,
+                seg_start_ns: now,
+                seg_from: p,
+                seg_to: p,
                 seg_end_ns: now,
                 seg_velocity: 0.0,
+                velocity: 0.0,
+                on_reference: true,
                 feed_forward: None,
+                arrived_ns: now,
             }),
         });
         Ok(())
     }
 
-    /// The stream is released (or its owner is gone): always accepted.
+    /// The stream is released (or its owner is gone): always accepted. The
+    /// axis stops now, from the command's state, at the stream's
+    /// deceleration — not at the end of a segment that may lie far ahead.
     pub(super) fn stream_end(&mut self, now: u64) {
         let id = self.accept_op(OpKind::StreamEnd);
         let State::Motion(Motion {
-            run: Run::Stream(st),
+            run: Run::Stream(_),
             ..
         }) = self.state
         else {
@@ -96,18 +143,17 @@ impl Axis {
             return;
         };
         let (t, p, v) = self.motion_state(now);
-        let decel = self.limits.max_deceleration;
-        let last = st.prev.map_or(p, |k| k.raw);
-        let landing = if v != 0.0 && reaches_without_reversing(p, v, last, decel) {
-            Profile::move_to(t, p, v, last, v.abs(), decel, decel)
-        } else {
-            self.stop_inside(t, p, v, decel)
-        };
-        self.profile.set(landing);
+        let decel = self.stream_decel();
+        let limits = self.stop_limits();
+        self.profile.set(Self::stop_within(t, p, v, decel, limits));
         self.status.last_stop = StopCause::Released;
         self.state = State::Motion(Motion {
             op: id,
-            run: Run::Halt(Halt { normal: true }),
+            run: Run::Halt(Halt {
+                normal: true,
+                decel,
+                limits,
+            }),
         });
     }
 
@@ -121,7 +167,7 @@ impl Axis {
             return;
         };
         match self.judge(now, sp, &st) {
-            Ok(taken) => self.follow(now, op, taken, sp.velocity),
+            Ok(taken) => self.new_segment(now, op, taken, sp.velocity),
             Err(exerr) => {
                 self.op_fault(
                     now,
@@ -177,7 +223,7 @@ impl Axis {
         }
         let dt = ns_to_s(dt_ns);
         let velocity = (raw - from) / dt;
-        let vmax = self.limits.max_speed.unwrap_or(0.0) * (1.0 + TOLERANCE);
+        let vmax = self.speed_cap() * (1.0 + TOLERANCE);
         let ff_fast = sp.velocity.is_some_and(|f| f.abs() > vmax);
         if !within(velocity, vmax) || ff_fast {
             return Err(EX_SETPOINT_SPEED);
@@ -193,9 +239,10 @@ impl Axis {
         })
     }
 
-    /// Follows an accepted setpoint: a segment from the previous step's
-    /// command to it, lasting the program's Δ in whole cycles.
-    fn follow(&mut self, now: u64, op: u32, k: Taken, feed_forward: Option<f64>) {
+    /// An accepted setpoint: the reference's next segment, from where the
+    /// reference is at the previous step to it, lasting the program's Δ in
+    /// whole cycles.
+    fn new_segment(&mut self, now: u64, op: u32, k: Taken, feed_forward: Option<f64>) {
         let State::Motion(Motion {
             run: Run::Stream(st),
             ..
@@ -205,36 +252,35 @@ impl Axis {
         };
         let cycle = self.cycle_ns(now);
         let dt_ns = st.prev.map_or(cycle, |p| k.t_ns - p.t_ns);
-        let mut cycles = (dt_ns as f64 / cycle as f64).round().max(1.0);
+        let cycles = (dt_ns as f64 / cycle as f64).round().max(1.0);
         let t0 = self.ops.prev_step_ns.unwrap_or(now.saturating_sub(cycle));
-        let from = self.last_command.position;
-        // Catching up: never faster than max_speed.
-        let vmax = self.limits.max_speed.unwrap_or(f64::INFINITY);
-        let need = (k.raw - from).abs() / vmax / ns_to_s(cycle);
-        if need > cycles {
-            cycles = need.ceil();
-        }
+        let from = st.reference(t0).0;
         let seg_ns = f64_as_ns(cycles * cycle as f64);
-        self.profile.set(Profile::segment(t0, from, k.raw, seg_ns));
         self.state = State::Motion(Motion {
             op,
             run: Run::Stream(Stream {
                 prev: Some(k),
+                seg_start_ns: t0,
+                seg_from: from,
+                seg_to: k.raw,
                 seg_end_ns: t0.saturating_add(seg_ns),
                 seg_velocity: (k.raw - from) / ns_to_s(seg_ns),
                 feed_forward,
+                arrived_ns: now,
+                ..st
             }),
         });
     }
 
-    /// One step of the stream: still homed, not silent.
-    pub(super) fn advance_stream(&mut self, now: u64, _op: u32, st: Stream) {
+    /// One step of the stream: still homed, not silent, then the command
+    /// one cycle further along the reference, within the bounds.
+    pub(super) fn advance_stream(&mut self, now: u64, op: u32, st: Stream) {
         let fault = if !self.status.homed && !self.cfg.stream_unhomed {
             Some(EX_SETPOINT_NOT_HOMED)
-        } else if now.saturating_sub(st.seg_end_ns) > self.limits.stream_timeout_ns {
+        } else if now.saturating_sub(st.arrived_ns) > self.limits.stream_timeout_ns {
             Some(EX_SETPOINT_STALE)
         } else {
-            None
+            self.follow(now, op, st).err()
         };
         if let Some(exerr) = fault {
             self.op_fault(
@@ -244,5 +290,51 @@ impl Axis {
                 false,
             );
         }
+    }
+
+    /// This step's command along the reference (`follower`); the EXERR
+    /// when it would lag the reference further than it can be followed
+    /// (nothing of this step is then commanded).
+    fn follow(&mut self, now: u64, op: u32, st: Stream) -> Result<(), u16> {
+        let Some(dt_ns) = self.ops.prev_step_ns.map(|t| now.saturating_sub(t)) else {
+            return Ok(());
+        };
+        if dt_ns == 0 {
+            return Ok(());
+        }
+        let (r, _) = st.reference(now);
+        let u = if now <= st.seg_end_ns {
+            st.seg_velocity
+        } else {
+            0.0
+        };
+        let bounds = Bounds {
+            cap: self.speed_cap(),
+            accel: self.limits.stream_acceleration,
+            limits: self.soft_limits_raw(),
+        };
+        let x = self.last_command.position;
+        let step = follower::step(x, st.velocity, r, u, ns_to_s(dt_ns), &bounds);
+        let cycle_s = ns_to_s(self.cycle_ns(now));
+        if !within(
+            r - step.position,
+            follower::lag_bound(bounds.cap, bounds.accel, cycle_s),
+        ) {
+            return Err(if step.capped {
+                EX_SETPOINT_SPEED
+            } else {
+                EX_SETPOINT_ACCELERATION
+            });
+        }
+        self.profile.set(Profile::hold(now, step.position));
+        self.state = State::Motion(Motion {
+            op,
+            run: Run::Stream(Stream {
+                velocity: step.velocity,
+                on_reference: step.on_reference,
+                ..st
+            }),
+        });
+        Ok(())
     }
 }
