@@ -8,6 +8,7 @@
 //! access read-only, users only with a salted password hash.
 
 use crate::keys::Reader;
+use crate::keytable::{opcua::*, Section};
 use crate::{names, AxisEntry, MachineConfig, Problem};
 use std::path::{Path, PathBuf};
 
@@ -40,6 +41,12 @@ impl Policy {
             .map_or("?", |(n, _)| n)
     }
 }
+
+/// `anonymous`: may anonymous sessions read?
+pub const ANONYMOUS: &[(&str, bool)] = &[("read", true), ("off", false)];
+
+/// `role` of a user.
+pub const ROLES: &[(&str, Role)] = &[("operator", Role::Operator), ("viewer", Role::Viewer)];
 
 /// The secure policies offered by default.
 pub const DEFAULT_POLICIES: [Policy; 3] = [
@@ -138,30 +145,30 @@ pub(crate) fn parse(
     problems: &mut Vec<Problem>,
 ) -> OpcuaConfig {
     let empty = toml::Table::new();
-    let mut r = Reader::new(table.unwrap_or(&empty), None, "opcua.", problems);
-    let endpoint = r.string("endpoint", DEFAULT_ENDPOINT);
+    let mut r = Reader::new(table.unwrap_or(&empty), None, Section::Opcua, problems);
+    let endpoint = r.string(&ENDPOINT);
     let (host, port, path) = match split_endpoint(&endpoint) {
         Ok(x) => x,
         Err(e) => {
-            r.problem("endpoint", e);
+            r.problem(&ENDPOINT, e);
             ("127.0.0.1".into(), 4840, "/".into())
         }
     };
-    let anonymous = r.choice("anonymous", &[("read", true), ("off", false)], true);
-    let policies = policies(&mut r, table.and_then(|t| t.get("policies")));
+    let anonymous = r.choice(&ANONYMOUS_ACCESS, ANONYMOUS);
+    let policies = policies(&mut r);
     if policies.contains(&Policy::None) && !anonymous {
         r.problem(
-            "policies",
+            &POLICIES,
             "\"None\" is offered read-only, to anonymous sessions only: it needs \
              anonymous = \"read\""
                 .into(),
         );
     }
-    let pki_dir = if r.has("pki_dir") {
-        let d = r.string("pki_dir", "");
+    let pki_dir = if r.has(&PKI_DIR) {
+        let d = r.string(&PKI_DIR);
         if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
             r.problem(
-                "pki_dir",
+                &PKI_DIR,
                 format!(
                     "{} must be an absolute path of at most 200 characters without \"..\"",
                     names::shown(&d)
@@ -173,7 +180,7 @@ pub(crate) fn parse(
         state_dir.join("opcua")
     };
     let units = units(&mut r, axes);
-    let user_tables = r.array_of_tables("user");
+    let user_tables = r.array_of_tables(&USER);
     r.finish();
     let users = users(&user_tables, problems);
     OpcuaConfig {
@@ -189,25 +196,24 @@ pub(crate) fn parse(
     }
 }
 
-fn policies(r: &mut Reader, value: Option<&toml::Value>) -> Vec<Policy> {
-    let Some(value) = value else {
+fn policies(r: &mut Reader) -> Vec<Policy> {
+    let Some(value) = r.value(&POLICIES) else {
         return DEFAULT_POLICIES.to_vec();
     };
-    r.mark_used("policies");
     let Some(list) = value
         .as_array()
         .and_then(|a| a.iter().map(|v| v.as_str()).collect::<Option<Vec<_>>>())
     else {
-        r.problem("policies", "expected a list of policy names".into());
+        r.problem(&POLICIES, "expected a list of policy names".into());
         return DEFAULT_POLICIES.to_vec();
     };
     let mut out = Vec::new();
     for s in list {
         match Policy::NAMES.iter().find(|(n, _)| *n == s) {
             Some((_, p)) if !out.contains(p) => out.push(*p),
-            Some(_) => r.problem("policies", format!("{} listed twice", names::shown(s))),
+            Some(_) => r.problem(&POLICIES, format!("{} listed twice", names::shown(s))),
             None => r.problem(
-                "policies",
+                &POLICIES,
                 format!(
                     "{} is not one of {}",
                     names::shown(s),
@@ -221,19 +227,19 @@ fn policies(r: &mut Reader, value: Option<&toml::Value>) -> Vec<Policy> {
         }
     }
     if out.is_empty() {
-        r.problem("policies", "no policy: list at least one".into());
+        r.problem(&POLICIES, "no policy: list at least one".into());
     }
     out
 }
 
 fn units(r: &mut Reader, axes: &[AxisEntry]) -> Vec<(String, Unit)> {
-    let Some(t) = r.table("units") else {
+    let Some(t) = r.table(&UNITS) else {
         return Vec::new();
     };
     let mut out = Vec::new();
     for (axis, v) in &t {
         if !axes.iter().any(|a| &a.name == axis) {
-            r.problem(
+            r.problem_at(
                 &format!("units.{axis}"),
                 format!("no axis is called {}", names::shown(axis)),
             );
@@ -244,7 +250,7 @@ fn units(r: &mut Reader, axes: &[AxisEntry]) -> Vec<(String, Unit)> {
             .and_then(|s| Unit::NAMES.iter().find(|(n, _)| *n == s))
         {
             Some((_, u)) => out.push((axis.clone(), *u)),
-            None => r.problem(
+            None => r.problem_at(
                 &format!("units.{axis}"),
                 format!(
                     "expected one of {}",
@@ -263,39 +269,32 @@ fn units(r: &mut Reader, axes: &[AxisEntry]) -> Vec<(String, Unit)> {
 fn users(tables: &[toml::Table], problems: &mut Vec<Problem>) -> Vec<User> {
     let mut out: Vec<User> = Vec::new();
     for (i, t) in tables.iter().enumerate() {
-        let mut r = Reader::new(t, None, "opcua.user.", problems);
-        let name = r.string("name", "");
+        let mut r = Reader::new(t, None, Section::OpcuaUser, problems);
+        let name = r.string(&USER_NAME);
         let at = format!("[[opcua.user]] #{}", i + 1);
         if let Err(e) = names::check_name(&name) {
-            r.problem("name", format!("{at}: {e}"));
+            r.problem(&USER_NAME, format!("{at}: {e}"));
         } else if out.iter().any(|u| u.name == name) {
-            r.problem("name", format!("user {name} configured twice"));
+            r.problem(&USER_NAME, format!("user {name} configured twice"));
         }
-        if r.has("password") {
-            r.mark_used("password");
+        if r.has(&PASSWORD) {
+            r.mark_used(&PASSWORD);
             r.problem(
-                "password",
+                &PASSWORD,
                 format!(
                     "{at}: a clear-text password is never accepted: put the output of \
                      `motion-opcua --config FILE hash-password` in password_hash"
                 ),
             );
         }
-        let password_hash = r.string("password_hash", "");
+        let password_hash = r.string(&PASSWORD_HASH);
         if let Err(e) = check_phc(&password_hash) {
-            r.problem(
-                "password_hash",
-                format!("user {}: {e}", names::shown(&name)),
-            );
+            r.problem(&PASSWORD_HASH, format!("user {}: {e}", names::shown(&name)));
         }
-        let role = r.choice(
-            "role",
-            &[("operator", Role::Operator), ("viewer", Role::Viewer)],
-            Role::Viewer,
-        );
-        if !r.has("role") {
+        let role = r.choice(&ROLE, ROLES);
+        if !r.has(&ROLE) {
             r.problem(
-                "role",
+                &ROLE,
                 format!(
                     "user {}: missing (\"operator\" or \"viewer\")",
                     names::shown(&name)

@@ -38,18 +38,17 @@ pub enum EthercatDc {
     Off,
 }
 
-impl EthercatDc {
-    pub fn name(self) -> &'static str {
-        match self {
-            EthercatDc::Auto => "auto",
-            EthercatDc::On => "on",
-            EthercatDc::Off => "off",
-        }
-    }
-}
+motion_homing::spellings!(EthercatDc {
+    Auto => "auto",
+    On => "on",
+    Off => "off",
+});
+
+/// `[[io]] dc`.
+pub const DC_MODES: &[(&str, EthercatDc)] = EthercatDc::NAMES;
 
 /// The `[[io]]` keys of an I/O process with `backend = "ethercat"`
-/// (ranges in [`crate::limits`]).
+/// (declared, with their ranges and defaults, in [`crate::keytable::ethercat`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EthercatIo {
     /// Network interface of the EtherCAT segment (`motion-io --interface`
@@ -75,16 +74,18 @@ pub struct EthercatIo {
 }
 
 impl Default for EthercatIo {
+    /// The key table's defaults (`crate::keytable::ethercat`).
     fn default() -> Self {
+        use crate::keytable::ethercat as k;
         EthercatIo {
             interface: String::new(),
-            dc: EthercatDc::Auto,
-            sm_watchdog_ms: 50,
+            dc: EthercatDc::default(),
+            sm_watchdog_ms: k::SM_WATCHDOG_MS.default_f64() as u32,
             reply_timeout_us: None,
-            startup_timeout_s: 30,
-            mode_in_pdo: false,
-            dc_static_sync_iterations: 1000,
-            quick_stop_timeout_ms: 500,
+            startup_timeout_s: k::STARTUP_TIMEOUT_S.default_f64() as u32,
+            mode_in_pdo: k::MODE_IN_PDO.default_bool(),
+            dc_static_sync_iterations: k::DC_STATIC_SYNC_ITERATIONS.default_f64() as u32,
+            quick_stop_timeout_ms: k::QUICK_STOP_TIMEOUT_MS.default_f64() as u32,
         }
     }
 }
