@@ -73,23 +73,6 @@ pub struct EthercatIo {
     pub quick_stop_timeout_ms: u32,
 }
 
-impl Default for EthercatIo {
-    /// The key table's defaults (`crate::keytable::ethercat`).
-    fn default() -> Self {
-        use crate::keytable::ethercat as k;
-        EthercatIo {
-            interface: String::new(),
-            dc: EthercatDc::default(),
-            sm_watchdog_ms: k::SM_WATCHDOG_MS.default_f64() as u32,
-            reply_timeout_us: None,
-            startup_timeout_s: k::STARTUP_TIMEOUT_S.default_f64() as u32,
-            mode_in_pdo: k::MODE_IN_PDO.default_bool(),
-            dc_static_sync_iterations: k::DC_STATIC_SYNC_ITERATIONS.default_f64() as u32,
-            quick_stop_timeout_ms: k::QUICK_STOP_TIMEOUT_MS.default_f64() as u32,
-        }
-    }
-}
-
 /// How an axis of an EtherCAT I/O process finds its drive.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum EthercatDrive {

@@ -316,3 +316,19 @@ pub(crate) fn checks(ios: &[IoConfig], axes: &[AxisEntry], problems: &mut Vec<Pr
         }
     }
 }
+
+impl Default for EthercatIo {
+    /// The key table's defaults.
+    fn default() -> Self {
+        EthercatIo {
+            interface: String::new(),
+            dc: super::EthercatDc::default(),
+            sm_watchdog_ms: SM_WATCHDOG_MS.default_f64() as u32,
+            reply_timeout_us: None,
+            startup_timeout_s: STARTUP_TIMEOUT_S.default_f64() as u32,
+            mode_in_pdo: MODE_IN_PDO.default_bool(),
+            dc_static_sync_iterations: DC_STATIC_SYNC_ITERATIONS.default_f64() as u32,
+            quick_stop_timeout_ms: QUICK_STOP_TIMEOUT_MS.default_f64() as u32,
+        }
+    }
+}
