@@ -3,6 +3,7 @@
 //! Every read names a key of the key table ([`crate::keytable`]): its
 //! default, range and unit come from there.
 
+pub(crate) use crate::keytable::number as num;
 use crate::keytable::{self, Key, Section};
 use crate::Problem;
 use std::collections::BTreeSet;
@@ -363,15 +364,5 @@ impl<'a> Reader<'a> {
                 ));
             }
         }
-    }
-}
-
-/// A number as a person reads it: plain in the usual range, scientific
-/// beyond (`1e308`, not 309 digits).
-pub(crate) fn num(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-4..1e10).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
     }
 }

@@ -82,7 +82,8 @@ fn help(a: &Arg) -> String {
         .iter()
         .map(|v| v.to_string_lossy().into_owned())
         .collect();
-    if !defaults.is_empty() {
+    let takes = a.get_num_args().is_some_and(|n| n.takes_values());
+    if !defaults.is_empty() && takes {
         text += &format!(" (default: {})", defaults.join(", "));
     }
     let possible: Vec<String> = a
@@ -91,7 +92,7 @@ fn help(a: &Arg) -> String {
         .filter(|p| !p.is_hide_set())
         .map(|p| format!("`{}`", p.get_name()))
         .collect();
-    if !possible.is_empty() && a.get_num_args().is_some_and(|n| n.takes_values()) {
+    if !possible.is_empty() && takes {
         text += &format!(" (one of {})", possible.join(", "));
     }
     crate::markdown::cell(&text)

@@ -25,7 +25,7 @@ fn table_of(k: &Key) -> String {
 pub fn render() -> String {
     let mut out = String::new();
     for g in GROUPS {
-        out += &format!("## {}\n\n{}\n\n", g.title, g.intro);
+        out += &format!("### {}\n\n{}\n\n", g.title, g.intro);
         out += "| key | type | default | bounds |\n|---|---|---|---|\n";
         for k in g.keys {
             out += &format!(
@@ -46,12 +46,23 @@ pub fn render() -> String {
 }
 
 fn key_block(k: &Key) -> String {
-    let mut facts = vec![keys::kind(k), format!("default: {}", keys::default(k))];
+    let mut facts = vec![
+        format!("*{}*", keys::kind(k)),
+        format!("default: {}", keys::default(k)),
+    ];
     let b = keys::bounds(k);
     if !b.is_empty() {
-        facts.push(b);
+        facts.push(format!("bounds: {b}"));
     }
-    let mut out = format!("### {}\n\n{}.\n\n{}", title(k), facts.join("; "), k.meaning);
+    if k.fixed {
+        facts.push(keys::FIXED.to_string());
+    }
+    let mut out = format!(
+        "#### {}\n\n{}\n\n{}",
+        title(k),
+        facts.join(" · "),
+        k.meaning
+    );
     for r in keys::remarks(k) {
         out += &format!(" {r}");
     }
@@ -72,13 +83,14 @@ mod tests {
         let anchors = crate::markdown::anchors(&page);
         for k in all() {
             let t = title(k);
-            assert!(page.contains(&format!("### {t}\n")), "{t}");
+            assert!(page.contains(&format!("#### {t}\n")), "{t}");
             assert!(anchors.contains(&slug(&t)), "{t}");
             assert!(page.contains(&keys::example(k)), "{t}");
             assert!(page.contains(&keys::default(k)), "{t}");
         }
         assert!(page.contains(
-            "### [supervisor] cycle_us\n\ninteger, µs; default: `1000`; 50 ..= 100000 µs."
+            "#### [supervisor] cycle_us\n\n*integer, µs* · default: `1000` · \
+             bounds: 50 ..= 100000 µs · fixed name\n"
         ));
         assert!(page.contains("| [`home_speed`](#axis-home_speed) |"));
     }

@@ -14,7 +14,7 @@ fn id(c: &Code) -> String {
 }
 
 fn title(c: &Code) -> String {
-    format!("ERR {} — {}", id(c), c.short)
+    format!("ERR {}", id(c))
 }
 
 pub fn render() -> String {
@@ -39,8 +39,9 @@ pub fn render() -> String {
             "A Logix code."
         };
         out += &format!(
-            "### {}\n\nReported as: {}. {origin}\n\n**Cause.** {}\n\n**Remedy.** {}\n\n",
+            "### {}\n\n*{}.* Reported as: {}. {origin}\n\n**Cause.** {}\n\n**Remedy.** {}\n\n",
             title(c),
+            c.short,
             seen(c),
             c.cause,
             c.remedy
@@ -73,6 +74,7 @@ mod tests {
                 id(c)
             );
         }
-        assert!(page.contains("### ERR 12 / 45 — drive lost"));
+        assert!(page.contains("### ERR 12 / 45\n\n*drive lost"));
+        assert!(page.contains("| [12 / 45](#err-12--45) |"));
     }
 }

@@ -15,7 +15,7 @@ pub fn kind(k: &Key) -> String {
 pub fn default(k: &Key) -> String {
     match k.default {
         Default::Required => "required".into(),
-        Default::Unset(words) => format!("unset: {words}"),
+        Default::Unset(words) => format!("none — {words}"),
         Default::Int(i) => format!("`{i}`"),
         Default::Num(x) => format!("`{}`", number(x)),
         Default::Bool(b) => format!("`{b}`"),
@@ -45,8 +45,7 @@ pub fn bounds(k: &Key) -> String {
     }
 }
 
-/// Sentences on where the key applies, whether it is current, and whether
-/// its name is fixed.
+/// Sentences on where the key applies and whether it is current.
 pub fn remarks(k: &Key) -> Vec<String> {
     let mut out = Vec::new();
     if k.only == Only::Ethercat {
@@ -61,9 +60,6 @@ pub fn remarks(k: &Key) -> Vec<String> {
         Status::Deprecated(words) => out.push(format!("Deprecated: {words}.")),
         Status::Refused(words) => out.push(format!("Refused: {words}.")),
     }
-    if k.fixed {
-        out.push("A fixed name: tools outside this repository rely on it.".into());
-    }
     out
 }
 
@@ -71,3 +67,6 @@ pub fn remarks(k: &Key) -> Vec<String> {
 pub fn example(k: &Key) -> String {
     format!("{} = {}", k.name, k.example)
 }
+
+/// Said of a key whose name is one of the interface's fixed points.
+pub const FIXED: &str = "fixed name";

@@ -2,7 +2,7 @@
 //! table (the same rows as `docs/configuration.md`).
 
 use crate::keys;
-use motion_config::keytable::{Section, GROUPS};
+use motion_config::keytable::{Key, Kind, Section, GROUPS};
 use roff::{bold, italic, roman, Inline, Roff};
 
 /// Markdown's code spans as bold, the rest roman (the key table's texts use
@@ -13,6 +13,18 @@ fn inline(md: &str) -> Vec<Inline> {
         .filter(|(_, s)| !s.is_empty())
         .map(|(i, s)| if i % 2 == 1 { bold(s) } else { roman(s) })
         .collect()
+}
+
+/// Longest example shown whole: a longer one (a password hash) would not
+/// fit a terminal's line, and is cut.
+const EXAMPLE_MAX: usize = 48;
+
+fn example(k: &Key) -> String {
+    let e = keys::example(k);
+    match e.char_indices().nth(EXAMPLE_MAX) {
+        Some((i, _)) => format!("{}…", &e[..i]),
+        None => e,
+    }
 }
 
 /// The page's roff source; `date` and `source` as the command pages have.
@@ -35,21 +47,21 @@ pub fn render(date: &str, source: &str) -> String {
     page.control("SH", ["SYNOPSIS"]);
     page.text([roman("/etc/motion/machine.toml")]);
     page.control("SH", ["DESCRIPTION"]);
-    page.text(inline(GROUPS[0].intro));
-    page.control("PP", []);
     page.text(inline(
-        "The file is TOML. Every key below is read by the supervisor, `motion-io` and \
-         `motion-opcua` alike; `motion-supervisor check --config FILE` names every problem \
-         of a file at once, by axis and key, with the instruction's ERR / EXERR where the \
-         engine's validation refused it.",
+        "The machine configuration of `motion-supervisor`, `motion-io` and `motion-opcua`: \
+         the real-time cycle, the drive-I/O processes, the axes and how they home, the \
+         limits of their operations, gantries, and the OPC UA server. Every key is listed \
+         below with its type, default, bounds, meaning and an example; the same list is \
+         the manual's configuration page.",
     ));
     for g in GROUPS {
         page.control("SH", [g.title.to_uppercase().as_str()]);
         page.text(inline(g.intro));
         for k in g.keys {
             page.control("TP", []);
-            let name = match k.section {
-                Section::Top => format!("[{}]", k.name),
+            let name = match (k.section, k.kind) {
+                (Section::Top, Kind::Tables) => format!("[[{}]]", k.name),
+                (Section::Top, _) => format!("[{}]", k.name),
                 _ => k.name.to_string(),
             };
             page.text([bold(name), roman(" ("), italic(keys::kind(k)), roman(")")]);
@@ -58,13 +70,16 @@ pub fn render(date: &str, source: &str) -> String {
             if !b.is_empty() {
                 facts.push(format!("Bounds: {b}."));
             }
+            if k.fixed {
+                facts.push("A fixed name: tools outside this repository rely on it.".into());
+            }
             let mut text = format!("{} {}", k.meaning, facts.join(" "));
             for r in keys::remarks(k) {
                 text += &format!(" {r}");
             }
             page.text(inline(&text));
             page.control("br", []);
-            page.text([roman("Example: "), bold(keys::example(k))]);
+            page.text([roman("Example: "), bold(example(k))]);
         }
     }
     page.control("SH", ["FILES"]);

@@ -225,7 +225,7 @@ mod tests {
                 .any(|p| p.starts_with("docs/errors.md:3: a generated region")),
             "{stale:?}"
         );
-        assert!(pages[0].2.contains("### ERR 12 / 45"));
+        assert!(pages[0].2.contains("### ERR 12 / 45\n"));
         std::fs::remove_dir_all(&root).unwrap();
     }
 }

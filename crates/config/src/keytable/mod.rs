@@ -385,5 +385,15 @@ pub fn find(section: Section, name: &str) -> Option<&'static Key> {
     all().find(|k| k.section == section && k.name == name)
 }
 
+/// A number as a person reads it: plain in the usual range, scientific
+/// beyond (`1e308`, not 309 digits).
+pub fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e10).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 #[cfg(test)]
 mod tests;
