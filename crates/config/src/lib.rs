@@ -162,8 +162,8 @@ pub struct AxisEntry {
     /// Index into [`MachineConfig::ios`] of the I/O process driving it.
     pub io: usize,
     /// `home_order`: home-all homes order 0, then 1, ...; equal orders in
-    /// parallel. `None`: see interface.md (config order when no axis has
-    /// one; only when named when some have one).
+    /// parallel. `None`: config order, one at a time, when no axis has one;
+    /// homed only when named when some have one.
     pub home_order: Option<u32>,
     /// Warn when a home event lands further than this (units) from the
     /// median of the axis's recent events (switch wear, coupling slip);

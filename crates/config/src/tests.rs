@@ -142,7 +142,8 @@ fn has(lines: &[String], want: &str) {
 
 const ONE_AXIS: &str = "[[axis]]\nname = \"X\"\n";
 
-/// Issue 8's configuration attacks: every one is a problem naming the key.
+/// Hostile numbers in a configuration (huge, tiny, NaN, wrong types): every
+/// one is a problem naming the key, never a value taken.
 #[test]
 fn hostile_numbers_are_refused_by_key() {
     let text = r#"
