@@ -266,6 +266,22 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// An absolute path of at most 200 characters without `..` (a
+    /// directory the daemon keeps files in); a problem otherwise.
+    pub fn directory(&mut self, key: &Key) -> std::path::PathBuf {
+        let d = self.string(key);
+        if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
+            self.problem(
+                key,
+                format!(
+                    "{} must be an absolute path of at most 200 characters without \"..\"",
+                    crate::names::shown(&d)
+                ),
+            );
+        }
+        d.into()
+    }
+
     /// One of `options` (the key's default, by name, when left out or
     /// wrong; the first option for a key without one).
     pub fn choice<T: Copy>(&mut self, key: &Key, options: &[(&str, T)]) -> T {

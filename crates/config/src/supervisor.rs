@@ -134,17 +134,7 @@ fn directories(r: &mut Reader<'_>) -> (Option<PathBuf>, PathBuf) {
         PathBuf::from(d)
     });
     let state_dir = if r.has(&STATE_DIR) {
-        let d = r.string(&STATE_DIR);
-        if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
-            r.problem(
-                &STATE_DIR,
-                format!(
-                    "{} must be an absolute path of at most 200 characters without \"..\"",
-                    names::shown(&d)
-                ),
-            );
-        }
-        PathBuf::from(d)
+        r.directory(&STATE_DIR)
     } else {
         default_state_dir()
     };

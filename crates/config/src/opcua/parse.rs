@@ -7,7 +7,7 @@ use super::{
 use crate::keys::Reader;
 use crate::keytable::{opcua::*, Section};
 use crate::{names, AxisEntry, Problem};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Reads `[opcua]` (`None`: the section is absent; every key defaults).
 /// `axes` are the machine's, for `units`; `state_dir` the default home of
@@ -39,17 +39,7 @@ pub(crate) fn parse(
         );
     }
     let pki_dir = if r.has(&PKI_DIR) {
-        let d = r.string(&PKI_DIR);
-        if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
-            r.problem(
-                &PKI_DIR,
-                format!(
-                    "{} must be an absolute path of at most 200 characters without \"..\"",
-                    names::shown(&d)
-                ),
-            );
-        }
-        PathBuf::from(d)
+        r.directory(&PKI_DIR)
     } else {
         state_dir.join("opcua")
     };
