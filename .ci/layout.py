@@ -5,7 +5,7 @@ functions, and import circles between the files of a crate.
 Why a script: no maintained tool reports "functions over N lines" and
 "module-file cycles" for Rust (clippy's too_many_lines counts differently and
 per function only; cargo-modules draws graphs but does not list cycles of
-files), and these are the figures issue 14 asks to keep down.
+files), and these are the figures the team's standards keep down.
 
     python3 .ci/layout.py            # report
     python3 .ci/layout.py --check    # exit 1 on a function over 120 lines or a circle

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The README's trace plots: one homing per family, recorded with
+# The trace plots of docs/homing.md: one homing per family, recorded with
 # `motionctl trace` against a running daemon (docs/plots.toml).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,8 +1,9 @@
 //! `[[axis]]` and its `[axis.sim]`.
 
 use crate::keys::Reader;
+use crate::keytable::{axis::*, sim, Section};
 use crate::limit_switches;
-use crate::limits::*;
+use crate::limits::MAX_COUNTS;
 use crate::{names, AxisEntry, IoConfig, Problem, SupervisorConfig};
 use motion_homing::{validate, AxisConfig};
 use motion_plant::PlantConfig;
@@ -16,17 +17,15 @@ pub(crate) fn parse(
 ) -> Option<AxisEntry> {
     let name = axis_name(index, t, problems);
     let before = problems.len();
-    let mut r = Reader::new(t, Some(&name), "", problems);
-    r.mark_used("name");
+    let mut r = Reader::new(t, Some(&name), Section::Axis, problems);
+    r.mark_used(&NAME);
     let io = io_of(&mut r, ios);
-    let home_order = r
-        .has("home_order")
-        .then(|| r.u32_in("home_order", 0, 0, 1000));
-    let drift_limit = r.f64_in("drift_limit", 0.0, 0.0, POSITION, "units");
+    let home_order = r.has(&HOME_ORDER).then(|| r.u32_in(&HOME_ORDER));
+    let drift_limit = r.f64_in(&DRIFT_LIMIT);
     let mut engine = engine(&mut r, sup);
     crate::operations::keys(&mut r, &mut engine);
     let ethercat = crate::ethercat::parse::axis_keys(&mut r, &mut engine, ios.get(io));
-    let sim_table = r.table("sim");
+    let sim_table = r.table(&SIM);
     r.finish();
     let sim = parse_sim(&name, sim_table.as_ref(), &engine, problems);
     if ios
@@ -52,16 +51,16 @@ pub(crate) fn parse(
 /// called `#n` (its place in the file) in the problems that follow.
 fn axis_name(index: usize, t: &toml::Table, problems: &mut Vec<Problem>) -> String {
     let fallback = format!("#{}", index + 1);
-    match t.get("name").and_then(|v| v.as_str()) {
+    match t.get(NAME.name).and_then(|v| v.as_str()) {
         Some(n) => match names::check_name(n) {
             Ok(()) => n.to_string(),
             Err(e) => {
-                problems.push(Problem::new(Some(&fallback), "name", e));
+                problems.push(Problem::new(Some(&fallback), NAME.name, e));
                 fallback
             }
         },
         None => {
-            problems.push(Problem::new(Some(&fallback), "name", "missing"));
+            problems.push(Problem::new(Some(&fallback), NAME.name, "missing"));
             fallback
         }
     }
@@ -70,22 +69,22 @@ fn axis_name(index: usize, t: &toml::Table, problems: &mut Vec<Problem>) -> Stri
 /// The index of the axis's I/O process (`io`, which may be left out when
 /// there is only one).
 fn io_of(r: &mut Reader<'_>, ios: &[IoConfig]) -> usize {
-    if !r.has("io") {
+    if !r.has(&IO) {
         if ios.len() > 1 {
             r.problem(
-                "io",
+                &IO,
                 "missing: with several [[io]] sections every axis names its I/O process".into(),
             );
         }
         return 0;
     }
-    let io_name = r.string("io", "");
+    let io_name = r.string(&IO);
     match ios.iter().position(|i| i.name == io_name) {
         Some(k) => k,
         None => {
             let known: Vec<&str> = ios.iter().map(|i| i.name.as_str()).collect();
             r.problem(
-                "io",
+                &IO,
                 format!(
                     "no I/O process {} (configured: {})",
                     names::shown(&io_name),
@@ -100,18 +99,11 @@ fn io_of(r: &mut Reader<'_>, ios: &[IoConfig]) -> usize {
 /// `counts_per_unit` and `max_position`: positions travel as exact integer
 /// counts, so the largest one must be one.
 fn scaling(r: &mut Reader<'_>) -> (f64, f64) {
-    let counts_per_unit = r.f64_in(
-        "counts_per_unit",
-        1.0,
-        COUNTS_PER_UNIT.0,
-        COUNTS_PER_UNIT.1,
-        "counts/unit",
-    );
-    let default = AxisConfig::default().max_position;
-    let max_position = r.f64_in("max_position", default, 1e-3, POSITION, "units");
+    let counts_per_unit = r.f64_in(&COUNTS_PER_UNIT);
+    let max_position = r.f64_in(&MAX_POSITION);
     if max_position * counts_per_unit > MAX_COUNTS {
         r.problem(
-            "max_position",
+            &MAX_POSITION,
             format!(
                 "max_position {} × counts_per_unit {} = {:e} counts exceeds {MAX_COUNTS:e} \
                  (positions travel as exact integer counts)",
@@ -134,50 +126,50 @@ fn engine(r: &mut Reader<'_>, sup: &SupervisorConfig) -> AxisConfig {
     let d = AxisConfig::default();
     let (counts_per_unit, max_position) = scaling(r);
     let mut engine = AxisConfig {
-        configuration: r.choice("configuration", AC::NAMES, AC::Servo),
-        control_mode: r.choice("control_mode", CM::NAMES, CM::Position),
-        travel: r.choice("travel", TM::NAMES, TM::Linear),
-        unwind: r.f64_in("unwind", 0.0, 0.0, POSITION, "units"),
+        configuration: r.choice(&CONFIGURATION, AC::NAMES),
+        control_mode: r.choice(&CONTROL_MODE, CM::NAMES),
+        travel: r.choice(&TRAVEL, TM::NAMES),
+        unwind: r.f64_in(&UNWIND),
         counts_per_unit,
-        marker: r.bool("marker", false),
-        marker_latch: r.bool("marker_latch", true),
-        registration: r.bool("registration", false),
-        travel_limits: r.interval("travel_limits", POSITION),
-        home_mode: r.choice("home_mode", HM::NAMES, HM::Active),
-        home_direction: r.choice("home_direction", HD::NAMES, HD::BidirectionalForward),
-        home_sequence: r.choice("home_sequence", HS::NAMES, HS::Immediate),
-        home_switch_normally_closed: r.bool("home_switch_normally_closed", false),
-        home_position: r.f64_in("home_position", 0.0, -POSITION, POSITION, "units"),
-        home_offset: r.f64_in("home_offset", 0.0, -POSITION, POSITION, "units"),
-        home_speed: r.f64_in("home_speed", 0.0, 0.0, SPEED, "units/s"),
-        home_return_speed: r.f64_in("home_return_speed", 0.0, 0.0, SPEED, "units/s"),
-        home_acceleration: r.f64_in("home_acceleration", 0.0, 0.0, ACCELERATION, "units/s²"),
-        home_deceleration: r.f64_in("home_deceleration", 0.0, 0.0, ACCELERATION, "units/s²"),
-        home_torque_level: r.f64_in("home_torque_level", 0.0, 0.0, TORQUE, "% rated"),
-        home_torque_threshold: r.f64_in("home_torque_threshold", 0.0, 0.0, TORQUE, "% rated"),
-        home_torque_time: r.f64_in("home_torque_time", 0.0, 0.0, SHORT_TIME_S, "s"),
-        home_timeout: r.f64_in("home_timeout", 0.0, 0.0, TIMEOUT_S, "s"),
-        home_creep_speed: r.f64_in("home_creep_speed", 0.0, 0.0, SPEED, "units/s"),
-        search_limit: r.f64_in("search_limit", 0.0, 0.0, 2.0 * POSITION, "units"),
-        torque_limit: r.f64_in("torque_limit", d.torque_limit, 0.0, TORQUE, "% rated"),
-        position_error_tolerance: r.f64_in("position_error_tolerance", 0.0, 0.0, POSITION, "units"),
-        velocity_error_tolerance: r.f64_in("velocity_error_tolerance", 0.0, 0.0, SPEED, "units/s"),
-        enable_timeout: r.f64_in("enable_timeout", d.enable_timeout, 1e-3, SHORT_TIME_S, "s"),
+        marker: r.bool(&MARKER),
+        marker_latch: r.bool(&MARKER_LATCH),
+        registration: r.bool(&REGISTRATION),
+        travel_limits: r.interval(&TRAVEL_LIMITS),
+        home_mode: r.choice(&HOME_MODE, HM::NAMES),
+        home_direction: r.choice(&HOME_DIRECTION, HD::NAMES),
+        home_sequence: r.choice(&HOME_SEQUENCE, HS::NAMES),
+        home_switch_normally_closed: r.bool(&HOME_SWITCH_NORMALLY_CLOSED),
+        home_position: r.f64_in(&HOME_POSITION),
+        home_offset: r.f64_in(&HOME_OFFSET),
+        home_speed: r.f64_in(&HOME_SPEED),
+        home_return_speed: r.f64_in(&HOME_RETURN_SPEED),
+        home_acceleration: r.f64_in(&HOME_ACCELERATION),
+        home_deceleration: r.f64_in(&HOME_DECELERATION),
+        home_torque_level: r.f64_in(&HOME_TORQUE_LEVEL),
+        home_torque_threshold: r.f64_in(&HOME_TORQUE_THRESHOLD),
+        home_torque_time: r.f64_in(&HOME_TORQUE_TIME),
+        home_timeout: r.f64_in(&HOME_TIMEOUT),
+        home_creep_speed: r.f64_in(&HOME_CREEP_SPEED),
+        search_limit: r.f64_in(&SEARCH_LIMIT),
+        torque_limit: r.f64_in(&TORQUE_LIMIT),
+        position_error_tolerance: r.f64_in(&POSITION_ERROR_TOLERANCE),
+        velocity_error_tolerance: r.f64_in(&VELOCITY_ERROR_TOLERANCE),
+        enable_timeout: r.f64_in(&ENABLE_TIMEOUT),
         feedback_timeout_ns: sup.feedback_timeout_ns(),
         feedback_loss_drain: sup.feedback_loss_drain,
         cycle_ns: sup.cycle_ns(),
         max_position,
-        absolute: r.bool("absolute", false),
-        max_speed: r.f64_in("max_speed", 0.0, 0.0, SPEED, "units/s"),
+        absolute: r.bool(&ABSOLUTE),
+        max_speed: r.f64_in(&MAX_SPEED),
         marker_min_distance: 0.0,
-        refuse_ambiguous_marker: r.bool("refuse_ambiguous_marker", false),
+        refuse_ambiguous_marker: r.bool(&REFUSE_AMBIGUOUS_MARKER),
         unhomed_speed: d.unhomed_speed,
         limit_switches: d.limit_switches,
         max_deceleration: d.max_deceleration,
         stream_acceleration: d.stream_acceleration,
         stream_timeout_ns: d.stream_timeout_ns,
         stream_unhomed: d.stream_unhomed,
-        home_reverse_at_limit: r.bool("home_reverse_at_limit", false),
+        home_reverse_at_limit: r.bool(&HOME_REVERSE_AT_LIMIT),
         // set by the EtherCAT keys (`drive_homing`)
         drive_homing: false,
     };
@@ -185,12 +177,9 @@ fn engine(r: &mut Reader<'_>, sup: &SupervisorConfig) -> AxisConfig {
     // return speed; a marker closer than two such cycles to it is ambiguous.
     // The default check uses exactly that distance.
     let cycle_ms = f64::from(sup.cycle_us) / 1000.0;
-    engine.marker_min_distance = r.f64_in(
-        "marker_min_distance",
+    engine.marker_min_distance = r.f64_in_or(
+        &MARKER_MIN_DISTANCE,
         2.0 * engine.home_return_speed * cycle_ms / 1000.0,
-        0.0,
-        POSITION,
-        "units",
     );
     engine
 }
@@ -217,25 +206,24 @@ fn parse_sim(
     problems: &mut Vec<Problem>,
 ) -> PlantConfig {
     let empty = toml::Table::new();
-    let mut r = Reader::new(t.unwrap_or(&empty), Some(axis), "sim.", problems);
-    let d = PlantConfig::default();
+    let mut r = Reader::new(t.unwrap_or(&empty), Some(axis), Section::AxisSim, problems);
     let sim = PlantConfig {
-        start: r.f64_in("start", d.start, -POSITION, POSITION, "units"),
-        switch: r.interval("switch", POSITION),
+        start: r.f64_in(&sim::START),
+        switch: r.interval(&sim::SWITCH),
         // The sim wires the switch as the axis says.
         switch_normally_closed: engine.home_switch_normally_closed,
-        marker_every: r.f64_in("marker_every", 0.0, 0.0, POSITION, "units"),
-        marker_at: r.f64_in("marker_at", 0.0, -POSITION, POSITION, "units"),
-        hard_stop: r.interval("hard_stop", POSITION),
+        marker_every: r.f64_in(&sim::MARKER_EVERY),
+        marker_at: r.f64_in(&sim::MARKER_AT),
+        hard_stop: r.interval(&sim::HARD_STOP),
         overtravel: limit_switches::read(&mut r),
-        limit_switches_normally_closed: r.bool("limit_switches_normally_closed", false),
+        limit_switches_normally_closed: r.bool(&sim::LIMIT_SWITCHES_NORMALLY_CLOSED),
         // The probe input is wired to the switch the axis homes on.
         registration_input: limit_switches::registration_input(engine),
-        external_speed: r.f64_in("external_speed", 0.0, -SPEED, SPEED, "units/s"),
-        push_gain: r.f64_in("push_gain", d.push_gain, 0.0, 1e6, "% per unit"),
-        inertia_gain: r.f64_in("inertia_gain", d.inertia_gain, 0.0, 1e3, "% per unit/s²"),
-        friction: r.f64_in("friction", d.friction, 0.0, TORQUE, "% rated"),
-        enable_delay_cycles: r.u32_in("enable_delay_cycles", d.enable_delay_cycles, 0, 10_000),
+        external_speed: r.f64_in(&sim::EXTERNAL_SPEED),
+        push_gain: r.f64_in(&sim::PUSH_GAIN),
+        inertia_gain: r.f64_in(&sim::INERTIA_GAIN),
+        friction: r.f64_in(&sim::FRICTION),
+        enable_delay_cycles: r.u32_in(&sim::ENABLE_DELAY_CYCLES),
         torque_spike: None,
     };
     r.finish();

@@ -1,5 +1,5 @@
-//! The argument-vector fuzz test of every binary (issue 8: no input
-//! panics), written once. Behind the `cli-fuzz` feature, which only the
+//! The argument-vector fuzz test of every binary (no input panics),
+//! written once. Behind the `cli-fuzz` feature, which only the
 //! binaries' dev-dependencies enable: the product never links proptest.
 
 use clap::Parser;

@@ -110,8 +110,9 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    /// Issue 8: the path is swapped between a regular file and a FIFO
-    /// while it is read (a symlink replaced atomically, over and over). A
+    /// An attack on the reader: the path is swapped between a regular file
+    /// and a FIFO while it is read (a symlink replaced atomically, over and
+    /// over). A
     /// check by path followed by a blocking open of the same path could
     /// judge the file and then open the FIFO, and block forever; the file
     /// judged must be the file opened.

@@ -1,4 +1,4 @@
-//! `[[gantry]]`: axes homed as one machine axis (interface.md).
+//! `[[gantry]]`: axes homed as one machine axis.
 //!
 //! The sides run the same sequence in lockstep (every leg starts on all
 //! sides in the same cycle), so what decides the legs must be the same on
@@ -7,7 +7,7 @@
 //! switch, marker and hard stop, and its own `home_offset` / Home Position.
 
 use crate::keys::Reader;
-use crate::limits::POSITION;
+use crate::keytable::{gantry::*, Section};
 use crate::{names, AxisEntry, Problem};
 
 /// Most sides a gantry has.
@@ -30,39 +30,38 @@ pub(crate) fn parse(
 ) -> Vec<GantryConfig> {
     let mut out: Vec<GantryConfig> = Vec::new();
     for (g, t) in tables.iter().enumerate() {
-        let mut r = Reader::new(t, None, "gantry.", problems);
-        let name = r.string("name", "");
+        let mut r = Reader::new(t, None, Section::Gantry, problems);
+        let name = r.string(&NAME);
         let label = format!("gantry #{}", g + 1);
         if let Err(e) = names::check_name(&name) {
-            r.problem("name", format!("{label}: {e}"));
+            r.problem(&NAME, format!("{label}: {e}"));
         }
         if axes.iter().any(|a| a.name == name) {
             r.problem(
-                "name",
+                &NAME,
                 format!("{label}: {} is also an axis name", names::shown(&name)),
             );
         }
         if out.iter().any(|o| o.name == name) {
             r.problem(
-                "name",
+                &NAME,
                 format!("gantry name {} used twice", names::shown(&name)),
             );
         }
-        let max_skew = r.f64_in("max_skew", 1.0, 1e-6, POSITION, "units");
-        let side_names: Vec<String> = match t.get("axes") {
+        let max_skew = r.f64_in(&MAX_SKEW);
+        let side_names: Vec<String> = match r.value(&AXES) {
             Some(toml::Value::Array(a)) => a
                 .iter()
                 .map(|v| v.as_str().map(str::to_string).unwrap_or_default())
                 .collect(),
             _ => {
-                r.problem("axes", format!("{label}: expected a list of axis names"));
+                r.problem(&AXES, format!("{label}: expected a list of axis names"));
                 Vec::new()
             }
         };
-        r.mark_used("axes");
         if !(2..=MAX_SIDES).contains(&side_names.len()) && !side_names.is_empty() {
             r.problem(
-                "axes",
+                &AXES,
                 format!(
                     "{label}: {} sides; a gantry has 2..={MAX_SIDES}",
                     side_names.len()
@@ -73,18 +72,18 @@ pub(crate) fn parse(
         for n in &side_names {
             match axes.iter().position(|a| &a.name == n) {
                 Some(i) if sides.contains(&i) => r.problem(
-                    "axes",
+                    &AXES,
                     format!("{label}: axis {} named twice", names::shown(n)),
                 ),
                 Some(i) if out.iter().any(|o| o.axes.contains(&i)) => r.problem(
-                    "axes",
+                    &AXES,
                     format!(
                         "{label}: axis {} is already a side of another gantry",
                         names::shown(n)
                     ),
                 ),
                 Some(i) => sides.push(i),
-                None => r.problem("axes", format!("{label}: no axis {}", names::shown(n))),
+                None => r.problem(&AXES, format!("{label}: no axis {}", names::shown(n))),
             }
         }
         r.finish();

@@ -5,9 +5,10 @@
 //! [`crate::ethercat`]); on any other backend those keys are a problem.
 
 use crate::keys::Reader;
+use crate::keytable::{io::*, Section};
 use crate::{
     check_cpu, ethercat, names, IoBackend, IoConfig, IoMode, Problem, SupervisorConfig,
-    DEFAULT_IO_NAME, MAX_IOS,
+    DEFAULT_IO_NAME, MAX_IOS, SPAWN_NAMES,
 };
 
 pub(crate) fn parse(
@@ -42,50 +43,36 @@ pub(crate) fn parse(
     let mut ios: Vec<IoConfig> = Vec::new();
     for (i, t) in tables.iter().enumerate() {
         let label = format!("io #{}", i + 1);
-        let mut r = Reader::new(t, None, "io.", problems);
-        let name = r.string("name", "");
+        let mut r = Reader::new(t, None, Section::Io, problems);
+        let name = r.string(&NAME);
         if let Err(e) = names::check_io_name(&name) {
-            r.problem("name", format!("{label}: {e}"));
+            r.problem(&NAME, format!("{label}: {e}"));
         }
-        let spawn = match r.string("spawn", "sim").as_str() {
-            // "sim" (interface.md) means "the supervisor starts it", whatever
-            // its backend; "supervisor" says so.
-            "sim" | "supervisor" => IoMode::Sim,
-            "external" => IoMode::External,
-            other => {
-                r.problem(
-                    "spawn",
-                    format!(
-                        "{label}: {} is not one of \"sim\", \"supervisor\", \"external\"",
-                        names::shown(other)
-                    ),
-                );
-                IoMode::Sim
-            }
-        };
-        let backend = r.choice("backend", IoBackend::NAMES, IoBackend::Sim);
+        let spawn = spawn(&mut r, &label);
+        let backend = r.choice(&BACKEND, IoBackend::NAMES);
         let who = if names::check_io_name(&name).is_ok() {
             format!("I/O process {name}")
         } else {
             label.clone()
         };
         let ethercat = ethercat::parse::io_keys(&mut r, &who, backend, sup);
-        let cpu = r.has("cpu").then(|| r.u32("cpu", 0) as usize);
+        let cpu = r.has(&CPU).then(|| r.u32(&CPU) as usize);
         if let Some(c) = cpu {
             if let Err(e) = check_cpu(c as i64) {
-                r.problem("cpu", format!("{label}: {e}"));
+                r.problem(&CPU, format!("{label}: {e}"));
             }
         }
-        let priority = r.i32("priority", sup.io_priority);
-        if !(0..=99).contains(&priority) {
+        let priority = r.i32_or(&PRIORITY, sup.io_priority);
+        let (lo, hi) = PRIORITY.range_of();
+        if !(lo..=hi).contains(&f64::from(priority)) {
             r.problem(
-                "priority",
-                format!("{label}: {priority} is outside 0..=99 (0: normal scheduling)"),
+                &PRIORITY,
+                format!("{label}: {priority} is outside {lo}..={hi} (0: normal scheduling)"),
             );
         }
         if ios.iter().any(|o| o.name == name) {
             r.problem(
-                "name",
+                &NAME,
                 format!("I/O process name {} used twice", names::shown(&name)),
             );
         }
@@ -100,4 +87,28 @@ pub(crate) fn parse(
         });
     }
     ios
+}
+
+/// `spawn`: one of [`SPAWN_NAMES`] (`label` names the I/O process in the
+/// problem).
+fn spawn(r: &mut Reader<'_>, label: &str) -> IoMode {
+    let given = r.string(&SPAWN);
+    match SPAWN_NAMES.iter().find(|(n, _)| *n == given) {
+        Some((_, mode)) => *mode,
+        None => {
+            let names: Vec<String> = SPAWN_NAMES
+                .iter()
+                .map(|(n, _)| format!("\"{n}\""))
+                .collect();
+            r.problem(
+                &SPAWN,
+                format!(
+                    "{label}: {} is not one of {}",
+                    names::shown(&given),
+                    names.join(", ")
+                ),
+            );
+            IoMode::Sim
+        }
+    }
 }

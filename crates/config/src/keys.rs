@@ -1,54 +1,80 @@
 //! Typed reads from a TOML table that record a [`Problem`] instead of
 //! stopping, and report every key nobody read (a typo is a problem too).
+//! Every read names a key of the key table ([`crate::keytable`]): its
+//! default, range and unit come from there.
 
+pub(crate) use crate::keytable::number as num;
+use crate::keytable::{self, Key, Section};
 use crate::Problem;
 use std::collections::BTreeSet;
 
 pub(crate) struct Reader<'a> {
     table: &'a toml::Table,
     axis: Option<String>,
-    prefix: &'static str,
+    section: Section,
     used: BTreeSet<String>,
     problems: &'a mut Vec<Problem>,
 }
 
 impl<'a> Reader<'a> {
+    /// Reads `table`, a `section` (of `axis`, named in problems).
     pub fn new(
         table: &'a toml::Table,
         axis: Option<&str>,
-        prefix: &'static str,
+        section: Section,
         problems: &'a mut Vec<Problem>,
     ) -> Self {
         Self {
             table,
             axis: axis.map(str::to_string),
-            prefix,
+            section,
             used: BTreeSet::new(),
             problems,
         }
     }
 
-    pub fn problem(&mut self, key: &str, message: String) {
-        let key = format!("{}{key}", self.prefix);
+    /// A problem with `key`.
+    pub fn problem(&mut self, key: &Key, message: String) {
+        self.problem_at(key.name, message);
+    }
+
+    /// A problem named by a key below one of this section's keys
+    /// (`units.X`).
+    pub fn problem_at(&mut self, key: &str, message: String) {
+        let key = format!("{}{key}", self.section.prefix());
         self.problems
             .push(Problem::new(self.axis.as_deref(), &key, message));
     }
 
-    pub fn mark_used(&mut self, key: &str) {
-        self.used.insert(key.to_string());
+    /// `key` is this section's and declared in the key table: a key read
+    /// must be documented (debug builds and tests check it).
+    fn declared(&self, key: &Key) {
+        debug_assert!(
+            key.section == self.section && keytable::find(key.section, key.name).is_some(),
+            "{} is read in {} but not declared there in the key table",
+            key.name,
+            self.section.header()
+        );
     }
 
-    fn get(&mut self, key: &str) -> Option<&'a toml::Value> {
-        self.used.insert(key.to_string());
-        self.table.get(key)
+    pub fn mark_used(&mut self, key: &Key) {
+        self.declared(key);
+        self.used.insert(key.name.to_string());
     }
 
-    fn wrong_type(&mut self, key: &str, want: &str, v: &toml::Value) {
+    /// The raw value of `key`, marked as read.
+    pub fn value(&mut self, key: &Key) -> Option<&'a toml::Value> {
+        self.mark_used(key);
+        self.table.get(key.name)
+    }
+
+    fn wrong_type(&mut self, key: &Key, want: &str, v: &toml::Value) {
         self.problem(key, format!("expected {want}, found {}", v.type_str()));
     }
 
-    pub fn f64(&mut self, key: &str, default: f64) -> f64 {
-        match self.get(key) {
+    /// A number, or its default (the key's, `default` for a derived one).
+    fn number(&mut self, key: &Key, default: f64) -> f64 {
+        match self.value(key) {
             None => default,
             Some(toml::Value::Float(x)) => *x,
             Some(toml::Value::Integer(i)) => *i as f64,
@@ -59,11 +85,18 @@ impl<'a> Reader<'a> {
         }
     }
 
-    /// A number in `[lo, hi]`; anything else (NaN, ±inf, out of range) is a
-    /// problem naming the key and the range, and gives `default`.
-    pub fn f64_in(&mut self, key: &str, default: f64, lo: f64, hi: f64, unit: &str) -> f64 {
-        let present = self.table.contains_key(key);
-        let x = self.f64(key, default);
+    /// A number in the key's range (its default when left out).
+    pub fn f64_in(&mut self, key: &Key) -> f64 {
+        self.f64_in_or(key, key.default_f64())
+    }
+
+    /// A number in the key's range; anything else (NaN, ±inf, out of range)
+    /// is a problem naming the key and the range, and gives `default` (the
+    /// derived default of the key).
+    pub fn f64_in_or(&mut self, key: &Key, default: f64) -> f64 {
+        let (lo, hi) = key.range_of();
+        let present = self.table.contains_key(key.name);
+        let x = self.number(key, default);
         if present && !(x.is_finite() && x >= lo && x <= hi) {
             let what = if x.is_finite() {
                 "is outside"
@@ -72,19 +105,22 @@ impl<'a> Reader<'a> {
             };
             self.problem(
                 key,
-                format!("{} {what} {}..={} {unit}", num(x), num(lo), num(hi)),
+                format!("{} {what} {}..={} {}", num(x), num(lo), num(hi), key.unit),
             );
             return default;
         }
         x
     }
 
-    /// A number in `(0, hi]` when present; 0 when absent (the caller's
-    /// "default"). Zero given is a problem that says what leaving the key
-    /// out means (`default`); anything else outside is `f64_in`'s problem.
-    pub fn f64_positive(&mut self, key: &str, hi: f64, unit: &str, default: &str) -> f64 {
-        let present = self.table.contains_key(key);
-        let x = self.f64(key, 0.0);
+    /// A number in `(0, hi]` (the key's [`Bounds::AboveZero`](crate::keytable::Bounds::AboveZero)) when
+    /// present; 0 when absent (the engine derives it). Zero given is a
+    /// problem that says what leaving the key out means (`default`, in
+    /// words); anything else outside is `f64_in`'s problem.
+    pub fn f64_positive(&mut self, key: &Key, default: &str) -> f64 {
+        let (_, hi) = key.range_of();
+        let unit = key.unit;
+        let present = self.table.contains_key(key.name);
+        let x = self.number(key, 0.0);
         if present && x == 0.0 {
             self.problem(
                 key,
@@ -107,8 +143,9 @@ impl<'a> Reader<'a> {
         x
     }
 
-    /// `[lo, hi]` of two finite numbers within ±`bound`, `lo < hi`.
-    pub fn interval(&mut self, key: &str, bound: f64) -> Option<(f64, f64)> {
+    /// `[lo, hi]` of two finite numbers within the key's range, `lo < hi`.
+    pub fn interval(&mut self, key: &Key) -> Option<(f64, f64)> {
+        let (_, bound) = key.range_of();
         let (a, b) = self.pair(key)?;
         if !(a.is_finite() && b.is_finite() && a.abs() <= bound && b.abs() <= bound) {
             self.problem(
@@ -132,10 +169,25 @@ impl<'a> Reader<'a> {
         Some((a, b))
     }
 
-    /// A non-negative integer of at most `hi`.
-    pub fn u32_in(&mut self, key: &str, default: u32, lo: u32, hi: u32) -> u32 {
-        let present = self.table.contains_key(key);
-        let x = self.u32(key, default);
+    /// A non-negative integer in the key's range (its default when left
+    /// out).
+    pub fn u32_in(&mut self, key: &Key) -> u32 {
+        let (lo, hi) = key.range_of();
+        self.u32_within(key, key.default_f64() as u32, lo as u32, hi as u32)
+    }
+
+    /// A non-negative integer in the key's range, `default` when left out
+    /// or wrong.
+    pub fn u32_in_or(&mut self, key: &Key, default: u32) -> u32 {
+        let (lo, hi) = key.range_of();
+        self.u32_within(key, default, lo as u32, hi as u32)
+    }
+
+    /// A non-negative integer in `lo..=hi` (a range the key's words state,
+    /// computed by the caller).
+    pub fn u32_within(&mut self, key: &Key, default: u32, lo: u32, hi: u32) -> u32 {
+        let present = self.table.contains_key(key.name);
+        let x = self.u32_or(key, default);
         if present && !(lo..=hi).contains(&x) {
             self.problem(key, format!("{x} is outside {lo}..={hi}"));
             return default;
@@ -143,22 +195,33 @@ impl<'a> Reader<'a> {
         x
     }
 
-    pub fn has(&self, key: &str) -> bool {
-        self.table.contains_key(key)
+    pub fn has(&self, key: &Key) -> bool {
+        self.declared(key);
+        self.table.contains_key(key.name)
     }
 
-    pub fn u32(&mut self, key: &str, default: u32) -> u32 {
+    /// A non-negative 32-bit integer (its default when left out).
+    pub fn u32(&mut self, key: &Key) -> u32 {
+        self.u32_or(key, key.default_f64() as u32)
+    }
+
+    pub fn u32_or(&mut self, key: &Key, default: u32) -> u32 {
         self.integer(key, default, "a non-negative 32-bit integer")
     }
 
-    pub fn i32(&mut self, key: &str, default: i32) -> i32 {
+    /// A 32-bit integer (its default when left out).
+    pub fn i32(&mut self, key: &Key) -> i32 {
+        self.i32_or(key, key.default_f64() as i32)
+    }
+
+    pub fn i32_or(&mut self, key: &Key, default: i32) -> i32 {
         self.integer(key, default, "a 32-bit integer")
     }
 
     /// An integer key that must fit `T` (`what` names the range in the
     /// problem).
-    fn integer<T: TryFrom<i64>>(&mut self, key: &str, default: T, what: &str) -> T {
-        match self.get(key) {
+    fn integer<T: TryFrom<i64>>(&mut self, key: &Key, default: T, what: &str) -> T {
+        match self.value(key) {
             None => default,
             Some(toml::Value::Integer(i)) => {
                 let i = *i;
@@ -174,8 +237,13 @@ impl<'a> Reader<'a> {
         }
     }
 
-    pub fn bool(&mut self, key: &str, default: bool) -> bool {
-        match self.get(key) {
+    /// true or false (its default when left out).
+    pub fn bool(&mut self, key: &Key) -> bool {
+        self.bool_or(key, key.default_bool())
+    }
+
+    pub fn bool_or(&mut self, key: &Key, default: bool) -> bool {
+        match self.value(key) {
             None => default,
             Some(toml::Value::Boolean(b)) => *b,
             Some(v) => {
@@ -185,8 +253,10 @@ impl<'a> Reader<'a> {
         }
     }
 
-    pub fn string(&mut self, key: &str, default: &str) -> String {
-        match self.get(key) {
+    /// A string (its default when left out; "" for a key without one).
+    pub fn string(&mut self, key: &Key) -> String {
+        let default = key.default_text();
+        match self.value(key) {
             None => default.to_string(),
             Some(toml::Value::String(s)) => s.clone(),
             Some(v) => {
@@ -196,8 +266,31 @@ impl<'a> Reader<'a> {
         }
     }
 
-    pub fn choice<T: Copy>(&mut self, key: &str, options: &[(&str, T)], default: T) -> T {
-        match self.get(key) {
+    /// An absolute path of at most 200 characters without `..` (a
+    /// directory the daemon keeps files in); a problem otherwise.
+    pub fn directory(&mut self, key: &Key) -> std::path::PathBuf {
+        let d = self.string(key);
+        if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
+            self.problem(
+                key,
+                format!(
+                    "{} must be an absolute path of at most 200 characters without \"..\"",
+                    crate::names::shown(&d)
+                ),
+            );
+        }
+        d.into()
+    }
+
+    /// One of `options` (the key's default, by name, when left out or
+    /// wrong; the first option for a key without one).
+    pub fn choice<T: Copy>(&mut self, key: &Key, options: &[(&str, T)]) -> T {
+        let default = options
+            .iter()
+            .find(|(n, _)| *n == key.default_text())
+            .unwrap_or(&options[0])
+            .1;
+        match self.value(key) {
             None => default,
             Some(toml::Value::String(s)) => match options.iter().find(|(n, _)| n == s) {
                 Some((_, t)) => *t,
@@ -223,8 +316,8 @@ impl<'a> Reader<'a> {
     }
 
     /// `[lo, hi]` of two numbers.
-    pub fn pair(&mut self, key: &str) -> Option<(f64, f64)> {
-        let v = self.get(key)?;
+    fn pair(&mut self, key: &Key) -> Option<(f64, f64)> {
+        let v = self.value(key)?;
         let num = |x: &toml::Value| match x {
             toml::Value::Float(f) => Some(*f),
             toml::Value::Integer(i) => Some(*i as f64),
@@ -245,8 +338,8 @@ impl<'a> Reader<'a> {
         }
     }
 
-    pub fn table(&mut self, key: &str) -> Option<toml::Table> {
-        match self.get(key)? {
+    pub fn table(&mut self, key: &Key) -> Option<toml::Table> {
+        match self.value(key)? {
             toml::Value::Table(t) => Some(t.clone()),
             v => {
                 self.wrong_type(key, "a table", v);
@@ -255,21 +348,22 @@ impl<'a> Reader<'a> {
         }
     }
 
-    pub fn array_of_tables(&mut self, key: &str) -> Vec<toml::Table> {
-        match self.get(key) {
+    pub fn array_of_tables(&mut self, key: &Key) -> Vec<toml::Table> {
+        let name = key.name;
+        match self.value(key) {
             None => Vec::new(),
             Some(toml::Value::Array(a)) => {
                 let mut out = Vec::new();
                 for v in a {
                     match v {
                         toml::Value::Table(t) => out.push(t.clone()),
-                        other => self.wrong_type(key, &format!("[[{key}]] tables"), other),
+                        other => self.wrong_type(key, &format!("[[{name}]] tables"), other),
                     }
                 }
                 out
             }
             Some(v) => {
-                self.wrong_type(key, &format!("[[{key}]] tables"), v);
+                self.wrong_type(key, &format!("[[{name}]] tables"), v);
                 Vec::new()
             }
         }
@@ -281,20 +375,10 @@ impl<'a> Reader<'a> {
             if !self.used.contains(k) {
                 self.problems.push(Problem::new(
                     self.axis.as_deref(),
-                    &format!("{}{k}", self.prefix),
+                    &format!("{}{k}", self.section.prefix()),
                     "unknown key (misspelt?)",
                 ));
             }
         }
-    }
-}
-
-/// A number as a person reads it: plain in the usual range, scientific
-/// beyond (`1e308`, not 309 digits).
-pub(crate) fn num(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-4..1e10).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
     }
 }

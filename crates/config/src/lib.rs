@@ -7,8 +7,9 @@
 //! come from [`motion_homing::validate`], so they are written only once; the
 //! physical ranges every number must lie in are one table ([`limits`]).
 //!
-//! Keys and enum spellings are fixed by `interface.md`; the keys this project
-//! adds are listed in the README's configuration table.
+//! Every key is declared once, in the key table ([`keytable`]): the parser
+//! reads keys only through it, and `docs/configuration.md` and the man page
+//! `motion-machine.toml(5)` are written from it.
 
 pub mod args;
 mod axis;
@@ -19,6 +20,7 @@ pub mod file;
 mod gantry;
 mod io;
 mod keys;
+pub mod keytable;
 mod limit_switches;
 pub mod limits;
 pub mod names;
@@ -66,6 +68,14 @@ motion_homing::spellings!(IoMode {
     Sim => "sim",
     External => "external",
 });
+
+/// `[[io]] spawn`: "sim" means "the supervisor starts it", whatever its
+/// backend (the name the interface fixed); "supervisor" says so.
+pub const SPAWN_NAMES: &[(&str, IoMode)] = &[
+    ("sim", IoMode::Sim),
+    ("supervisor", IoMode::Sim),
+    ("external", IoMode::External),
+];
 
 /// The drive backend of an I/O process (`[[io]] backend`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -152,8 +162,8 @@ pub struct AxisEntry {
     /// Index into [`MachineConfig::ios`] of the I/O process driving it.
     pub io: usize,
     /// `home_order`: home-all homes order 0, then 1, ...; equal orders in
-    /// parallel. `None`: see interface.md (config order when no axis has
-    /// one; only when named when some have one).
+    /// parallel. `None`: config order, one at a time, when no axis has one;
+    /// homed only when named when some have one.
     pub home_order: Option<u32>,
     /// Warn when a home event lands further than this (units) from the
     /// median of the axis's recent events (switch wear, coupling slip);
@@ -218,12 +228,12 @@ pub fn parse(text: &str) -> Result<MachineConfig, Vec<Problem>> {
     };
     let mut problems = Vec::new();
     let mut warnings = Vec::new();
-    let mut top = Reader::new(&table, None, "", &mut problems);
-    let sup_table = top.table("supervisor");
-    let io_tables = top.array_of_tables("io");
-    let axis_tables = top.array_of_tables("axis");
-    let gantry_tables = top.array_of_tables("gantry");
-    let opcua_table = top.table("opcua");
+    let mut top = Reader::new(&table, None, keytable::Section::Top, &mut problems);
+    let sup_table = top.table(&keytable::top::SUPERVISOR);
+    let io_tables = top.array_of_tables(&keytable::top::IO);
+    let axis_tables = top.array_of_tables(&keytable::top::AXIS);
+    let gantry_tables = top.array_of_tables(&keytable::top::GANTRY);
+    let opcua_table = top.table(&keytable::top::OPCUA);
     top.finish();
 
     let supervisor = supervisor::parse(sup_table.as_ref(), &mut problems, &mut warnings);

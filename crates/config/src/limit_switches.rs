@@ -9,28 +9,28 @@
 //! at the ends of its interval. Giving both is a problem.
 
 use crate::keys::Reader;
-use crate::limits::POSITION;
+use crate::keytable::sim::{LIMIT_SWITCHES, OVERTRAVEL};
 use crate::Problem;
 use motion_homing::AxisConfig;
 use motion_plant::{PlantConfig, RegistrationInput};
 
 /// `limit_switches`, else `overtravel`.
 pub(crate) fn read(r: &mut Reader<'_>) -> Option<(f64, f64)> {
-    let new = r.has("limit_switches");
-    let old = r.has("overtravel");
+    let new = r.has(&LIMIT_SWITCHES);
+    let old = r.has(&OVERTRAVEL);
     if new && old {
         r.problem(
-            "overtravel",
+            &OVERTRAVEL,
             "given together with limit_switches, which replaces it: keep limit_switches".into(),
         );
     }
     let key = if old && !new {
-        "overtravel"
+        &OVERTRAVEL
     } else {
-        "limit_switches"
+        &LIMIT_SWITCHES
     };
-    let limits = r.interval(key, POSITION);
-    r.mark_used("overtravel");
+    let limits = r.interval(key);
+    r.mark_used(&OVERTRAVEL);
     limits
 }
 

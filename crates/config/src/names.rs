@@ -26,7 +26,7 @@ pub fn check_name(s: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// I/O process names (interface.md: `[A-Za-z0-9_-]`), 1..=32 characters:
+/// I/O process names (`[A-Za-z0-9_-]`, a fixed rule), 1..=32 characters:
 /// they become part of service names.
 pub fn check_io_name(s: &str) -> Result<(), String> {
     if s.is_empty() || s.len() > NAME_MAX || !name_chars_ok(s, false) {

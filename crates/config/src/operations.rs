@@ -1,4 +1,5 @@
-//! The keys of the operations around homing (interface.md "Limits"):
+//! The keys of the operations around homing (declared in
+//! [`crate::keytable::operations`]):
 //! `unhomed_speed`, `limit_switches`, `max_deceleration`,
 //! `stream_acceleration`, `stream_timeout_ms`, `stream_unhomed`
 //! (`travel_limits` and `max_speed` are read with the homing keys).
@@ -10,7 +11,7 @@
 //! setting but a machine that cannot move or stop).
 
 use crate::keys::{num, Reader};
-use crate::limits::{ACCELERATION, SPEED, STREAM_TIMEOUT_MS};
+use crate::keytable::operations::*;
 use motion_homing::AxisConfig;
 
 /// Reads the keys into `engine` (which holds the homing keys already).
@@ -18,27 +19,18 @@ pub(crate) fn keys(r: &mut Reader<'_>, engine: &mut AxisConfig) {
     let home_speed = engine.home_speed;
     let home_deceleration = engine.home_deceleration;
     let home_acceleration = engine.home_acceleration;
-    engine.unhomed_speed = r.f64_positive(
-        "unhomed_speed",
-        SPEED,
-        "units/s",
-        &format!("home_speed ({})", num(home_speed)),
-    );
-    engine.limit_switches = r.bool("limit_switches", true);
+    engine.unhomed_speed =
+        r.f64_positive(&UNHOMED_SPEED, &format!("home_speed ({})", num(home_speed)));
+    engine.limit_switches = r.bool(&LIMIT_SWITCHES);
     engine.max_deceleration = r.f64_positive(
-        "max_deceleration",
-        ACCELERATION,
-        "units/s²",
+        &MAX_DECELERATION,
         &format!("home_deceleration ({})", num(home_deceleration)),
     );
     engine.stream_acceleration = r.f64_positive(
-        "stream_acceleration",
-        ACCELERATION,
-        "units/s²",
+        &STREAM_ACCELERATION,
         &format!("10 × home_acceleration ({})", num(10.0 * home_acceleration)),
     );
-    let (lo, hi) = STREAM_TIMEOUT_MS;
-    let ms = r.f64_in("stream_timeout_ms", 50.0, lo, hi, "ms");
+    let ms = r.f64_in(&STREAM_TIMEOUT_MS);
     engine.stream_timeout_ns = (ms * 1e6).round() as u64;
-    engine.stream_unhomed = r.bool("stream_unhomed", false);
+    engine.stream_unhomed = r.bool(&STREAM_UNHOMED);
 }

@@ -50,8 +50,8 @@ impl Problem {
     }
 }
 
-/// A problem as a JSON error entry (interface.md, "Errors as JSON"): how
-/// every binary reports a configuration it refuses.
+/// A problem as a JSON error entry (`{"errors": [...]}`, a fixed shape):
+/// how every binary reports a configuration it refuses.
 impl From<&Problem> for ErrorEntry {
     fn from(p: &Problem) -> Self {
         ErrorEntry {

@@ -1,7 +1,9 @@
 //! `[supervisor]`.
 
 use crate::keys::Reader;
-use crate::limits::*;
+use crate::keytable::supervisor::*;
+use crate::keytable::Section;
+use crate::limits::WATCHDOG_MS;
 use crate::{check_cpu, names, IoMode, Problem, SupervisorConfig};
 use std::path::PathBuf;
 
@@ -11,29 +13,31 @@ pub(crate) fn parse(
     warnings: &mut Vec<String>,
 ) -> SupervisorConfig {
     let empty = toml::Table::new();
-    let mut r = Reader::new(t.unwrap_or(&empty), None, "supervisor.", problems);
-    let cycle_us = r.u32_in("cycle_us", 1000, CYCLE_US.0, CYCLE_US.1);
-    let cpu = r.u32("cpu", 1);
+    let mut r = Reader::new(t.unwrap_or(&empty), None, Section::Supervisor, problems);
+    let cycle_us = r.u32_in(&CYCLE_US);
+    let cpu = r.u32(&CPU);
     if let Err(e) = check_cpu(i64::from(cpu)) {
-        r.problem("cpu", e);
+        r.problem(&CPU, e);
     }
-    let priority = r.u32_in("priority", 80, 1, 99) as i32;
-    let io = r.choice("io", IoMode::NAMES, IoMode::Sim);
-    let service_prefix = r.string("service_prefix", "motion");
+    let priority = r.u32_in(&PRIORITY) as i32;
+    let io = r.choice(&IO, IoMode::NAMES);
+    let service_prefix = r.string(&SERVICE_PREFIX);
     if let Err(e) = names::check_service_prefix(&service_prefix) {
-        r.problem("service_prefix", e);
+        r.problem(&SERVICE_PREFIX, e);
     }
     let cycle_ms = f64::from(cycle_us) / 1000.0;
     let feedback_timeout_ms = feedback_timeout_ms(&mut r, cycle_ms, warnings);
-    let feedback_loss_drain = r.f64_in("feedback_loss_drain", 0.25, 0.0, 1.0, "");
+    let feedback_loss_drain = r.f64_in(&FEEDBACK_LOSS_DRAIN);
     let max_watchdog = ((WATCHDOG_MS / cycle_ms) as u32).max(1);
-    let io_watchdog_cycles = r.u32_in("io_watchdog_cycles", 50.min(max_watchdog), 1, max_watchdog);
-    let lock_memory = r.bool("lock_memory", true);
-    let cpu_dma_latency_us = r.i32("cpu_dma_latency_us", 0);
-    if cpu_dma_latency_us > 10_000 {
+    let io_watchdog_cycles =
+        r.u32_within(&IO_WATCHDOG_CYCLES, 50.min(max_watchdog), 1, max_watchdog);
+    let lock_memory = r.bool(&LOCK_MEMORY);
+    let cpu_dma_latency_us = r.i32(&CPU_DMA_LATENCY_US);
+    let (_, most) = CPU_DMA_LATENCY_US.range_of();
+    if f64::from(cpu_dma_latency_us) > most {
         r.problem(
-            "cpu_dma_latency_us",
-            format!("{cpu_dma_latency_us} µs is above 10000 (negative: leave idle states alone)"),
+            &CPU_DMA_LATENCY_US,
+            format!("{cpu_dma_latency_us} µs is above {most} (negative: leave idle states alone)"),
         );
     }
     let (io_priority, io_cpu) = io_scheduling(&mut r, priority);
@@ -60,28 +64,23 @@ pub(crate) fn parse(
 /// The feedback-loss rule in time. The older `stale_cycles` (cycles in a
 /// row) is still read, converted to the same time at this cycle.
 fn feedback_timeout_ms(r: &mut Reader<'_>, cycle_ms: f64, warnings: &mut Vec<String>) -> f64 {
-    let mut feedback_timeout_ms = r.f64_in(
-        "feedback_timeout_ms",
-        10.0,
-        FEEDBACK_TIMEOUT_MS.0,
-        FEEDBACK_TIMEOUT_MS.1,
-        "ms",
-    );
-    if r.has("stale_cycles") {
-        let stale = r.u32("stale_cycles", 0);
+    let mut feedback_timeout_ms = r.f64_in(&FEEDBACK_TIMEOUT_MS);
+    if r.has(&STALE_CYCLES) {
+        let (lo, hi) = FEEDBACK_TIMEOUT_MS.range_of();
+        let stale = r.u32(&STALE_CYCLES);
         let ms = f64::from(stale) * cycle_ms;
-        if r.has("feedback_timeout_ms") {
+        if r.has(&FEEDBACK_TIMEOUT_MS) {
             r.problem(
-                "stale_cycles",
+                &STALE_CYCLES,
                 "give feedback_timeout_ms or the older stale_cycles, not both".into(),
             );
-        } else if !(FEEDBACK_TIMEOUT_MS.0..=FEEDBACK_TIMEOUT_MS.1).contains(&ms) {
+        } else if !(lo..=hi).contains(&ms) {
             r.problem(
-                "stale_cycles",
+                &STALE_CYCLES,
                 format!(
                     "{stale} cycles = {ms} ms is outside {}..={} ms (a larger value would \
                      switch feedback-loss detection off)",
-                    FEEDBACK_TIMEOUT_MS.0, FEEDBACK_TIMEOUT_MS.1
+                    lo, hi
                 ),
             );
         } else {
@@ -98,24 +97,25 @@ fn feedback_timeout_ms(r: &mut Reader<'_>, cycle_ms: f64, warnings: &mut Vec<Str
 /// `io_priority` (default 10 below the cycle) and `io_cpu` (-1: the
 /// cycle's CPU) of the spawned I/O processes.
 fn io_scheduling(r: &mut Reader<'_>, priority: i32) -> (i32, Option<usize>) {
-    let io_priority = r.i32("io_priority", (priority - 10).max(1));
-    if !(0..=99).contains(&io_priority) {
+    let io_priority = r.i32_or(&IO_PRIORITY, (priority - 10).max(1));
+    let (lo, hi) = IO_PRIORITY.range_of();
+    if !(lo..=hi).contains(&f64::from(io_priority)) {
         r.problem(
-            "io_priority",
-            format!("{io_priority} is outside 0..=99 (0: normal scheduling)"),
+            &IO_PRIORITY,
+            format!("{io_priority} is outside {lo}..={hi} (0: normal scheduling)"),
         );
     }
-    let io_cpu = match r.i32("io_cpu", -1) {
+    let io_cpu = match r.i32(&IO_CPU) {
         c if c >= 0 => {
             if let Err(e) = check_cpu(i64::from(c)) {
-                r.problem("io_cpu", e);
+                r.problem(&IO_CPU, e);
             }
             Some(c as usize)
         }
         -1 => None,
         c => {
             r.problem(
-                "io_cpu",
+                &IO_CPU,
                 format!("{c}: a CPU number, or -1 for the cycle's CPU"),
             );
             None
@@ -126,25 +126,15 @@ fn io_scheduling(r: &mut Reader<'_>, priority: i32) -> (i32, Option<usize>) {
 
 /// `runtime_dir` (if given) and `state_dir` (else the default).
 fn directories(r: &mut Reader<'_>) -> (Option<PathBuf>, PathBuf) {
-    let runtime_dir = r.has("runtime_dir").then(|| {
-        let d = r.string("runtime_dir", "");
+    let runtime_dir = r.has(&RUNTIME_DIR).then(|| {
+        let d = r.string(&RUNTIME_DIR);
         if let Err(e) = crate::args::runtime_dir(&d) {
-            r.problem("runtime_dir", e);
+            r.problem(&RUNTIME_DIR, e);
         }
         PathBuf::from(d)
     });
-    let state_dir = if r.has("state_dir") {
-        let d = r.string("state_dir", "");
-        if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
-            r.problem(
-                "state_dir",
-                format!(
-                    "{} must be an absolute path of at most 200 characters without \"..\"",
-                    names::shown(&d)
-                ),
-            );
-        }
-        PathBuf::from(d)
+    let state_dir = if r.has(&STATE_DIR) {
+        r.directory(&STATE_DIR)
     } else {
         default_state_dir()
     };

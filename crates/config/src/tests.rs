@@ -142,7 +142,8 @@ fn has(lines: &[String], want: &str) {
 
 const ONE_AXIS: &str = "[[axis]]\nname = \"X\"\n";
 
-/// Issue 8's configuration attacks: every one is a problem naming the key.
+/// Hostile numbers in a configuration (huge, tiny, NaN, wrong types): every
+/// one is a problem naming the key, never a value taken.
 #[test]
 fn hostile_numbers_are_refused_by_key() {
     let text = r#"
@@ -545,20 +546,8 @@ fn the_gantry_example_has_orders_a_gantry_and_an_absolute_axis() {
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
 }
 
-/// The README's ranges table is the one the code enforces.
-#[test]
-fn the_readme_prints_every_range() {
-    let readme = include_str!("../../../README.md");
-    for (key, ..) in crate::limits::TABLE {
-        assert!(
-            readme.contains(&format!("| `{key}` |")),
-            "README.md lacks the range of {key}"
-        );
-    }
-}
-
-/// Issue 15's axis keys: parsed, defaults left to the engine (0), every
-/// mistake named by axis and key.
+/// The keys of the operations: parsed, defaults left to the engine (0),
+/// every mistake named by axis and key.
 #[test]
 fn the_keys_of_the_operations() {
     let base = r#"

@@ -1,63 +1,102 @@
-//! `motion-docgen [DIR]`: writes the man pages (`DIR/man/*.1.gz`, one per
-//! binary and per subcommand, `clap_mangen`) and the bash, zsh and fish
-//! completions (`DIR/completions/{bash,zsh,fish}/`, `clap_complete`) of
-//! `motion-supervisor`, `motion-io` and `motionctl`, from the very clap
-//! definitions the binaries parse with — so they cannot drift from the code.
+//! `motion-docgen`: the one generator of everything the docs derive from
+//! the code, and the check that they still do.
 //!
-//! A build helper of the Debian package, never shipped: `DIR` defaults to
-//! `assets/` beside this executable, i.e. `target/release/assets` after
-//! `cargo build --release`, which is where the `[package.metadata.deb]`
-//! assets of `crates/supervisor` look (cargo-deb maps `target/release/` to
-//! the real target directory and profile). Run it before `cargo deb`.
+//! * `motion-docgen [assets [DIR]]` — the Debian package's man pages (every
+//!   binary and subcommand, and `motion-machine.toml(5)` from the key table)
+//!   and shell completions, into `DIR` (default: `assets/` beside this
+//!   executable, i.e. `target/release/assets` after `cargo build --release`,
+//!   where the `[package.metadata.deb]` assets of `crates/supervisor` look).
+//!   Run it before `cargo deb`.
+//! * `motion-docgen docs` — rewrites the generated regions of the Markdown
+//!   pages (`docs/configuration.md` from the key table, `docs/errors.md`
+//!   from the code table, `docs/commands.md` from the clap definitions,
+//!   `docs/protocol.md` from the layout description).
+//! * `motion-docgen docs --check` — changes nothing; fails when a generated
+//!   region differs from what the code would generate, a relative link does
+//!   not resolve, a complete configuration example does not load, a command
+//!   shown is refused by its binary's parser, a text file points outside the
+//!   repository, or `README.md` is longer than 400 lines.
 //!
-//! Why a separate binary and not hidden `--generate-man` options: the
-//! shipped binaries' command lines are fixed (interface.md) and stay free of
-//! build-only switches; why not a build script: a build script may write
+//! A build helper, never shipped. Why a separate binary and not hidden
+//! options of the shipped ones: their command lines are fixed and stay free
+//! of build-only switches; why not a build script: a build script may write
 //! only into its own `OUT_DIR`, which cargo-deb cannot name.
 
-use std::fs::{self, File};
-use std::io::{self, Write};
+mod assets;
+mod commands_page;
+mod config_page;
+mod errors_page;
+mod keys;
+mod lint;
+mod machine_page;
+mod markdown;
+mod protocol_page;
+mod regions;
+mod repo;
+
+use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::CommandFactory;
-use clap_complete::Shell;
-use flate2::write::GzEncoder;
-use flate2::Compression;
-
-/// The Debian changelog: its latest entry's date is the pages' date (the
-/// release's, and the same on every build).
-const CHANGELOG: &str = include_str!("../../../deploy/debian/changelog");
-
-/// `2026-12-01` from the first trailer line of a Debian changelog,
-/// ` -- Name <address>  Tue, 01 Dec 2026 21:30:00 +0000` (RFC 2822 date).
-fn release_date(changelog: &str) -> Option<String> {
-    const MONTHS: [&str; 12] = [
-        "Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec",
-    ];
-    let trailer = changelog.lines().find(|l| l.starts_with(" -- "))?;
-    let (_, date) = trailer.split_once(">  ")?;
-    let mut words = date.split_whitespace().skip(1);
-    let day: u8 = words.next()?.parse().ok()?;
-    let month_name = words.next()?;
-    let month = MONTHS.iter().position(|m| *m == month_name)? + 1;
-    let year: u16 = words.next()?.parse().ok()?;
-    Some(format!("{year}-{month:02}-{day:02}"))
+/// Writes the man pages, completions and generated doc pages of
+/// motion-supervisor from the code, and checks the docs.
+#[derive(Parser, Debug)]
+#[command(name = "motion-docgen", version)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
 }
 
-/// The shipped binaries' command lines.
-fn commands() -> [clap::Command; 4] {
-    [
-        motion_supervisor::cli::Cli::command(),
-        motion_io::cli::Options::command(),
-        motionctl::cli::Cli::command(),
-        motion_opcua::cli::Cli::command(),
-    ]
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// The man pages and shell completions of the Debian package (the
+    /// default).
+    Assets {
+        /// Where to write them; default: `assets/` beside this executable.
+        dir: Option<PathBuf>,
+    },
+    /// Rewrites the generated regions of the docs; with --check, checks the
+    /// docs instead.
+    Docs {
+        /// Change nothing; fail on a stale region, a broken link, a
+        /// configuration example that does not load, a command its parser
+        /// refuses, a word pointing outside the repository, a long README.
+        #[arg(long)]
+        check: bool,
+        /// The repository; default: the one this binary was built from.
+        #[arg(long, value_name = "DIR")]
+        root: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
-    let out = match std::env::args_os().nth(1) {
-        Some(dir) => PathBuf::from(dir),
+    let cli = Cli::parse();
+    match cli.command {
+        None => assets_into(None),
+        Some(Command::Assets { dir }) => assets_into(dir),
+        Some(Command::Docs { check, root }) => {
+            let root = root.unwrap_or_else(repo::default_root);
+            let problems = if check {
+                check_docs(&root)
+            } else {
+                write_docs(&root)
+            };
+            for p in &problems {
+                eprintln!("{p}");
+            }
+            if problems.is_empty() {
+                ExitCode::SUCCESS
+            } else {
+                eprintln!("motion-docgen: {} problem(s)", problems.len());
+                ExitCode::FAILURE
+            }
+        }
+    }
+}
+
+fn assets_into(dir: Option<PathBuf>) -> ExitCode {
+    let out = match dir {
+        Some(dir) => dir,
         None => match std::env::current_exe() {
             Ok(exe) => exe.with_file_name("assets"),
             Err(e) => {
@@ -68,7 +107,7 @@ fn main() -> ExitCode {
             }
         },
     };
-    match write_all(&out) {
+    match assets::write_all(&out) {
         Ok(files) => {
             println!("motion-docgen: {} files in {}", files.len(), out.display());
             ExitCode::SUCCESS
@@ -80,144 +119,113 @@ fn main() -> ExitCode {
     }
 }
 
-/// Writes every man page and completion below `out` (emptied first, so a
-/// removed subcommand leaves no stale page behind); returns the files.
-fn write_all(out: &Path) -> io::Result<Vec<PathBuf>> {
-    let (man, completions) = (out.join("man"), out.join("completions"));
-    for dir in [&man, &completions] {
-        if dir.exists() {
-            fs::remove_dir_all(dir)?;
+/// Each page's text, and the text with its regions generated (problems of
+/// the markers or the generators, by page).
+fn generated(root: &Path) -> (Vec<(PathBuf, String, String)>, Vec<String>) {
+    let gens = regions::generators();
+    let mut pages = Vec::new();
+    let mut problems = Vec::new();
+    let mut used: Vec<(&str, PathBuf)> = Vec::new();
+    for rel in repo::markdown(root) {
+        let Ok(text) = std::fs::read_to_string(root.join(&rel)) else {
+            continue;
+        };
+        let mut make = |name: &str| -> Result<String, String> {
+            let g = gens
+                .iter()
+                .find(|g| g.name == name)
+                .ok_or_else(|| format!("no generator is called {name}"))?;
+            used.push((g.name, rel.clone()));
+            (g.make)(root)
+        };
+        match regions::rewrite(&text, &mut make) {
+            Ok(new) => pages.push((rel, text, new)),
+            Err(e) => problems.push(format!("{}: {e}", rel.display())),
         }
-        fs::create_dir_all(dir)?;
     }
-    let mut files = Vec::new();
-    for cmd in commands() {
-        write_man_pages(cmd.clone(), &man, &mut files)?;
-        write_completions(cmd, &completions, &mut files)?;
+    for g in &gens {
+        let places: Vec<String> = used
+            .iter()
+            .filter(|(n, _)| *n == g.name)
+            .map(|(_, p)| p.display().to_string())
+            .collect();
+        if places.len() != 1 {
+            problems.push(format!(
+                "the region {} (from {}) must be on exactly one page; it is on {places:?}",
+                g.name, g.from
+            ));
+        }
     }
-    Ok(files)
+    (pages, problems)
 }
 
-/// One gzip-compressed page for `cmd` and for each of its visible
-/// subcommands, named as `clap_mangen::generate_to` names them
-/// (`motionctl-home.1.gz`); gzip at the best level without a timestamp, as
-/// Debian policy wants man pages (and as reproducible builds want them).
-fn write_man_pages(cmd: clap::Command, dir: &Path, files: &mut Vec<PathBuf>) -> io::Result<()> {
-    let mut cmd = cmd.disable_help_subcommand(true);
-    cmd.build();
-    let version = cmd.get_version().unwrap_or_default().to_owned();
-    let date = release_date(CHANGELOG).ok_or_else(|| {
-        io::Error::new(
-            io::ErrorKind::InvalidData,
-            "no date in deploy/debian/changelog",
-        )
-    })?;
-    let mut todo = vec![cmd];
-    while let Some(cmd) = todo.pop() {
-        todo.extend(cmd.get_subcommands().filter(|s| !s.is_hide_set()).cloned());
-        let page = clap_mangen::Man::new(cmd)
-            .date(&date)
-            .manual("motion-supervisor")
-            .source(format!("motion-supervisor {version}"));
-        let path = dir.join(format!("{}.gz", page.get_filename()));
-        let mut gz = GzEncoder::new(File::create(&path)?, Compression::best());
-        page.render(&mut gz)?;
-        gz.finish()?.flush()?;
-        files.push(path);
+fn write_docs(root: &Path) -> Vec<String> {
+    let (pages, mut problems) = generated(root);
+    for (rel, old, new) in pages {
+        if old != new {
+            match std::fs::write(root.join(&rel), new) {
+                Ok(()) => println!("motion-docgen: wrote {}", rel.display()),
+                Err(e) => problems.push(format!("{}: {e}", rel.display())),
+            }
+        }
     }
-    Ok(())
+    problems
 }
 
-/// Where each shell looks for a command's completion, by file name:
-/// bash-completion loads `completions/NAME` on first use, zsh autoloads
-/// `_NAME` from its function path, fish loads `NAME.fish`.
-fn completion_file(shell: Shell, bin: &str) -> String {
-    match shell {
-        Shell::Zsh => format!("_{bin}"),
-        Shell::Fish => format!("{bin}.fish"),
-        _ => bin.to_owned(),
+fn check_docs(root: &Path) -> Vec<String> {
+    let (pages, mut problems) = generated(root);
+    for (rel, old, new) in pages {
+        if old != new {
+            let line = old
+                .lines()
+                .zip(new.lines())
+                .position(|(a, b)| a != b)
+                .map_or(old.lines().count().min(new.lines().count()) + 1, |i| i + 1);
+            problems.push(format!(
+                "{}:{line}: a generated region differs from what the code generates: run \
+                 `cargo run -p motion-docgen -- docs`",
+                rel.display()
+            ));
+        }
     }
-}
-
-fn write_completions(
-    mut cmd: clap::Command,
-    dir: &Path,
-    files: &mut Vec<PathBuf>,
-) -> io::Result<()> {
-    let bin = cmd.get_name().to_owned();
-    for shell in [Shell::Bash, Shell::Zsh, Shell::Fish] {
-        let sub = dir.join(shell.to_string());
-        fs::create_dir_all(&sub)?;
-        let path = sub.join(completion_file(shell, &bin));
-        let mut file = File::create(&path)?;
-        clap_complete::generate(shell, &mut cmd, &bin, &mut file);
-        file.flush()?;
-        files.push(path);
-    }
-    Ok(())
+    problems.extend(lint::all(root));
+    problems
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::io::Read;
 
-    /// Every binary and every visible subcommand has a page, every binary a
-    /// completion for each shell, and a page is a real roff page.
+    /// The docs of this repository, as CI checks them: generated regions
+    /// current, links resolving, examples loading, commands parsing,
+    /// nothing pointing outside.
     #[test]
-    fn writes_a_page_per_command_and_a_completion_per_shell() {
-        let out = std::env::temp_dir().join(format!("docgen-{}", std::process::id()));
-        let files = write_all(&out).unwrap();
-        let names: Vec<String> = files
-            .iter()
-            .map(|p| p.strip_prefix(&out).unwrap().display().to_string())
-            .collect();
-        for want in [
-            "man/motion-supervisor.1.gz",
-            "man/motion-supervisor-run.1.gz",
-            "man/motion-supervisor-home.1.gz",
-            "man/motion-supervisor-check.1.gz",
-            "man/motion-io.1.gz",
-            "man/motionctl.1.gz",
-            "man/motionctl-status.1.gz",
-            "man/motionctl-home.1.gz",
-            "man/motionctl-stop.1.gz",
-            "man/motionctl-unhome.1.gz",
-            "man/motionctl-stats.1.gz",
-            "man/motionctl-trace.1.gz",
-            "man/motion-opcua.1.gz",
-            "man/motion-opcua-trust.1.gz",
-            "completions/bash/motion-opcua",
-            "completions/bash/motionctl",
-            "completions/zsh/_motion-io",
-            "completions/fish/motion-supervisor.fish",
-        ] {
-            assert!(
-                names.iter().any(|n| n == want),
-                "{want} missing in {names:?}"
-            );
-        }
-        let mut page = String::new();
-        flate2::read::GzDecoder::new(File::open(out.join("man/motionctl-home.1.gz")).unwrap())
-            .read_to_string(&mut page)
-            .unwrap();
-        assert!(page.starts_with(".ie \\n(.g .ds Aq"), "{page}");
-        assert!(
-            page.contains(".TH motionctl-home 1 ") && page.contains(" motion-supervisor\n"),
-            "{page}"
-        );
-        assert!(page.contains("\\-\\-parallel"), "{page}");
-        fs::remove_dir_all(&out).unwrap();
+    fn the_docs_are_true() {
+        let problems = check_docs(&repo::default_root());
+        assert!(problems.is_empty(), "\n{}", problems.join("\n"));
     }
 
+    /// A stale region is found, and `docs` would rewrite it.
     #[test]
-    fn the_pages_date_is_the_latest_changelog_entry() {
-        let log = "p (0.2.0-1) unstable; urgency=medium\n\n  * x\n\n \
-                   -- A B <a@b.example>  Wed, 03 Feb 2027 10:00:00 +0000\n\n\
-                   p (0.1.0-1) unstable; urgency=medium\n\n  * y\n\n \
-                   -- A B <a@b.example>  Tue, 01 Dec 2026 21:30:00 +0000\n";
-        assert_eq!(release_date(log).as_deref(), Some("2027-02-03"));
-        assert!(release_date(CHANGELOG).is_some());
-        assert_eq!(release_date("no trailer"), None);
+    fn a_stale_region_fails_the_check() {
+        let root = std::env::temp_dir().join(format!("docgen-stale-{}", std::process::id()));
+        std::fs::create_dir_all(root.join("docs")).unwrap();
+        let page = "# Errors\n\n<!-- BEGIN motion-docgen errors: x -->\nstale\n\
+                    <!-- END motion-docgen errors -->\n";
+        std::fs::write(root.join("docs/errors.md"), page).unwrap();
+        let (pages, problems) = generated(&root);
+        assert!(
+            problems.iter().any(|p| p.contains("region configuration")),
+            "{problems:?}"
+        );
+        let stale = check_docs(&root);
+        assert!(
+            stale
+                .iter()
+                .any(|p| p.starts_with("docs/errors.md:3: a generated region")),
+            "{stale:?}"
+        );
+        assert!(pages[0].2.contains("### ERR 12 / 45\n"));
+        std::fs::remove_dir_all(&root).unwrap();
     }
 }

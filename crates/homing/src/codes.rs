@@ -1,49 +1,20 @@
-//! Error codes reported in the instruction's `ERR` / `EXERR`.
+//! Error codes reported in the instruction's `ERR` / `EXERR`. Each has a
+//! row in [`crate::code_table`] with its meaning, cause and remedy — what
+//! `motionctl` prints beside a code and what the manual's error page
+//! (`docs/errors.md`, written by `motion-docgen`) lists.
 //!
 //! The CIP codes (12, 41 and the extended codes 1, 4, 6, 7, 12, 16) are the
 //! Motion Axis Home instruction's; 1014 and 1015 are the Home operation
-//! wrapper's. Codes marked *ours* extend those tables in the same style; each
-//! one is listed here and nowhere else.
+//! wrapper's; the operations around homing use the codes the Logix motion
+//! instructions report (3, 5, 9, 13, 16, 20). Codes marked *ours* extend
+//! those tables in the same style.
 //!
-//! | ERR  | EXERR | meaning |
-//! |------|-------|---------|
-//! | 12   | 1     | process terminated on request: a stop during homing |
-//! | 12   | 12    | axis in shutdown (at start or during homing) |
-//! | 12   | 16    | device in wrong state: drive fault during homing |
-//! | 12   | 40    | *ours* feedback lost: the leaky bucket of missing-feedback time went above `feedback_timeout_ns` (I/O process gone, or frames lost too often); `Status::lost_after_ns` holds the gap |
-//! | 12   | 41    | *ours* feedback invalid: non-finite or absurd value (the status names the attribute) |
-//! | 12   | 42    | *ours* drive did not report enabled within `enable_timeout` |
-//! | 12   | 43    | *ours* hardware overtravel input tripped during homing |
-//! | 12   | 44    | *ours* feedback implausible: a position further than `max_speed` allows from where the axis was last seen or has been commanded since (a forged or corrupt frame; never an event) |
-//! | 12   | 45    | *ours* drive lost: the I/O process is alive but reports the axis's drive gone (EtherCAT: its SubDevice stopped answering, left OP or was power-cycled); the feedback-loss rule tripped on it. motion-io's log names the SubDevice and says what to do |
-//! | 12   | 46    | *ours* drive homing error: a `drive_homing` axis's drive reported a homing error (CiA 402 statusword bit 13), refused homing mode, or left it before attaining home |
-//! | 41   | 4     | home sequence incompatible with home mode / axis (passive torque, virtual axis moving sequence, absolute mode with a sequence other than immediate) |
-//! | 41   | 6     | home speed zero |
-//! | 41   | 7     | home return speed zero |
-//! | 41   | 20    | *ours* active home mode on a feedback-only axis |
-//! | 41   | 21    | *ours* marker sequence but the feedback has no marker |
-//! | 41   | 22    | *ours* unidirectional torque sequence |
-//! | 41   | 23    | *ours* active homing in torque control mode |
-//! | 41   | 24    | *ours* cyclic home position outside `[0, unwind)` |
-//! | 41   | 25    | *ours* negative or non-finite number |
-//! | 41   | 26    | *ours* home acceleration zero for an active sequence |
-//! | 41   | 27    | *ours* home deceleration zero for an active sequence |
-//! | 41   | 28    | *ours* torque level zero, above 100 %, or below the threshold (a hard stop could never be detected) |
-//! | 41   | 29    | *ours* cyclic axis without a positive unwind |
-//! | 41   | 30    | *ours* conversion constant not positive |
-//! | 41   | 31    | *ours* home position outside the travel limits |
-//! | 41   | 32    | *ours* travel limits empty or reversed |
-//! | 41   | 33    | *ours* absolute home mode on a non-absolute feedback device |
-//! | 41   | 34    | *ours* a homing speed the sequence commands is above `max_speed` |
-//! | 41   | 35    | *ours* limit-switch sequence with a unidirectional direction (the axis must come back off the limit) |
-//! | 41   | 36    | *ours* limit-switch sequence whose `home_offset` does not end the axis off the switch: `limit_switch`'s must point away from the limit, into the travel, by more than one cycle of travel at Home Return Speed; `limit_switch_then_marker`'s (which rests on its marker, beyond the clear point) must be 0 or point away from the limit |
-//! | 41   | 37    | *ours* `home_reverse_at_limit` on a sequence that cannot reverse (only active bidirectional switch and switch then marker can; a unidirectional search is refused here, not failed at the limit) |
-//! | 41   | 38    | *ours* limit-switch sequence or `home_reverse_at_limit` on an axis without limit switches (`limit_switches = false`, or a cyclic axis, which has no ends) |
-//! | 1014 | 0     | homing interrupted externally: the wrapper's code, kept for tools that map it; this engine reports every interruption it sees more precisely (a stop request or the supervisor shutting down: 12/1, a shutdown: 12/12, lost feedback: 12/40) |
-//! | 1015 | 0     | home timeout: homing took longer than `home_timeout` |
-//! | 1016 | leg | *ours* search limit: a search leg travelled farther than `search_limit`; EXERR names the leg: 2 seek, 5 return, 10 creep, 11 reverse (the run back past the home switch after a limit, `home_reverse_at_limit`) (an explicit mapping, kept equal to the numbers these legs' phases had when the code was introduced) |
-//! | 1017 | 0     | *ours* gantry skew: the sides of a gantry found their events further apart than `max_skew` (reported by the coordinator through `Request::stop_code`) |
-//! | 1018 | 0     | *ours* ambiguous marker: switch then marker found its marker closer than `marker_min_distance` to the switch edge, and `refuse_ambiguous_marker` is set (axis stopped, not homed) |
+//! Three kinds of report carry a code: a homing that ends without PC
+//! (`ER`, the instruction's error), a **refusal** of an operation (answered
+//! per axis and in `Status::op.refused`, never setting the axis's ER), and
+//! an **axis fault** that ends a motion (ER set, `Status::faulted`, cleared
+//! by `Operation::Reset`). A configuration the engine's validation refuses
+//! carries its ERR 41 code in `check`'s problem.
 //!
 //! **Limit switches while homing** (12 / 43): a limit switch tripped in the
 //! direction of travel aborts homing, except where the sequence means to be
@@ -57,42 +28,8 @@
 //! with 12 / 43 (it cannot reverse; `home_reverse_at_limit` is refused for
 //! it with 41 / 37).
 //!
-//! The operations around homing (issue 15: enable, disable, reset, jog,
-//! move, stop, the supervised stream) use the Logix codes the Logix motion
-//! instructions report (MOTION-RM002, "Motion Error Codes (.ERR)") for
-//! their **refusals** — answered in `Status::op.refused`, never setting the
-//! axis's ER — and ERR 12 / 1019 for the **axis faults** that end a motion
-//! (ER set, `Status::faulted`, cleared by `Operation::Reset`):
-//!
-//! | ERR  | EXERR | meaning |
-//! |------|-------|---------|
-//! | 3    | 0     | execution collision: the axis runs an operation this one may not replace (a move on a jogging or moving axis without `supersede`, a jog on a moving axis, anything but a stop on a streaming axis, a stream start on an axis in motion, a home on an axis that jogs, moves or streams) |
-//! | 5    | 0     | servo off state: jog, move or stream on an axis whose drive is not enabled (ServoActionStatus false, or a disable in progress) |
-//! | 5    | 1     | *ours* not a servo axis: enable, jog, move or stream on a `feedback_only` axis |
-//! | 9    | 0     | overtravel condition: jog or move towards a tripped limit switch (motion away is allowed) |
-//! | 12   | 12    | axis in shutdown: enable, jog, move or stream while `Request::shutdown` is set |
-//! | 12   | 40    | as a refusal: enable, jog, move or stream without valid feedback (the position to start from is unknown) |
-//! | 13   | 1     | parameter out of range, speed: not finite, not above zero, above `max_speed`, or (not homed) above `unhomed_speed`; a stream start without any speed bound (no `max_speed` and no homing speed to derive one) |
-//! | 13   | 2     | parameter out of range, acceleration: not finite or not above zero |
-//! | 13   | 3     | parameter out of range, deceleration: not finite, not above zero, or above `max_deceleration` |
-//! | 13   | 4     | parameter out of range, target: outside `travel_limits` (homed, linear), beyond ±`max_position`, a jog towards a travel limit already reached, or a motion that could not stop inside the travel limits from where the axis is |
-//! | 13   | 5     | parameter out of range, target not finite |
-//! | 13   | 6     | parameter out of range, jog lease outside 50 ms ..= 5 s |
-//! | 13   | 7     | no speed bound: jog, move or stream on an axis without `max_speed` whose homing derives none (immediate, absolute, passive) |
-//! | 16   | 0     | home in process: enable, reset, jog, move or stream on an axis that is homing (stop it first; `disable` and `stop` are always accepted) |
-//! | 20   | 0     | axis in faulted state: home, enable, jog, move or stream while the axis has an axis fault (`Status::faulted`): `reset` first |
-//! | 12   | 16    | axis fault: the drive faulted (or dropped its power stage) — during homing, a jog, move or stream, or at rest |
-//! | 12   | 40    | axis fault: feedback lost during a jog, move or stream (41 invalid, 44 implausible likewise; 45 the drive reported lost) |
-//! | 12   | 42    | axis fault: the drive did not report enabled within `enable_timeout` after an enable |
-//! | 12   | 43    | axis fault: a jog, move or stream moved towards a tripped limit switch (stopped at `max_deceleration`) |
-//! | 1019 | 1     | *ours* setpoint refused (the stream stops the axis at the larger of `max_deceleration` and `stream_acceleration`): position or velocity not finite |
-//! | 1019 | 2     | *ours* setpoint refused: outside `travel_limits` (homed, linear) or beyond ±`max_position` |
-//! | 1019 | 3     | *ours* setpoint refused: step faster than the speed cap (`max_speed`; `unhomed_speed` while not homed), a velocity feed-forward above it, or a command the cap holds back further than it can follow |
-//! | 1019 | 4     | *ours* setpoint refused: change of segment velocity faster than `stream_acceleration`, or a command that acceleration holds back further than it can follow (whatever the timestamps) |
-//! | 1019 | 5     | *ours* stream silent: no new setpoint for `stream_timeout_ms` after the last one arrived |
-//! | 1019 | 6     | *ours* setpoint out of order: its time is not after the previous one's |
-//! | 1019 | 7     | *ours* axis not homed (cleared while streaming) and `stream_unhomed` false |
-//! | 1020 | 0     | *ours* jog lease expired (hold to run): NOT an error — the jog stops normally, ER stays false; only logged and shown as `StopCause::LeaseExpired` |
+//! To add a code: its constant below, and one row in
+//! [`TABLE`](crate::code_table::TABLE).
 
 /// Servo message failure.
 pub const ERR_SERVO_MESSAGE: u16 = 12;
@@ -148,7 +85,7 @@ pub const EX_TRAVEL_LIMITS: u16 = 32;
 pub const EX_ABSOLUTE_NOT_ABSOLUTE: u16 = 33;
 pub const EX_ABOVE_MAX_SPEED: u16 = 34;
 
-// --- the operations around homing (issue 15) ---------------------------
+// --- the operations around homing ---------------------------------------
 
 /// Execution collision: another operation runs that this one may not replace.
 pub const ERR_EXECUTION_COLLISION: u16 = 3;

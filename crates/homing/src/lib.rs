@@ -27,6 +27,7 @@
 //!   of the limit-switch sequences and of a search that reverses at a limit.
 
 pub mod axis;
+pub mod code_table;
 pub mod codes;
 pub mod config;
 pub mod equivalent;

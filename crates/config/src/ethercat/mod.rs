@@ -38,18 +38,17 @@ pub enum EthercatDc {
     Off,
 }
 
-impl EthercatDc {
-    pub fn name(self) -> &'static str {
-        match self {
-            EthercatDc::Auto => "auto",
-            EthercatDc::On => "on",
-            EthercatDc::Off => "off",
-        }
-    }
-}
+motion_homing::spellings!(EthercatDc {
+    Auto => "auto",
+    On => "on",
+    Off => "off",
+});
+
+/// `[[io]] dc`.
+pub const DC_MODES: &[(&str, EthercatDc)] = EthercatDc::NAMES;
 
 /// The `[[io]]` keys of an I/O process with `backend = "ethercat"`
-/// (ranges in [`crate::limits`]).
+/// (declared, with their ranges and defaults, in [`crate::keytable::ethercat`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EthercatIo {
     /// Network interface of the EtherCAT segment (`motion-io --interface`
@@ -72,21 +71,6 @@ pub struct EthercatIo {
     /// at most this long (less once it is at rest, none if it ignores quick
     /// stop), then disable voltage (Switch on disabled, power stage off).
     pub quick_stop_timeout_ms: u32,
-}
-
-impl Default for EthercatIo {
-    fn default() -> Self {
-        EthercatIo {
-            interface: String::new(),
-            dc: EthercatDc::Auto,
-            sm_watchdog_ms: 50,
-            reply_timeout_us: None,
-            startup_timeout_s: 30,
-            mode_in_pdo: false,
-            dc_static_sync_iterations: 1000,
-            quick_stop_timeout_ms: 500,
-        }
-    }
 }
 
 /// How an axis of an EtherCAT I/O process finds its drive.

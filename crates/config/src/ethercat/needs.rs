@@ -66,13 +66,11 @@ pub struct AxisNeeds {
     pub brake_delay_ms: u32,
 }
 
-/// The axis has overtravel limit switches. Issue 15 adds the `[[axis]]`
-/// key `limit_switches` (default true; helper `ops`): once it is on this
-/// branch, return `engine.limit_switches` here — an EtherCAT axis without
-/// them then does not need 0x60FD bits 0/1. Until then every servo axis
-/// has them.
+/// The axis has overtravel limit switches: a servo axis unless it says
+/// `limit_switches = false` (then its drive need not report 0x60FD bits
+/// 0/1, and the engine ignores them).
 fn has_limit_switches(engine: &AxisConfig) -> bool {
-    engine.configuration == AxisConfiguration::Servo
+    engine.configuration == AxisConfiguration::Servo && engine.limit_switches
 }
 
 fn counts(x: f64, counts_per_unit: f64) -> u32 {

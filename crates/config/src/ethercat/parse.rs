@@ -5,39 +5,13 @@
 
 use motion_homing::AxisConfig;
 
-use super::{AxisEthercat, EthercatDc, EthercatDrive, EthercatIo};
+use super::{AxisEthercat, EthercatDrive, EthercatIo, DC_MODES};
 use crate::keys::Reader;
-use crate::limits::*;
+use crate::keytable::ethercat::{self as keys, *};
+use crate::keytable::io::BACKEND;
+use crate::keytable::Key;
+use crate::limits::{ETHERCAT_MAX_AXES, ETHERCAT_MIN_CYCLE_US};
 use crate::{names, AxisEntry, IoBackend, IoConfig, Problem, SupervisorConfig};
-
-/// The `[[io]]` keys that only an EtherCAT I/O process has.
-const IO_KEYS: &[&str] = &[
-    "interface",
-    "dc",
-    "sm_watchdog_ms",
-    "reply_timeout_us",
-    "startup_timeout_s",
-    "mode_in_pdo",
-    "dc_static_sync_iterations",
-    "quick_stop_timeout_ms",
-];
-
-/// The `[[axis]]` keys that only an axis of an EtherCAT I/O process has.
-const AXIS_KEYS: [&str; 7] = [
-    "ethercat_position",
-    "ethercat_name",
-    "ethercat_index_pulse_bit",
-    "ethercat_home_switch_bit",
-    "ethercat_brake_delay_ms",
-    "drive_homing",
-    "drive_homing_method",
-];
-
-const DC_MODES: &[(&str, EthercatDc)] = &[
-    ("auto", EthercatDc::Auto),
-    ("on", EthercatDc::On),
-    ("off", EthercatDc::Off),
-];
 
 /// The EtherCAT keys of the `[[io]]` read by `r` (`who` names it in
 /// messages): `Some` on `backend = "ethercat"`, else `None` and each key
@@ -51,7 +25,7 @@ pub(crate) fn io_keys(
     if backend == IoBackend::Ethercat {
         return Some(ethercat_io(r, who, sup));
     }
-    for k in IO_KEYS {
+    for k in keys::IO.keys {
         if r.has(k) {
             r.mark_used(k);
             r.problem(
@@ -68,16 +42,15 @@ pub(crate) fn io_keys(
 }
 
 fn ethercat_io(r: &mut Reader<'_>, label: &str, sup: &SupervisorConfig) -> EthercatIo {
-    let d = EthercatIo::default();
-    let interface = if r.has("interface") {
-        let i = r.string("interface", "");
+    let interface = if r.has(&INTERFACE) {
+        let i = r.string(&INTERFACE);
         if let Err(e) = names::check_interface_name(&i) {
-            r.problem("interface", format!("{label}: {e}"));
+            r.problem(&INTERFACE, format!("{label}: {e}"));
         }
         i
     } else {
         r.problem(
-            "interface",
+            &INTERFACE,
             format!(
                 "{label}: missing: backend = \"ethercat\" needs the network interface of the \
                  bus (e.g. interface = \"eth1\"; motion-io --interface overrides it)"
@@ -85,33 +58,23 @@ fn ethercat_io(r: &mut Reader<'_>, label: &str, sup: &SupervisorConfig) -> Ether
         );
         String::new()
     };
-    let dc = r.choice("dc", DC_MODES, d.dc);
-    let sm_watchdog_ms = r.u32_in(
-        "sm_watchdog_ms",
-        d.sm_watchdog_ms,
-        SM_WATCHDOG_MS.0,
-        SM_WATCHDOG_MS.1,
-    );
+    let dc = r.choice(&DC, DC_MODES);
+    let sm_watchdog_ms = r.u32_in(&SM_WATCHDOG_MS);
     if u64::from(sm_watchdog_ms) * 1000 < 3 * u64::from(sup.cycle_us) {
         r.problem(
-            "sm_watchdog_ms",
+            &SM_WATCHDOG_MS,
             format!(
                 "{label}: {sm_watchdog_ms} ms is shorter than 3 cycles of {} µs",
                 sup.cycle_us
             ),
         );
     }
-    let reply_timeout_us = r.has("reply_timeout_us").then(|| {
-        let v = r.u32_in(
-            "reply_timeout_us",
-            0,
-            REPLY_TIMEOUT_US.0,
-            REPLY_TIMEOUT_US.1,
-        );
+    let reply_timeout_us = r.has(&REPLY_TIMEOUT_US).then(|| {
+        let v = r.u32_in(&REPLY_TIMEOUT_US);
         let most = sup.cycle_us / 100 * 95;
         if v > most {
             r.problem(
-                "reply_timeout_us",
+                &REPLY_TIMEOUT_US,
                 format!(
                     "{label}: {v} µs leaves no time in a cycle of {} µs (at most 95 %: {most} µs)",
                     sup.cycle_us
@@ -120,28 +83,13 @@ fn ethercat_io(r: &mut Reader<'_>, label: &str, sup: &SupervisorConfig) -> Ether
         }
         v
     });
-    let startup_timeout_s = r.u32_in(
-        "startup_timeout_s",
-        d.startup_timeout_s,
-        STARTUP_TIMEOUT_S.0,
-        STARTUP_TIMEOUT_S.1,
-    );
-    let mode_in_pdo = r.bool("mode_in_pdo", d.mode_in_pdo);
-    let dc_static_sync_iterations = r.u32_in(
-        "dc_static_sync_iterations",
-        d.dc_static_sync_iterations,
-        DC_STATIC_SYNC_ITERATIONS.0,
-        DC_STATIC_SYNC_ITERATIONS.1,
-    );
-    let quick_stop_timeout_ms = r.u32_in(
-        "quick_stop_timeout_ms",
-        d.quick_stop_timeout_ms,
-        QUICK_STOP_TIMEOUT_MS.0,
-        QUICK_STOP_TIMEOUT_MS.1,
-    );
+    let startup_timeout_s = r.u32_in(&STARTUP_TIMEOUT_S);
+    let mode_in_pdo = r.bool(&MODE_IN_PDO);
+    let dc_static_sync_iterations = r.u32_in(&DC_STATIC_SYNC_ITERATIONS);
+    let quick_stop_timeout_ms = r.u32_in(&QUICK_STOP_TIMEOUT_MS);
     if sup.cycle_us < ETHERCAT_MIN_CYCLE_US {
         r.problem(
-            "backend",
+            &BACKEND,
             format!(
                 "{label}: the EtherCAT bus cycles at [supervisor] cycle_us = {} µs; it needs \
                  at least {ETHERCAT_MIN_CYCLE_US} µs",
@@ -170,7 +118,12 @@ pub(crate) fn axis_keys(
     engine: &mut AxisConfig,
     io: Option<&IoConfig>,
 ) -> Option<AxisEthercat> {
-    let given: Vec<&str> = AXIS_KEYS.iter().copied().filter(|k| r.has(k)).collect();
+    let given: Vec<&Key> = keys::AXIS
+        .keys
+        .iter()
+        .copied()
+        .filter(|k| r.has(k))
+        .collect();
     let io_name = io.map_or("?", |i| i.name.as_str());
     let on_ethercat = io.is_some_and(|i| i.backend == IoBackend::Ethercat);
     if !on_ethercat {
@@ -195,18 +148,13 @@ pub(crate) fn axis_keys(
         return None;
     }
     let drive = drive_key(r, io_name);
-    let bit = |r: &mut Reader<'_>, key: &str| {
+    let bit = |r: &mut Reader<'_>, key: &Key| {
         r.has(key)
-            .then(|| r.u32_in(key, INDEX_PULSE_BIT.0, INDEX_PULSE_BIT.0, INDEX_PULSE_BIT.1) as u8)
+            .then(|| r.u32_in_or(key, key.range_of().0 as u32) as u8)
     };
-    let index_pulse_bit = bit(r, "ethercat_index_pulse_bit");
-    let home_switch_bit = bit(r, "ethercat_home_switch_bit");
-    let brake_delay_ms = r.u32_in(
-        "ethercat_brake_delay_ms",
-        0,
-        BRAKE_DELAY_MS.0,
-        BRAKE_DELAY_MS.1,
-    );
+    let index_pulse_bit = bit(r, &ETHERCAT_INDEX_PULSE_BIT);
+    let home_switch_bit = bit(r, &ETHERCAT_HOME_SWITCH_BIT);
+    let brake_delay_ms = r.u32_in(&ETHERCAT_BRAKE_DELAY_MS);
     let drive_homing_method = drive_homing(r, engine);
     engine.drive_homing = drive_homing_method.is_some();
     if engine.home_sequence.uses_marker()
@@ -215,7 +163,7 @@ pub(crate) fn axis_keys(
         && index_pulse_bit.is_none()
     {
         r.problem(
-            "ethercat_index_pulse_bit",
+            &ETHERCAT_INDEX_PULSE_BIT,
             "missing: a marker sequence with marker_latch = false sees the index pulse in a \
              manufacturer bit of 0x60FD: name it (16..=31), or latch the marker \
              (marker_latch = true, touch probe 0x60B8)"
@@ -233,18 +181,13 @@ pub(crate) fn axis_keys(
 
 /// `ethercat_position` or `ethercat_name`: exactly one of them.
 fn drive_key(r: &mut Reader<'_>, io_name: &str) -> EthercatDrive {
-    let position = r.has("ethercat_position").then(|| {
-        r.u32_in(
-            "ethercat_position",
-            0,
-            ETHERCAT_POSITION.0,
-            ETHERCAT_POSITION.1,
-        ) as u16
-    });
-    let name = r.has("ethercat_name").then(|| {
-        let n = r.string("ethercat_name", "");
+    let position = r
+        .has(&ETHERCAT_POSITION)
+        .then(|| r.u32_in_or(&ETHERCAT_POSITION, 0) as u16);
+    let name = r.has(&ETHERCAT_NAME).then(|| {
+        let n = r.string(&ETHERCAT_NAME);
         if let Err(e) = names::check_subdevice_name(&n) {
-            r.problem("ethercat_name", e);
+            r.problem(&ETHERCAT_NAME, e);
         }
         n
     });
@@ -253,14 +196,14 @@ fn drive_key(r: &mut Reader<'_>, io_name: &str) -> EthercatDrive {
         (None, Some(n)) => EthercatDrive::Name(n),
         (Some(p), Some(_)) => {
             r.problem(
-                "ethercat_name",
+                &ETHERCAT_NAME,
                 "give ethercat_position or ethercat_name, not both".into(),
             );
             EthercatDrive::Position(p)
         }
         (None, None) => {
             r.problem(
-                "ethercat_position",
+                &ETHERCAT_POSITION,
                 format!(
                     "missing: an axis of EtherCAT I/O process {io_name} names its drive with \
                      ethercat_position (bus position, 0 = first) or ethercat_name"
@@ -274,21 +217,22 @@ fn drive_key(r: &mut Reader<'_>, io_name: &str) -> EthercatDrive {
 /// `drive_homing` / `drive_homing_method`: the method the drive homes the
 /// axis with, if it does (a method given means `drive_homing = true`).
 fn drive_homing(r: &mut Reader<'_>, engine: &AxisConfig) -> Option<i8> {
-    let method = r.has("drive_homing_method").then(|| {
-        let m = r.i32("drive_homing_method", 0);
-        if m == 0 || !(DRIVE_HOMING_METHOD.0..=DRIVE_HOMING_METHOD.1).contains(&m) {
+    let method = r.has(&DRIVE_HOMING_METHOD).then(|| {
+        let m = r.i32_or(&DRIVE_HOMING_METHOD, 0);
+        let (lo, hi) = DRIVE_HOMING_METHOD.range_of();
+        if m == 0 || !(lo..=hi).contains(&f64::from(m)) {
             r.problem(
-                "drive_homing_method",
+                &DRIVE_HOMING_METHOD,
                 format!("{m}: a CiA 402 homing method is -128..=127 and not 0"),
             );
         }
         m.clamp(-128, 127) as i8
     });
-    let on = r.bool("drive_homing", method.is_some());
+    let on = r.bool_or(&DRIVE_HOMING, method.is_some());
     if !on {
         if method.is_some() {
             r.problem(
-                "drive_homing_method",
+                &DRIVE_HOMING_METHOD,
                 "drive_homing = false: the drive does not home this axis, its method is unused"
                     .into(),
             );
@@ -300,7 +244,7 @@ fn drive_homing(r: &mut Reader<'_>, engine: &AxisConfig) -> Option<i8> {
         || seq == motion_homing::HomeSequence::Immediate
     {
         r.problem(
-            "drive_homing",
+            &DRIVE_HOMING,
             format!(
                 "the drive homes actively; home_mode = {:?} with home_sequence = {:?} leaves it \
                  nothing to do",
@@ -314,7 +258,7 @@ fn drive_homing(r: &mut Reader<'_>, engine: &AxisConfig) -> Option<i8> {
         Some(m) => Some(m),
         None => {
             r.problem(
-                "drive_homing_method",
+                &DRIVE_HOMING_METHOD,
                 format!(
                     "missing: no standard CiA 402 homing method does home_sequence = {:?} \
                      {:?}{}: set the drive's method (see its 0x60E3 or motion-io scan)",
@@ -369,6 +313,22 @@ pub(crate) fn checks(ios: &[IoConfig], axes: &[AxisEntry], problems: &mut Vec<Pr
                     format!("the SubDevice at {what} already drives axis {}", b.name),
                 ));
             }
+        }
+    }
+}
+
+impl Default for EthercatIo {
+    /// The key table's defaults.
+    fn default() -> Self {
+        EthercatIo {
+            interface: String::new(),
+            dc: super::EthercatDc::default(),
+            sm_watchdog_ms: SM_WATCHDOG_MS.default_f64() as u32,
+            reply_timeout_us: None,
+            startup_timeout_s: STARTUP_TIMEOUT_S.default_f64() as u32,
+            mode_in_pdo: MODE_IN_PDO.default_bool(),
+            dc_static_sync_iterations: DC_STATIC_SYNC_ITERATIONS.default_f64() as u32,
+            quick_stop_timeout_ms: QUICK_STOP_TIMEOUT_MS.default_f64() as u32,
         }
     }
 }

@@ -1,4 +1,4 @@
-//! The EtherCAT keys of issue 17: the stop's bound, the home switch bit,
+//! The EtherCAT keys: the stop's bound, the home switch bit,
 //! the brake, the drive's own homing, and what each axis needs of its drive.
 
 use super::*;
@@ -98,9 +98,11 @@ fn drive_homing_mistakes_are_named() {
 
 #[test]
 fn what_each_sequence_needs_of_its_drive() {
-    // immediate: only the limit switches (every servo axis has them for now)
+    // immediate: only the limit switches (a servo axis has them unless it
+    // says otherwise)
     let n = needs("");
     assert!(n.limit_switches.is_some());
+    assert_eq!(needs("limit_switches = false\n"), AxisNeeds::default());
     assert_eq!(
         AxisNeeds {
             limit_switches: None,

@@ -7,9 +7,11 @@
 //! [`load`]. Secure by default: no `None` policy unless listed, anonymous
 //! access read-only, users only with a salted password hash.
 
-use crate::keys::Reader;
-use crate::{names, AxisEntry, MachineConfig, Problem};
+use crate::{names, MachineConfig, Problem};
 use std::path::{Path, PathBuf};
+
+mod parse;
+pub(crate) use parse::parse;
 
 /// The endpoint when none is configured: this host only.
 pub const DEFAULT_ENDPOINT: &str = "opc.tcp://127.0.0.1:4840";
@@ -40,6 +42,12 @@ impl Policy {
             .map_or("?", |(n, _)| n)
     }
 }
+
+/// `anonymous`: may anonymous sessions read?
+pub const ANONYMOUS: &[(&str, bool)] = &[("read", true), ("off", false)];
+
+/// `role` of a user.
+pub const ROLES: &[(&str, Role)] = &[("operator", Role::Operator), ("viewer", Role::Viewer)];
 
 /// The secure policies offered by default.
 pub const DEFAULT_POLICIES: [Policy; 3] = [
@@ -128,190 +136,6 @@ impl OpcuaConfig {
     }
 }
 
-/// Reads `[opcua]` (`None`: the section is absent; every key defaults).
-/// `axes` are the machine's, for `units`; `state_dir` the default home of
-/// `pki_dir`.
-pub(crate) fn parse(
-    table: Option<&toml::Table>,
-    axes: &[AxisEntry],
-    state_dir: &Path,
-    problems: &mut Vec<Problem>,
-) -> OpcuaConfig {
-    let empty = toml::Table::new();
-    let mut r = Reader::new(table.unwrap_or(&empty), None, "opcua.", problems);
-    let endpoint = r.string("endpoint", DEFAULT_ENDPOINT);
-    let (host, port, path) = match split_endpoint(&endpoint) {
-        Ok(x) => x,
-        Err(e) => {
-            r.problem("endpoint", e);
-            ("127.0.0.1".into(), 4840, "/".into())
-        }
-    };
-    let anonymous = r.choice("anonymous", &[("read", true), ("off", false)], true);
-    let policies = policies(&mut r, table.and_then(|t| t.get("policies")));
-    if policies.contains(&Policy::None) && !anonymous {
-        r.problem(
-            "policies",
-            "\"None\" is offered read-only, to anonymous sessions only: it needs \
-             anonymous = \"read\""
-                .into(),
-        );
-    }
-    let pki_dir = if r.has("pki_dir") {
-        let d = r.string("pki_dir", "");
-        if !d.starts_with('/') || d.len() > 200 || d.contains("..") {
-            r.problem(
-                "pki_dir",
-                format!(
-                    "{} must be an absolute path of at most 200 characters without \"..\"",
-                    names::shown(&d)
-                ),
-            );
-        }
-        PathBuf::from(d)
-    } else {
-        state_dir.join("opcua")
-    };
-    let units = units(&mut r, axes);
-    let user_tables = r.array_of_tables("user");
-    r.finish();
-    let users = users(&user_tables, problems);
-    OpcuaConfig {
-        endpoint,
-        host,
-        port,
-        path,
-        anonymous,
-        policies,
-        users,
-        pki_dir,
-        units,
-    }
-}
-
-fn policies(r: &mut Reader, value: Option<&toml::Value>) -> Vec<Policy> {
-    let Some(value) = value else {
-        return DEFAULT_POLICIES.to_vec();
-    };
-    r.mark_used("policies");
-    let Some(list) = value
-        .as_array()
-        .and_then(|a| a.iter().map(|v| v.as_str()).collect::<Option<Vec<_>>>())
-    else {
-        r.problem("policies", "expected a list of policy names".into());
-        return DEFAULT_POLICIES.to_vec();
-    };
-    let mut out = Vec::new();
-    for s in list {
-        match Policy::NAMES.iter().find(|(n, _)| *n == s) {
-            Some((_, p)) if !out.contains(p) => out.push(*p),
-            Some(_) => r.problem("policies", format!("{} listed twice", names::shown(s))),
-            None => r.problem(
-                "policies",
-                format!(
-                    "{} is not one of {}",
-                    names::shown(s),
-                    Policy::NAMES
-                        .iter()
-                        .map(|(n, _)| format!("\"{n}\""))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            ),
-        }
-    }
-    if out.is_empty() {
-        r.problem("policies", "no policy: list at least one".into());
-    }
-    out
-}
-
-fn units(r: &mut Reader, axes: &[AxisEntry]) -> Vec<(String, Unit)> {
-    let Some(t) = r.table("units") else {
-        return Vec::new();
-    };
-    let mut out = Vec::new();
-    for (axis, v) in &t {
-        if !axes.iter().any(|a| &a.name == axis) {
-            r.problem(
-                &format!("units.{axis}"),
-                format!("no axis is called {}", names::shown(axis)),
-            );
-            continue;
-        }
-        match v
-            .as_str()
-            .and_then(|s| Unit::NAMES.iter().find(|(n, _)| *n == s))
-        {
-            Some((_, u)) => out.push((axis.clone(), *u)),
-            None => r.problem(
-                &format!("units.{axis}"),
-                format!(
-                    "expected one of {}",
-                    Unit::NAMES
-                        .iter()
-                        .map(|(n, _)| format!("\"{n}\""))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            ),
-        }
-    }
-    out
-}
-
-fn users(tables: &[toml::Table], problems: &mut Vec<Problem>) -> Vec<User> {
-    let mut out: Vec<User> = Vec::new();
-    for (i, t) in tables.iter().enumerate() {
-        let mut r = Reader::new(t, None, "opcua.user.", problems);
-        let name = r.string("name", "");
-        let at = format!("[[opcua.user]] #{}", i + 1);
-        if let Err(e) = names::check_name(&name) {
-            r.problem("name", format!("{at}: {e}"));
-        } else if out.iter().any(|u| u.name == name) {
-            r.problem("name", format!("user {name} configured twice"));
-        }
-        if r.has("password") {
-            r.mark_used("password");
-            r.problem(
-                "password",
-                format!(
-                    "{at}: a clear-text password is never accepted: put the output of \
-                     `motion-opcua --config FILE hash-password` in password_hash"
-                ),
-            );
-        }
-        let password_hash = r.string("password_hash", "");
-        if let Err(e) = check_phc(&password_hash) {
-            r.problem(
-                "password_hash",
-                format!("user {}: {e}", names::shown(&name)),
-            );
-        }
-        let role = r.choice(
-            "role",
-            &[("operator", Role::Operator), ("viewer", Role::Viewer)],
-            Role::Viewer,
-        );
-        if !r.has("role") {
-            r.problem(
-                "role",
-                format!(
-                    "user {}: missing (\"operator\" or \"viewer\")",
-                    names::shown(&name)
-                ),
-            );
-        }
-        r.finish();
-        out.push(User {
-            name,
-            password_hash,
-            role,
-        });
-    }
-    out
-}
-
 /// The shape of an argon2 PHC string (`motion-opcua` verifies it fully at
 /// start): anything else is refused, so a clear-text password can never
 /// stand in the config for a hash.
@@ -338,7 +162,7 @@ pub fn check_phc(s: &str) -> Result<(), String> {
 }
 
 /// `opc.tcp://HOST:PORT[/PATH]` → host, port, path.
-fn split_endpoint(s: &str) -> Result<(String, u16, String), String> {
+pub(crate) fn split_endpoint(s: &str) -> Result<(String, u16, String), String> {
     let bad = || {
         format!(
             "{} is not opc.tcp://HOST:PORT[/PATH] (e.g. {DEFAULT_ENDPOINT})",
@@ -380,7 +204,7 @@ pub fn parse_text(text: &str) -> Result<(MachineConfig, OpcuaConfig), Vec<Proble
     let table: toml::Table = text.parse().map_err(|e| vec![Problem::syntax(text, &e)])?;
     let section = table.get("opcua").and_then(|v| v.as_table());
     let mut problems = Vec::new();
-    let cfg = parse(
+    let cfg = parse::parse(
         section,
         &machine.axes,
         &machine.supervisor.state_dir,
