@@ -92,6 +92,23 @@
 //! | 1019 | 6     | *ours* setpoint out of order: its time is not after the previous one's |
 //! | 1019 | 7     | *ours* axis not homed (cleared while streaming) and `stream_unhomed` false |
 //! | 1020 | 0     | *ours* jog lease expired (hold to run): NOT an error — the jog stops normally, ER stays false; only logged and shown as `StopCause::LeaseExpired` |
+//!
+//! The **cycle monitor** (`motion-monitor`, apart from the engine: it judges
+//! every command leaving it) reports ERR 1021 when a command broke one of its
+//! invariants; EXERR names the invariant. It is an axis fault (ER,
+//! `Status::faulted`, cleared by `Operation::Reset`); the monitor has stopped
+//! the axis itself (category 1 from the last command it passed, then the
+//! power stage off; category 0 where the power stage was already off):
+//!
+//! | ERR  | EXERR | meaning |
+//! |------|-------|---------|
+//! | 1021 | 1     | *ours* monitor: commanded velocity (the command's velocity field) above the speed bound that applies (the cap: `max_speed`, `unhomed_speed` while not homed, the operation's own speed, the homing speeds; after a stop, the bound decaying at the stop's deceleration) |
+//! | 1021 | 2     | *ours* monitor: commanded acceleration (second difference of the commanded positions over the cycle) above its bound (the operation's acceleration or deceleration, `stream_acceleration`, the homing accelerations; a stop at least `max_deceleration`) |
+//! | 1021 | 3     | *ours* monitor: a set-point step larger than the speed bound allows over the time since the last command |
+//! | 1021 | 4     | *ours* monitor: commanded position outside `travel_limits` while homed (linear axes), or further out than the command before it once outside |
+//! | 1021 | 5     | *ours* monitor: the power stage asked on after a drive fault, a dropped power stage, a lost drive, a shutdown, or a disable that had come to rest, without an explicit enable, home, jog, move or stream since |
+//! | 1021 | 6     | *ours* monitor: the sides of a gantry moved apart by more than `max_skew` from where they were at rest together |
+//! | 1021 | 7     | *ours* monitor: a command position or velocity not finite |
 
 /// Servo message failure.
 pub const ERR_SERVO_MESSAGE: u16 = 12;
@@ -166,6 +183,9 @@ pub const ERR_AXIS_FAULTED: u16 = 20;
 pub const ERR_SETPOINT_REFUSED: u16 = 1019;
 /// The jog's lease ran out (ours): a normal stop, only logged.
 pub const ERR_JOG_LEASE_EXPIRED: u16 = 1020;
+/// The cycle monitor stopped the axis: a command broke one of its
+/// invariants (ours). EXERR: `EX_MONITOR_*`.
+pub const ERR_MONITOR: u16 = 1021;
 
 // EXERR under ERR 5.
 /// The axis is `feedback_only`: nothing to enable or move.
@@ -191,3 +211,12 @@ pub const EX_LIMIT_UNIDIRECTIONAL: u16 = 35;
 pub const EX_LIMIT_OFFSET: u16 = 36;
 pub const EX_REVERSE_NOT_APPLICABLE: u16 = 37;
 pub const EX_NO_LIMIT_SWITCHES: u16 = 38;
+
+// EXERR under ERR 1021: the invariant the cycle monitor found broken.
+pub const EX_MONITOR_VELOCITY: u16 = 1;
+pub const EX_MONITOR_ACCELERATION: u16 = 2;
+pub const EX_MONITOR_STEP: u16 = 3;
+pub const EX_MONITOR_SOFT_LIMIT: u16 = 4;
+pub const EX_MONITOR_ENABLE: u16 = 5;
+pub const EX_MONITOR_GANTRY: u16 = 6;
+pub const EX_MONITOR_NOT_FINITE: u16 = 7;
