@@ -22,6 +22,10 @@ pub struct Bench {
     pub alive: Vec<bool>,
     pub k: u64,
     pub acks: Vec<Ack>,
+    /// The cycle monitor may trip (a test that feeds garbage, or checks a
+    /// trip); otherwise every cycle asserts that it did not: the monitor
+    /// never trips in normal operation.
+    pub allow_trips: bool,
 }
 
 impl Bench {
@@ -38,6 +42,7 @@ impl Bench {
             alive: vec![true; ios],
             k: 0,
             acks: Vec::new(),
+            allow_trips: false,
             m,
         }
     }
@@ -56,6 +61,17 @@ impl Bench {
             .map(|k| (self.alive[k] && self.seq[k] > 0).then_some(&self.fb[k]))
             .collect();
         self.core.step(now, false, &frames);
+        if !self.allow_trips {
+            for (i, slot) in self.core.axes().iter().enumerate() {
+                assert!(
+                    slot.trip().is_none(),
+                    "cycle {}: the monitor tripped on axis {i}: {:?}\n{:?}",
+                    self.k,
+                    slot.trip(),
+                    slot.status()
+                );
+            }
+        }
         let dt = self.m.supervisor.cycle_us as f64 * 1e-6;
         for k in 0..self.cmd.len() {
             self.core.fill(k, &mut self.cmd[k]);
