@@ -335,6 +335,9 @@ pub const SX_RESTORED: u8 = 1 << 5;
 /// its fieldbus, left operation, or was power-cycled): not a reading, not
 /// enabled.
 pub const SX_DRIVE_LOST: u8 = 1 << 6;
+/// The cycle monitor stopped the axis (ERR 1021; EXERR names the invariant
+/// broken; the value against its bound is in the supervisor's log).
+pub const SX_MONITOR: u8 = 1 << 7;
 
 /// `AxisStatusEntry::warnings`: the last homing's marker lay closer to the
 /// switch edge than `marker_min_distance` (which marker is taken is a

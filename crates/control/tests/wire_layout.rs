@@ -267,6 +267,7 @@ fn constants() -> Vec<(&'static str, u64)> {
         SX_LOST_RECONNECT,
         SX_RESTORED,
         SX_DRIVE_LOST,
+        SX_MONITOR,
         W_AMBIGUOUS_MARKER,
         W_DRIFT,
         W_SWITCH_DRIFT,

@@ -22,6 +22,9 @@ pub struct Cycle<'a> {
     pub reference: Option<f64>,
     /// The command the engine produced.
     pub command: &'a Command,
+    /// A new drive-I/O process took over in this cycle (another process
+    /// than before): its drives were off or stopped in between.
+    pub io_restarted: bool,
 }
 
 /// What the monitor remembers from the cycles before.
@@ -59,6 +62,8 @@ pub(crate) struct Events {
     pub dropped: bool,
     /// This cycle's feedback is valid: its drive state bits are news.
     pub fresh: bool,
+    /// A new I/O process took over.
+    pub io_restarted: bool,
     /// The drive state as known now (the newest valid feedback's).
     pub drive: Option<DriveState>,
 }
@@ -94,6 +99,7 @@ impl Seen {
             drive_fault,
             dropped,
             fresh: fresh.is_some(),
+            io_restarted: c.io_restarted,
             drive: fresh.or(before),
         };
         *self = Seen {

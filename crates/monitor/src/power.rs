@@ -4,8 +4,9 @@
 //! The permission is given by an explicit request the engine accepted —
 //! enable, home, jog, move, stream — and withdrawn by what takes the power
 //! stage away: a drive fault that appears, a power stage the drive dropped
-//! while it was asked on (STO, a power return, a new I/O process), a drive
-//! its I/O process reports lost, a shutdown. A disable withdraws it once
+//! while it was asked on (STO, a power return), a new I/O process (its
+//! drives were off or stopped by its watchdog in between), a drive its
+//! I/O process reports lost, a shutdown. A disable withdraws it once
 //! the axis has had the time its stop needs (the speed bound has decayed to
 //! rest) and one more cycle: category 1, then off.
 //!
@@ -49,7 +50,7 @@ impl Power {
         if ev.accepted == Some(Operation::Disable) {
             self.disabling = true;
         }
-        if ev.drive_fault || ev.dropped || req.drive_lost || req.shutdown {
+        if ev.drive_fault || ev.dropped || ev.io_restarted || req.drive_lost || req.shutdown {
             self.allowed = false;
         }
     }

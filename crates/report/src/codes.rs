@@ -92,6 +92,24 @@ pub fn explain(err: u16, exerr: u16) -> &'static str {
         }
         (ERR_SETPOINT_REFUSED, _) => "setpoint refused",
         (ERR_JOG_LEASE_EXPIRED, _) => "jog lease expired: the jog stopped (hold to run)",
+        (ERR_MONITOR, EX_MONITOR_VELOCITY) => {
+            "cycle monitor: commanded velocity above its bound (the log has the values)"
+        }
+        (ERR_MONITOR, EX_MONITOR_ACCELERATION) => {
+            "cycle monitor: commanded acceleration above its bound (the log has the values)"
+        }
+        (ERR_MONITOR, EX_MONITOR_STEP) => {
+            "cycle monitor: a set-point step larger than the speed bound allows"
+        }
+        (ERR_MONITOR, EX_MONITOR_SOFT_LIMIT) => {
+            "cycle monitor: commanded position beyond a travel limit"
+        }
+        (ERR_MONITOR, EX_MONITOR_ENABLE) => {
+            "cycle monitor: the power stage asked on without a request since it had to go off"
+        }
+        (ERR_MONITOR, EX_MONITOR_GANTRY) => "cycle monitor: the gantry's sides moved apart",
+        (ERR_MONITOR, EX_MONITOR_NOT_FINITE) => "cycle monitor: a command that is not a number",
+        (ERR_MONITOR, _) => "cycle monitor: a command broke an invariant",
         (ERR_INTERRUPTED, _) => "homing interrupted externally",
         (ERR_TIMEOUT, _) => "home timeout exceeded",
         (ERR_SEARCH_LIMIT, EX_SEARCH_REVERSE) => {

@@ -67,6 +67,7 @@ pub fn fill(
             | (if a.in_sequence { SX_IN_SEQUENCE } else { 0 })
             | (if a.restored { SX_RESTORED } else { 0 })
             | (if s.drive_lost { SX_DRIVE_LOST } else { 0 })
+            | (if a.monitor.is_some() { SX_MONITOR } else { 0 })
             | lost_cause_bits(a.lost_cause);
         let note = notes.get(i).copied().unwrap_or_default();
         e.warnings = note.warnings

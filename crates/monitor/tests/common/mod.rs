@@ -57,6 +57,7 @@ impl Rig {
             status: self.axis.status(),
             reference: self.axis.reference_offset(),
             command: &cmd,
+            io_restarted: false,
         });
         if self.monitor.trips() != trips {
             let t = *self.monitor.tripped().expect("a new trip is in force");

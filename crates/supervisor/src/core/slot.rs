@@ -135,6 +135,8 @@ pub(super) struct LinkEvents {
     pub reconnected: bool,
     /// The I/O process is detached.
     pub detached: bool,
+    /// A new I/O process took over (its drives were off in between).
+    pub restarted: bool,
 }
 
 /// Everything the cycle keeps for one axis.
@@ -225,6 +227,7 @@ impl AxisSlot {
         self.link = LinkEvents {
             reconnected: c.reconnected,
             detached,
+            restarted: c.restarted,
         };
         if c.reconnected {
             self.engine.reconnected(now_ns);
@@ -260,6 +263,7 @@ impl AxisSlot {
             status: self.engine.status(),
             reference: self.engine.reference_offset(),
             command: &self.engine_command,
+            io_restarted: self.link.restarted,
         });
         if self.monitor.trips() != trips {
             self.tell_engine(now_ns);
@@ -367,6 +371,8 @@ impl AxisSlot {
             offset: a.reference_offset(),
             restored: self.homed.restored && a.status().homed,
             cmd_axis: c.position.is_finite().then(|| a.to_axis(c.position)),
+            monitor: self.monitor.tripped().copied(),
+            monitor_trips: self.monitor.trips(),
             ..AxisSnap::default()
         }
     }
