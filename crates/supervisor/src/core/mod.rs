@@ -53,6 +53,7 @@ pub struct CycleInfo {
     pub roundtrip_ns: Option<u64>,
 }
 
+#[derive(Clone)]
 pub struct Core {
     /// Per axis, in config order.
     slots: Vec<AxisSlot>,
@@ -378,6 +379,8 @@ impl Core {
 }
 
 #[cfg(test)]
+mod campaign;
+#[cfg(test)]
 mod fuzz;
 #[cfg(test)]
 mod stream_fuzz;
@@ -385,3 +388,5 @@ mod stream_fuzz;
 pub(crate) mod testbench;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod together_tests;

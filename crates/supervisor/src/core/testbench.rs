@@ -10,6 +10,7 @@ use motion_plant::Plant;
 pub const MS: u64 = 1_000_000;
 
 /// A Core, plants per axis and one frame pair per I/O process.
+#[derive(Clone)]
 pub struct Bench {
     pub m: MachineConfig,
     pub core: Core,
