@@ -59,6 +59,15 @@ impl Machine {
         }
     }
 
+    /// `max_deceleration` as it applies (Home Deceleration when not set).
+    fn decel(&self) -> f64 {
+        if self.max_decel > 0.0 {
+            self.max_decel
+        } else {
+            self.home_decel
+        }
+    }
+
     fn plant(&self) -> PlantConfig {
         PlantConfig {
             start: self.start,
@@ -127,25 +136,26 @@ enum Input {
     Late(u64),
 }
 
-fn op() -> impl Strategy<Value = Operation> {
+/// Operations a user might ask for, their decelerations within what the
+/// machine allows (`max_decel`).
+fn op(max_decel: f64) -> impl Strategy<Value = Operation> {
     let dynamics = (1.0..40.0f64, 100.0..5000.0f64, 0.05..1.0f64);
     prop_oneof![
-        2 => (dynamics.clone(), any::<bool>(), 50u64..600).prop_map(|((s, a, d), neg, lease)| {
+        2 => (dynamics.clone(), any::<bool>(), 50u64..600).prop_map(move |((s, a, d), neg, lease)| {
             Operation::Jog {
                 speed: if neg { -s } else { s },
                 accel: a,
-                // a fraction of what may be asked: resolved per machine
-                decel: -d,
+                decel: d * max_decel,
                 lease_ns: lease * MS,
             }
         }),
         3 => (dynamics, -45.0..45.0f64, any::<bool>(), any::<bool>()).prop_map(
-            |((speed, accel, d), target, relative, supersede)| Operation::Move {
+            move |((speed, accel, d), target, relative, supersede)| Operation::Move {
                 target: if relative { target / 4.0 } else { target },
                 relative,
                 speed,
                 accel,
-                decel: -d,
+                decel: d * max_decel,
                 supersede,
             }
         ),
@@ -156,7 +166,7 @@ fn op() -> impl Strategy<Value = Operation> {
     ]
 }
 
-fn inputs() -> impl Strategy<Value = Vec<Input>> {
+fn inputs(max_decel: f64) -> impl Strategy<Value = Vec<Input>> {
     let end = prop_oneof![
         Just(End::Release),
         Just(End::ReleaseMoving),
@@ -165,7 +175,7 @@ fn inputs() -> impl Strategy<Value = Vec<Input>> {
     ];
     let input = prop_oneof![
         2 => Just(Input::Home),
-        6 => op().prop_map(Input::Op),
+        6 => op(max_decel).prop_map(Input::Op),
         2 => (1.0..40.0f64, 50u16..800, 20u16..200).prop_map(|(s, c, e)| Input::HeldJog {
             speed: s,
             cycles: c,
@@ -192,41 +202,6 @@ fn op_req(op: Operation) -> Request {
     Request {
         op: Some(op),
         ..Request::default()
-    }
-}
-
-/// A deceleration given as a fraction (negative) of what the machine
-/// allows becomes a number the engine accepts.
-fn resolve(op: Operation, max_decel: f64) -> Operation {
-    let d = |x: f64| if x < 0.0 { -x * max_decel } else { x };
-    match op {
-        Operation::Jog {
-            speed,
-            accel,
-            decel,
-            lease_ns,
-        } => Operation::Jog {
-            speed,
-            accel,
-            decel: d(decel),
-            lease_ns,
-        },
-        Operation::Move {
-            target,
-            relative,
-            speed,
-            accel,
-            decel,
-            supersede,
-        } => Operation::Move {
-            target,
-            relative,
-            speed,
-            accel,
-            decel: d(decel),
-            supersede,
-        },
-        op => op,
     }
 }
 
@@ -364,11 +339,7 @@ fn stream(r: &mut Rig, m: &Machine, cycles_per: u64, accels: &[f64], end: End) {
 fn play(m: &Machine, inputs: &[Input]) -> Result<(), String> {
     let mut r = Rig::new(m.config(), m.plant());
     r.idle(5);
-    let max_decel = if m.max_decel > 0.0 {
-        m.max_decel
-    } else {
-        m.home_decel
-    };
+    let max_decel = m.decel();
     let mut last_op = 0;
     for (i, input) in inputs.iter().enumerate() {
         match input {
@@ -380,7 +351,7 @@ fn play(m: &Machine, inputs: &[Input]) -> Result<(), String> {
                 // disable's power-off: an engine bug, reported; the
                 // monitor trips on it, 1021 / 5 — see `waiting.rs`)
                 if !(disabling && op == Operation::Stop) {
-                    r.step(op_req(resolve(op, max_decel)));
+                    r.step(op_req(op));
                 }
             }
             &Input::HeldJog {
@@ -433,7 +404,7 @@ fn cases() -> u32 {
     std::env::var("MONITOR_NORMAL_CASES")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(48)
+        .unwrap_or(96)
 }
 
 #[test]
@@ -444,11 +415,17 @@ fn the_monitor_never_trips_on_normal_homings_jogs_moves_and_streams() {
         ..Config::default()
     });
     runner
-        .run(&(machine(), inputs()), |(m, inputs)| {
-            let res = play(&m, &inputs);
-            prop_assert!(res.is_ok(), "{m:?}\n{}", res.unwrap_err());
-            Ok(())
-        })
+        .run(
+            &machine().prop_flat_map(|m| {
+                let d = m.decel();
+                (Just(m), inputs(d))
+            }),
+            |(m, inputs)| {
+                let res = play(&m, &inputs);
+                prop_assert!(res.is_ok(), "{m:?}\n{}", res.unwrap_err());
+                Ok(())
+            },
+        )
         .unwrap();
     let t: Vec<u64> = TALLY.iter().map(|a| a.load(Relaxed)).collect();
     eprintln!(

@@ -80,6 +80,18 @@ fn from(k: u64) -> Option<u64> {
     (k >= f).then(|| k - f + 1)
 }
 
+/// Enabled, homed, jogging at `speed` for `cycles`; the tamper starts
+/// with the next step, and that step is made.
+fn tampered_jog(speed: f64, cycles: u64, tamper: fn(u64, &mut Command)) -> Rig {
+    let mut r = ready(axis());
+    r.step(op(jog(speed, 500.0)));
+    r.idle(cycles);
+    start_tamper_at(r.k());
+    r.tamper = tamper;
+    r.step(Request::default());
+    r
+}
+
 /// The monitor's stop after a trip at step `at` from the last command it
 /// passed: the speed never rises, it is at rest within the time
 /// `max_deceleration` needs (plus a cycle), the power stage goes off once
@@ -118,17 +130,12 @@ fn stopped_by_the_monitor(r: &mut Rig, exerr: u16) {
 
 #[test]
 fn a_jog_commanded_faster_than_asked_trips_the_velocity_check() {
-    let mut r = ready(axis());
-    r.step(op(jog(5.0, 500.0)));
-    r.idle(100);
-    start_tamper_at(r.k());
-    r.tamper = |k, c| {
+    let mut r = tampered_jog(5.0, 100, |k, c| {
         if let Some(n) = from(k) {
             c.position += n as f64 * 0.002;
             c.velocity += 2.0;
         }
-    };
-    r.step(Request::default());
+    });
     let (_, trip) = r.tripped.expect("tripped");
     assert_eq!(trip.invariant, Invariant::Velocity);
     assert!(
@@ -146,16 +153,11 @@ fn a_jog_commanded_faster_than_asked_trips_the_velocity_check() {
 
 #[test]
 fn a_position_step_beyond_the_speed_bound_trips_the_step_check_and_reset_enables_nothing() {
-    let mut r = ready(axis());
-    r.step(op(jog(5.0, 500.0)));
-    r.idle(100);
-    start_tamper_at(r.k());
-    r.tamper = |k, c| {
+    let mut r = tampered_jog(5.0, 100, |k, c| {
         if let Some(n) = from(k) {
             c.position += n as f64 * 0.002;
         }
-    };
-    r.step(Request::default());
+    });
     let (_, trip) = r.tripped.expect("tripped");
     assert_eq!(trip.invariant, Invariant::Step);
     assert!((trip.value - 7.0).abs() < 1e-6, "{trip:?}");
@@ -307,16 +309,11 @@ fn a_disable_that_leaves_the_power_stage_on_at_rest_trips() {
 
 #[test]
 fn a_command_that_is_not_a_number_is_never_sent() {
-    let mut r = ready(axis());
-    r.step(op(jog(-5.0, 500.0)));
-    r.idle(30);
-    start_tamper_at(r.k());
-    r.tamper = |k, c| {
+    let mut r = tampered_jog(-5.0, 30, |k, c| {
         if from(k).is_some() {
             c.position = f64::NAN;
         }
-    };
-    r.step(Request::default());
+    });
     let (_, trip) = r.tripped.expect("tripped");
     assert_eq!(trip.invariant, Invariant::NotFinite);
     assert!(r.out.position.is_finite() && r.out.velocity.is_finite());
