@@ -7,8 +7,9 @@
 //! cycles (divided differences: a late cycle is judged over the time it
 //! really spanned). A sampled profile whose continuous speed and
 //! acceleration stay within their bounds has first differences within the
-//! speed bound and second divided differences within the acceleration
-//! bound, so the checks hold for every correct plan at any cycle timing.
+//! speed bound, and average velocities of consecutive intervals that differ
+//! by at most the acceleration bound × their mean length (≤ the longer
+//! one), so the checks hold for every correct plan at any cycle timing.
 
 use crate::bounds::{Bounds, Kind};
 use crate::envelope::Envelope;
@@ -260,13 +261,20 @@ impl Monitor {
             interval_bound * TOLERANCE + 2.0 * eps / h,
         )?;
         if let Some((v1, h1)) = self.hist.interval {
-            let acc = (v - v1) / (0.5 * (h + h1));
+            // The change of velocity between the two intervals, over the
+            // longer one: a sampled profile whose acceleration stays within
+            // the bound changes its average velocity by at most the bound ×
+            // the mean of the two intervals (× one cycle when they are
+            // equal), and a planner that allows the bound × the interval it
+            // plans (a late cycle is longer) passes too.
+            let hmax = h.max(h1);
+            let acc = (v - v1) / hmax;
             let bound = self.accel_bound(p0, v1, v, a);
             within(
                 Invariant::Acceleration,
                 acc.abs(),
                 bound,
-                bound * TOLERANCE + 4.0 * eps / (h * 0.5 * (h + h1)),
+                bound * TOLERANCE + 4.0 * eps / (h * hmax),
             )?;
         }
         Ok(Some((v, h)))
