@@ -66,4 +66,4 @@ mod trip;
 pub use events::Cycle;
 pub use gantry::{Apart, Side, Together};
 pub use monitor::{Monitor, POSITION_ROUNDING, TOLERANCE};
-pub use trip::{Category, Invariant, Trip};
+pub use trip::{Category, Invariant, Trip, Withdrawn};

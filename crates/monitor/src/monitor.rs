@@ -161,6 +161,7 @@ impl Monitor {
             invariant,
             value,
             bound,
+            withdrawn: None,
         };
         let decel = self.before.decel;
         self.trip(now_ns, command, self.following, broken, decel)
@@ -187,6 +188,7 @@ impl Monitor {
                 invariant: Invariant::NotFinite,
                 value: bad,
                 bound: f64::MAX,
+                withdrawn: None,
             });
         }
         let dt = self
@@ -329,6 +331,7 @@ impl Monitor {
             invariant: Invariant::SoftLimit,
             value: x,
             bound: if x > hi { hi } else { lo },
+            withdrawn: None,
         })
     }
 
@@ -361,6 +364,7 @@ impl Monitor {
                 Category::Stop0
             },
             from: p0,
+            withdrawn: broken.withdrawn,
         };
         self.trips = self.trips.wrapping_add(1);
         self.tripped = Some(Tripped {

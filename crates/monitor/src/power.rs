@@ -4,9 +4,10 @@
 //! The permission is given by an explicit request the engine accepted —
 //! enable, home, jog, move, stream — and withdrawn by what takes the power
 //! stage away: a drive fault that appears, a power stage the drive dropped
-//! while it was asked on (STO, a power return), a new I/O process (its
-//! drives were off or stopped by its watchdog in between), a drive its
-//! I/O process reports lost, a shutdown. A disable withdraws it once
+//! while it was asked on (STO, a power return; also one found off when a
+//! lost drive is back), a new I/O process (its drives were off or stopped
+//! by its watchdog in between), a drive its I/O process reports lost while
+//! an enable still waited for it, a shutdown. A disable withdraws it once
 //! the axis has had the time its stop needs (the speed bound has decayed to
 //! rest) and one more cycle: category 1, then off.
 //!
@@ -16,7 +17,7 @@
 //! shutdown is judged at once.
 
 use crate::events::Events;
-use crate::trip::{Broken, Invariant};
+use crate::trip::{Broken, Invariant, Withdrawn};
 use motion_homing::{Operation, Request};
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -27,6 +28,8 @@ pub(crate) struct Power {
     disabling: bool,
     /// Cycles the disabling axis has been at rest by the speed bound.
     rested: u8,
+    /// What took the permission away last.
+    why: Withdrawn,
 }
 
 impl Power {
@@ -50,8 +53,20 @@ impl Power {
         if ev.accepted == Some(Operation::Disable) {
             self.disabling = true;
         }
-        if ev.drive_fault || ev.dropped || ev.io_restarted || req.drive_lost || req.shutdown {
+        // A drive lost while its power stage was on is judged by what it
+        // reports when it is back (on, dropped, faulted); one lost while an
+        // enable still waited for it takes that enable away.
+        let was_on = ev.drive.is_some_and(|d| d.enabled && !d.fault);
+        let why = [
+            (ev.drive_fault, Withdrawn::DriveFault),
+            (ev.dropped, Withdrawn::PowerDropped),
+            (req.drive_lost && !was_on, Withdrawn::DriveLost),
+            (ev.io_restarted, Withdrawn::IoRestarted),
+            (req.shutdown, Withdrawn::Shutdown),
+        ];
+        if let Some(&(_, w)) = why.iter().find(|(happened, _)| *happened) {
             self.allowed = false;
+            self.why = w;
         }
     }
 
@@ -68,6 +83,7 @@ impl Power {
             // The disable is done: off until asked again.
             self.disabling = false;
             self.allowed = false;
+            self.why = Withdrawn::Disabled;
         }
         self.rested = if self.disabling && at_rest {
             self.rested.saturating_add(1)
@@ -75,12 +91,19 @@ impl Power {
             0
         };
         let present = ev.fresh && !req.drive_lost;
-        let refused = (present && !self.allowed) || req.shutdown || self.rested > 2;
-        if on && refused {
+        let withdrawn = if req.shutdown {
+            Some(Withdrawn::Shutdown)
+        } else if self.rested > 2 {
+            Some(Withdrawn::Disabled)
+        } else {
+            (present && !self.allowed).then_some(self.why)
+        };
+        if let (true, Some(w)) = (on, withdrawn) {
             return Err(Broken {
                 invariant: Invariant::Enable,
                 value: 1.0,
                 bound: 0.0,
+                withdrawn: Some(w),
             });
         }
         Ok(())

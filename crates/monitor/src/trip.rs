@@ -47,6 +47,37 @@ impl Invariant {
     }
 }
 
+/// Why the power stage was no longer allowed on (an `Enable` trip): what
+/// took the permission away last.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Withdrawn {
+    /// Nobody asked for it since the monitor started.
+    #[default]
+    NeverAsked = 0,
+    DriveFault = 1,
+    /// The drive switched its power stage off by itself (STO, a power
+    /// return).
+    PowerDropped = 2,
+    /// Its I/O process reports the drive lost.
+    DriveLost = 3,
+    /// A new I/O process took over.
+    IoRestarted = 4,
+    Shutdown = 5,
+    /// A disable, once its stop had had the time it needs.
+    Disabled = 6,
+}
+
+motion_homing::spellings!(Withdrawn {
+    NeverAsked => "never_asked",
+    DriveFault => "drive_fault",
+    PowerDropped => "power_stage_dropped",
+    DriveLost => "drive_lost",
+    IoRestarted => "io_restarted",
+    Shutdown => "shutdown",
+    Disabled => "disabled",
+});
+
 /// How the monitor stopped the axis (EN 60204-1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
@@ -71,6 +102,8 @@ pub struct Trip {
     pub category: Category,
     /// The last command the monitor passed (raw), where its stop starts.
     pub from: f64,
+    /// An `Enable` trip: what had taken the permission away.
+    pub withdrawn: Option<Withdrawn>,
 }
 
 impl Trip {
@@ -86,6 +119,7 @@ pub(crate) struct Broken {
     pub invariant: Invariant,
     pub value: f64,
     pub bound: f64,
+    pub withdrawn: Option<Withdrawn>,
 }
 
 /// `Err` with `invariant` when `value` is above `bound` by more than
@@ -103,6 +137,7 @@ pub(crate) fn within(
             invariant,
             value,
             bound,
+            withdrawn: None,
         })
     }
 }

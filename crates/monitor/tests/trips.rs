@@ -12,7 +12,7 @@ mod common;
 use common::{Rig, MS};
 use motion_homing::codes::*;
 use motion_homing::*;
-use motion_monitor::{Category, Invariant};
+use motion_monitor::{Category, Invariant, Withdrawn};
 use motion_plant::PlantConfig;
 use std::cell::Cell;
 
@@ -303,6 +303,7 @@ fn a_disable_that_leaves_the_power_stage_on_at_rest_trips() {
     r.idle(10);
     let (at, trip) = r.tripped.expect("tripped");
     assert_eq!(trip.invariant, Invariant::Enable);
+    assert_eq!(trip.withdrawn, Some(Withdrawn::Disabled));
     assert!(at <= FROM.with(Cell::get) + 16, "tripped at {at}");
     assert!(!r.out.enable);
 }

@@ -41,9 +41,10 @@ pub fn describe(t: &Trip, missed: u32) -> String {
     let (err, exerr) = t.code();
     let unit = t.invariant.unit();
     let what = match t.invariant {
-        motion_monitor::Invariant::Enable => "the power stage was asked on without a request \
-             since a fault, a dropped or lost drive, a shutdown or a disable"
-            .to_string(),
+        motion_monitor::Invariant::Enable => format!(
+            "the power stage was asked on without a request since it was taken away ({})",
+            t.withdrawn.unwrap_or_default()
+        ),
         motion_monitor::Invariant::NotFinite => {
             format!("a command that is not a number ({})", t.value)
         }
@@ -86,6 +87,7 @@ mod tests {
             at_ns: 1,
             category: Category::Stop1,
             from: 0.25,
+            withdrawn: None,
         };
         assert_eq!(
             describe(&t, 0),
@@ -95,8 +97,10 @@ mod tests {
         let e = Trip {
             invariant: Invariant::Enable,
             category: Category::Stop0,
+            withdrawn: Some(motion_monitor::Withdrawn::DriveFault),
             ..t
         };
+        assert!(describe(&e, 2).contains("since it was taken away (drive_fault)"));
         assert!(describe(&e, 2).contains("power stage off (category 0) at raw position 0.25"));
         assert!(describe(&e, 2).ends_with("(2 earlier trip(s) reset in between)"));
     }
