@@ -106,7 +106,7 @@
 //! | 1021 | 2     | *ours* monitor: commanded acceleration (second difference of the commanded positions over the cycle) above its bound (the operation's acceleration or deceleration, `stream_acceleration`, the homing accelerations; a stop at least `max_deceleration`) |
 //! | 1021 | 3     | *ours* monitor: a set-point step larger than the speed bound allows over the time since the last command |
 //! | 1021 | 4     | *ours* monitor: commanded position outside `travel_limits` while homed (linear axes), or further out than the command before it once outside |
-//! | 1021 | 5     | *ours* monitor: the power stage asked on after a drive fault, a dropped power stage, a lost drive, a shutdown, or a disable that had come to rest, without an explicit enable, home, jog, move or stream since |
+//! | 1021 | 5     | *ours* monitor: the power stage asked on after a drive fault, a dropped power stage, a lost drive an enable still waited for, a new I/O process, a shutdown, or a disable that had come to rest, without an explicit enable, home, jog, move or stream since |
 //! | 1021 | 6     | *ours* monitor: the sides of a gantry moved apart by more than `max_skew` from where they were at rest together |
 //! | 1021 | 7     | *ours* monitor: a command position or velocity not finite |
 
