@@ -271,35 +271,39 @@ impl Monitor {
             // plans (a late cycle is longer) passes too.
             let hmax = h.max(h1);
             let acc = (v - v1) / hmax;
-            let bound = self.accel_bound(p0, v1, v, a);
-            within(
-                Invariant::Acceleration,
-                acc.abs(),
-                bound,
-                bound * TOLERANCE + 4.0 * eps / (h * hmax),
-            )?;
+            let bound = self.accel_bound(a);
+            let slack = bound * TOLERANCE + 4.0 * eps / (h * hmax);
+            if acc.abs() > bound + slack && !self.braking_for_a_limit(p0, v1, v, bound) {
+                return Err(Broken {
+                    invariant: Invariant::Acceleration,
+                    value: acc.abs(),
+                    bound,
+                    withdrawn: None,
+                });
+            }
         }
         Ok(Some((v, h)))
     }
 
-    /// The acceleration allowed from velocity `v1` to `v2`: the largest
-    /// acceleration or deceleration of the plans followed in the window
-    /// (within two cycles a stop and a start in the other direction can
-    /// both fall into one second difference). A stop that brakes harder to
-    /// end on a soft limit it would otherwise pass is not bounded here (the
-    /// soft limit is): the engine's stops end on the limit, never beyond.
-    fn accel_bound(&self, p0: f64, v1: f64, v2: f64, a: Allowed) -> f64 {
-        let (b1, b2) = (self.before, self.before2);
-        let up = a.accel.max(b1.accel).max(b2.accel);
-        let down = a.decel.max(b1.decel).max(b2.decel);
+    /// The acceleration allowed now: the largest acceleration or
+    /// deceleration of the plans followed in the window (within two cycles
+    /// a stop and a start in the other direction can both fall into one
+    /// change of velocity).
+    fn accel_bound(&self, a: Allowed) -> f64 {
+        let most = |x: Allowed| x.accel.max(x.decel);
+        most(a).max(most(self.before)).max(most(self.before2))
+    }
+
+    /// A stop from `v1` to `v2` (same direction, slower) that brakes
+    /// harder than `bound` to end on the soft limit ahead, which braking at
+    /// `bound` would have passed: not bounded here (the soft limit is; the
+    /// engine's stops end on the limit, never beyond).
+    fn braking_for_a_limit(&self, p0: f64, v1: f64, v2: f64, bound: f64) -> bool {
         let braking = v1 * v2 >= 0.0 && v2.abs() < v1.abs();
-        let room = self
-            .limit_ahead(v1.signum())
-            .map(|l| (l - p0) * v1.signum());
-        match room {
-            Some(room) if braking && v1 * v1 > 2.0 * down * room => f64::INFINITY,
-            _ => up.max(down),
-        }
+        braking
+            && self
+                .limit_ahead(v1.signum())
+                .is_some_and(|l| v1 * v1 > 2.0 * bound * (l - p0) * v1.signum())
     }
 
     /// The soft limit in direction `dir` (raw), while homed on a linear

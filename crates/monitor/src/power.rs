@@ -57,14 +57,20 @@ impl Power {
         // reports when it is back (on, dropped, faulted); one lost while an
         // enable still waited for it takes that enable away.
         let was_on = ev.drive.is_some_and(|d| d.enabled && !d.fault);
-        let why = [
-            (ev.drive_fault, Withdrawn::DriveFault),
-            (ev.dropped, Withdrawn::PowerDropped),
-            (req.drive_lost && !was_on, Withdrawn::DriveLost),
-            (ev.io_restarted, Withdrawn::IoRestarted),
-            (req.shutdown, Withdrawn::Shutdown),
-        ];
-        if let Some(&(_, w)) = why.iter().find(|(happened, _)| *happened) {
+        let why = if ev.drive_fault {
+            Some(Withdrawn::DriveFault)
+        } else if ev.dropped {
+            Some(Withdrawn::PowerDropped)
+        } else if req.drive_lost && !was_on {
+            Some(Withdrawn::DriveLost)
+        } else if ev.io_restarted {
+            Some(Withdrawn::IoRestarted)
+        } else if req.shutdown {
+            Some(Withdrawn::Shutdown)
+        } else {
+            None
+        };
+        if let Some(w) = why {
             self.allowed = false;
             self.why = w;
         }
