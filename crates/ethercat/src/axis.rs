@@ -46,7 +46,13 @@
 //!   when it comes back.
 //! * **No data this cycle**: the outputs stay what they were (the state
 //!   machines are not stepped blind) and the feedback is the last good one
-//!   with `SW_NO_DATA`.
+//!   with `SW_NO_DATA` — but a stop (watchdog, emergency, disable, the
+//!   backend's fault) is sent all the same, on the last state seen and on
+//!   time alone (`blind_stop`): whatever the working counter says, the
+//!   stop reaches every drive that takes its outputs.
+//! * **Data back after a gap** of [`GAP_CYCLES`] or more: a command that
+//!   ran away meanwhile is not jumped to; the drive is held at its actual
+//!   position until the command comes back near it (`after_gap`).
 //! * **Objects the layout lacks**: without 0x606C the velocity is the
 //!   position's change per cycle; without 0x6077 the torque is 0; without
 //!   0x60FD no input is ever reported; without touch probes no latch.
@@ -71,6 +77,12 @@ pub const MAX_TARGET_DISTANCE: i64 = 1 << 30;
 /// its velocity), counts.
 pub const RESYNC_COUNTS: i64 = 16;
 
+/// Missing cycles after which data that returns is checked for a command
+/// that ran away ([`AxisLogic`]'s `after_gap`): one or two (a lost frame
+/// on a loaded host) only let the target catch up a cycle or two, as a
+/// repeated set-point does.
+pub const GAP_CYCLES: u32 = 3;
+
 /// What the caller wants from all axes this cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -87,6 +99,11 @@ pub enum Mode {
 pub struct AxisCounters {
     pub rejected_setpoints: u64,
     pub fault_resets: u64,
+    /// Returns of its data after a gap over which the command ran away:
+    /// the drive was held at its actual position instead of jumping.
+    pub resyncs: u64,
+    /// Cycles a stop was sent to the drive without its data (blind).
+    pub blind_stop_cycles: u64,
 }
 
 /// How one axis is set up.
@@ -137,7 +154,8 @@ pub struct AxisLogic {
     /// drive), cleared by a reset.
     fault_latch: bool,
     /// The command's target is not followed until it is near the actual
-    /// position again (after the drive's homing handed back).
+    /// position again (after the drive's homing handed back, or after a
+    /// gap in its data over which the command ran away).
     resync: bool,
     /// Its SubDevice was lost since the last valid inputs.
     was_lost: bool,
@@ -273,10 +291,12 @@ impl AxisLogic {
         }
         let Some(inp) = inputs else {
             self.since_inputs = self.since_inputs.saturating_add(1);
+            self.blind_stop(mode, enable);
             let mut fb = self.last_feedback;
             fb.status_word |= SW_NO_DATA;
             return (self.outputs, fb);
         };
+        let gap = self.since_inputs > GAP_CYCLES;
         let prev = self.pos64;
         let pos64 = self.extend(inp.position);
         let velocity = if self.layout.present.velocity {
@@ -298,11 +318,14 @@ impl AxisLogic {
             0
         };
         let at_rest = self.still >= REST_CYCLES;
-        let target = self.cia_target(mode, enable, at_rest);
+        let target = self.cia_target(mode, enable, at_rest, true);
         let home = self.drive_homing(cmd, mode, target, inp, at_rest);
         let mut controlword = self.cia.step(inp.statusword, target);
         if self.state.is_enabled() && target == Target::Enabled {
             controlword |= home.controlword;
+        }
+        if gap {
+            self.after_gap(cmd);
         }
         let target_position =
             self.target_position(cmd, target, set.target_ok, pos64, inp, home.hold_actual);
@@ -342,6 +365,58 @@ impl AxisLogic {
         self.last_reset = reset;
     }
 
+    /// No data this cycle: the outputs stay what they were (the state
+    /// machines are not stepped blind) — unless a stop is wanted. A stop
+    /// (the watchdog's, the emergency stop, a disable, the backend's own
+    /// fault) is sent whether or not the data came back: a working counter
+    /// that cannot be trusted, or frames lost, must not keep a drive
+    /// powered. Stepped on the last state seen and on time alone
+    /// ([`Stopper::step_blind`]): quick stop until the bound, then (the
+    /// brake's delay and) disable voltage; from Operation enabled a
+    /// disable is "shutdown". Nothing is concluded from it: the axis
+    /// counts as stopped only once its data shows it.
+    fn blind_stop(&mut self, mode: Mode, enable: bool) {
+        if mode == Mode::Normal && enable && !self.fault_latch {
+            return;
+        }
+        let target = self.cia_target(mode, enable, false, false);
+        self.outputs.controlword = self.cia.step(self.state.statusword(), target);
+        self.counters.blind_stop_cycles += 1;
+    }
+
+    /// The data came back after a gap of [`GAP_CYCLES`] or more: the drive
+    /// held the last target it got meanwhile. If the command moved on
+    /// further than catching up in one cycle allows (more than
+    /// [`RESYNC_COUNTS`] + four cycles of its velocity from that target), it
+    /// is not jumped to — a 30 ms gap at 20 units/s would be 0.6 units in
+    /// one cycle: the drive is held at its actual position until the
+    /// command comes back near it. The supervisor plans from the drive's
+    /// position again when it does: a gap that long is a loss of feedback
+    /// to its engine, which aborts the motion, and an enable starts from the
+    /// actual position.
+    fn after_gap(&mut self, cmd: &AxisCommand) {
+        if self.resync || cmd.target_position == INVALID_COUNTS {
+            return;
+        }
+        // the wire's targets are 32-bit: the step modulo 2^32
+        let step = (cmd.target_position as i32).wrapping_sub(self.outputs.target_position);
+        if (f64::from(step)).abs() > self.resync_window(cmd) {
+            self.resync = true;
+            self.counters.resyncs += 1;
+        }
+    }
+
+    /// How near the command's target must be to be followed (again):
+    /// [`RESYNC_COUNTS`] plus four cycles of the command's velocity.
+    fn resync_window(&self, cmd: &AxisCommand) -> f64 {
+        let v = if cmd.target_velocity.is_finite() {
+            cmd.target_velocity.abs()
+        } else {
+            0.0
+        };
+        RESYNC_COUNTS as f64 + v * 4.0 * self.cycle_s
+    }
+
     /// The set-point this cycle: the command's while following, the last
     /// good one after a refusal, else (and while the drive homes, or until
     /// the command has caught up after it) the actual position.
@@ -362,7 +437,7 @@ impl AxisLogic {
             return inp.position;
         }
         if self.resync {
-            let window = RESYNC_COUNTS as f64 + cmd.target_velocity.abs() * 4.0 * self.cycle_s;
+            let window = self.resync_window(cmd);
             let near = ((cmd.target_position - pos64) as f64).abs() <= window;
             if !(target_ok && near) {
                 return inp.position;
@@ -449,7 +524,16 @@ impl AxisLogic {
     }
 
     /// Where the CiA 402 machine walks the drive this cycle.
-    fn cia_target(&mut self, mode: Mode, enable: bool, at_rest: bool) -> Target {
+    /// (`seen`: from this cycle's data; else blind, see
+    /// [`blind_stop`](Self::blind_stop)).
+    fn cia_target(&mut self, mode: Mode, enable: bool, at_rest: bool, seen: bool) -> Target {
+        let stop = |s: &mut Stopper, state: State| {
+            if seen {
+                s.step(state, at_rest)
+            } else {
+                s.step_blind(state)
+            }
+        };
         match mode {
             Mode::Normal if enable && !self.fault_latch => {
                 self.stopper.reset();
@@ -457,13 +541,13 @@ impl AxisLogic {
             }
             // a refused set-point (or a drive back after a loss) while
             // enabled: the bounded stop
-            Mode::Normal if self.fault_latch => self.stopper.step(self.state, at_rest),
+            Mode::Normal if self.fault_latch => stop(&mut self.stopper, self.state),
             Mode::Normal => {
                 self.stopper.reset();
                 Target::Disabled
             }
             Mode::WatchdogStop => {
-                let t = self.stopper.step(self.state, at_rest);
+                let t = stop(&mut self.stopper, self.state);
                 if t == Target::Off && self.last_enable {
                     self.fault_latch = true;
                 }

@@ -304,6 +304,117 @@ fn no_data_keeps_outputs_and_reports_last_values() {
 }
 
 #[test]
+fn a_stop_without_data_is_sent_blind_on_time_alone() {
+    // quick stop bound 20 ms at 1 ms: enabled and moving, then no data
+    let mut a = AxisLogic::new(AxisSetup {
+        quick_stop_ms: 20,
+        ..AxisSetup::new(
+            PdoLayout::standard(TorqueLimits::PerDirection, false),
+            0.001,
+        )
+    });
+    let (o, _) = a.step(
+        &cmd(true, 100),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 90)),
+    );
+    assert_eq!(o.controlword, 0x000F);
+    // enabled and following: nothing is stepped blind
+    let (o, _) = a.step(&cmd(true, 120), Mode::Normal, None);
+    assert_eq!((o.controlword, o.target_position), (0x000F, 100));
+    // the watchdog stop: quick stop until the bound (never judged ignored
+    // without data), then disable voltage, the target held
+    let words: Vec<u16> = (0..22)
+        .map(|_| a.step(&cmd(true, 120), Mode::WatchdogStop, None).0)
+        .map(|o| {
+            assert_eq!(o.target_position, 100);
+            o.controlword
+        })
+        .collect();
+    assert!(words[..20].iter().all(|w| *w == 0x0002), "{words:?}");
+    assert_eq!(&words[20..], &[0x0000, 0x0000]);
+    assert_eq!(a.counters.blind_stop_cycles, 22);
+    // not counted as stopped: its state was not seen
+    assert!(!a.at_rest_and_disabled());
+    // data again: Switch on disabled seen, the stop complete, a fault
+    let (o, fb) = a.step(
+        &cmd(true, 120),
+        Mode::WatchdogStop,
+        Some(&inputs(State::SwitchOnDisabled, 95)),
+    );
+    assert_eq!(o.controlword, 0x0000);
+    assert!(a.at_rest_and_disabled());
+    assert_eq!(fb.status_word & (SW_ENABLED | SW_FAULT), SW_FAULT);
+
+    // a disable without data: "shutdown" at once; the emergency stop:
+    // disable voltage at once
+    for (mode, enable, word) in [
+        (Mode::Normal, false, 0x0006),
+        (Mode::Emergency, true, 0x0000),
+    ] {
+        let mut a = logic();
+        a.step(
+            &cmd(true, 0),
+            Mode::Normal,
+            Some(&inputs(State::OperationEnabled, 0)),
+        );
+        let (o, _) = a.step(&cmd(enable, 0), mode, None);
+        assert_eq!(o.controlword, word, "{mode:?}");
+    }
+}
+
+#[test]
+fn data_back_after_a_gap_never_jumps_to_a_command_that_ran_away() {
+    let mut a = logic();
+    let fast = |t: i64| AxisCommand {
+        target_velocity: 20_000.0, // 20 counts per cycle
+        ..cmd(true, t)
+    };
+    for k in 0..5 {
+        let (o, _) = a.step(
+            &fast(1000 + 20 * k),
+            Mode::Normal,
+            Some(&inputs(State::OperationEnabled, (980 + 20 * k) as i32)),
+        );
+        assert_eq!(o.target_position, (1000 + 20 * k) as i32);
+    }
+    // two cycles lost: caught up (three cycles' travel in one)
+    a.step(&fast(1100), Mode::Normal, None);
+    a.step(&fast(1120), Mode::Normal, None);
+    let (o, _) = a.step(
+        &fast(1140),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1070)),
+    );
+    assert_eq!(o.target_position, 1140);
+    assert_eq!(a.counters.resyncs, 0);
+    // 30 cycles lost while the command runs on: held where the drive is
+    for k in 1..=30 {
+        a.step(&fast(1140 + 20 * k), Mode::Normal, None);
+    }
+    let (o, _) = a.step(
+        &fast(1760),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1140)),
+    );
+    assert_eq!(o.target_position, 1140, "not 620 counts in one cycle");
+    assert_eq!(a.counters.resyncs, 1);
+    let (o, _) = a.step(
+        &fast(1780),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1140)),
+    );
+    assert_eq!(o.target_position, 1140);
+    // the command planned from the drive's position: followed again
+    let (o, _) = a.step(
+        &fast(1160),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1140)),
+    );
+    assert_eq!(o.target_position, 1160);
+}
+
+#[test]
 fn tolerance_becomes_the_following_error_window() {
     let mut a = logic();
     let mut c = cmd(true, 0);

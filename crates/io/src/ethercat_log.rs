@@ -60,8 +60,8 @@ pub fn summary(interface: &str, st: &BusStatus) -> String {
     format!(
         "EtherCAT on {interface}: {} bus cycles, {} lost frame(s), {} late, {} working-counter \
          error(s), {} overrun(s), {} recovery(ies), {} drive loss(es), {} back in OP, {} \
-         re-configured after a power cycle, {} SubDevice(s) needing a restart; bus round trip \
-         (frame out → inputs back): {}",
+         re-configured after a power cycle, {} SubDevice(s) needing a restart, {} stop(s) by \
+         the bus thread's own watchdog; bus round trip (frame out → inputs back): {}",
         st.cycles,
         st.lost_frames,
         st.late_frames,
@@ -72,6 +72,7 @@ pub fn summary(interface: &str, st: &BusStatus) -> String {
         st.returns,
         st.reconfigured,
         st.needs_restart,
+        st.bus_watchdog_trips,
         st.roundtrip
     )
 }
