@@ -26,8 +26,8 @@ pub mod od;
 pub mod sii;
 
 pub use chain::{Chain, Emulator, EmulatorConfig, SubDeviceView};
-pub use esc::{al, Dropped};
 pub use drive::{
     DriveConfig, DriveView, ModeDisplay, PdoProfile, State, TorqueObjects, SUPPORTED_METHODS,
 };
+pub use esc::{al, Dropped};
 pub use netns::{Skip, VethPair};

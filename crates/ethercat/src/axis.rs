@@ -44,15 +44,18 @@
 //! * **A lost drive** ([`AxisLogic::lost`]): the backend latches a fault
 //!   for an axis that was enabled, so the drive is not re-enabled by itself
 //!   when it comes back.
-//! * **No data this cycle**: the outputs stay what they were (the state
-//!   machines are not stepped blind) and the feedback is the last good one
-//!   with `SW_NO_DATA` — but a stop (watchdog, emergency, disable, the
+//! * **No data this cycle**: the state machines are not stepped blind and
+//!   the feedback is the last good one with `SW_NO_DATA`; a drive that was
+//!   following goes on getting the command's target (its outputs may well
+//!   arrive: a working counter that cannot be trusted), other outputs stay
+//!   what they were — but a stop (watchdog, emergency, disable, the
 //!   backend's fault) is sent all the same, on the last state seen and on
-//!   time alone (`blind_stop`): whatever the working counter says, the
-//!   stop reaches every drive that takes its outputs.
-//! * **Data back after a gap** of [`GAP_CYCLES`] or more: a command that
-//!   ran away meanwhile is not jumped to; the drive is held at its actual
-//!   position until the command comes back near it (`after_gap`).
+//!   time alone (`blind`): whatever the working counter says, the stop
+//!   reaches every drive that takes its outputs.
+//! * **Data back after a loss** of [`GAP_CYCLES`] or more cycles, the
+//!   drive still enabled but its command run away from the last target it
+//!   got: never jumped there — its target is its actual position and it
+//!   gets the backend's fault, the bounded stop (`after_gap`).
 //! * **Objects the layout lacks**: without 0x606C the velocity is the
 //!   position's change per cycle; without 0x6077 the torque is 0; without
 //!   0x60FD no input is ever reported; without touch probes no latch.
@@ -100,8 +103,8 @@ pub struct AxisCounters {
     pub rejected_setpoints: u64,
     pub fault_resets: u64,
     /// Returns of its data after a gap over which the command ran away:
-    /// the drive was held at its actual position instead of jumping.
-    pub resyncs: u64,
+    /// the drive was stopped where it stood instead of jumping.
+    pub gap_stops: u64,
     /// Cycles a stop was sent to the drive without its data (blind).
     pub blind_stop_cycles: u64,
 }
@@ -154,8 +157,7 @@ pub struct AxisLogic {
     /// drive), cleared by a reset.
     fault_latch: bool,
     /// The command's target is not followed until it is near the actual
-    /// position again (after the drive's homing handed back, or after a
-    /// gap in its data over which the command ran away).
+    /// position again (after the drive's homing handed back).
     resync: bool,
     /// Its SubDevice was lost since the last valid inputs.
     was_lost: bool,
@@ -291,7 +293,7 @@ impl AxisLogic {
         }
         let Some(inp) = inputs else {
             self.since_inputs = self.since_inputs.saturating_add(1);
-            self.blind_stop(mode, enable);
+            self.blind(cmd, mode, enable);
             let mut fb = self.last_feedback;
             fb.status_word |= SW_NO_DATA;
             return (self.outputs, fb);
@@ -318,14 +320,14 @@ impl AxisLogic {
             0
         };
         let at_rest = self.still >= REST_CYCLES;
+        if gap && mode == Mode::Normal {
+            self.after_gap(cmd);
+        }
         let target = self.cia_target(mode, enable, at_rest, true);
         let home = self.drive_homing(cmd, mode, target, inp, at_rest);
         let mut controlword = self.cia.step(inp.statusword, target);
         if self.state.is_enabled() && target == Target::Enabled {
             controlword |= home.controlword;
-        }
-        if gap {
-            self.after_gap(cmd);
         }
         let target_position =
             self.target_position(cmd, target, set.target_ok, pos64, inp, home.hold_actual);
@@ -365,18 +367,34 @@ impl AxisLogic {
         self.last_reset = reset;
     }
 
-    /// No data this cycle: the outputs stay what they were (the state
-    /// machines are not stepped blind) — unless a stop is wanted. A stop
-    /// (the watchdog's, the emergency stop, a disable, the backend's own
-    /// fault) is sent whether or not the data came back: a working counter
-    /// that cannot be trusted, or frames lost, must not keep a drive
-    /// powered. Stepped on the last state seen and on time alone
-    /// ([`Stopper::step_blind`]): quick stop until the bound, then (the
-    /// brake's delay and) disable voltage; from Operation enabled a
-    /// disable is "shutdown". Nothing is concluded from it: the axis
-    /// counts as stopped only once its data shows it.
-    fn blind_stop(&mut self, mode: Mode, enable: bool) {
+    /// No data this cycle (the state machines are not stepped blind).
+    ///
+    /// * A drive that was following in Operation enabled goes on getting
+    ///   the command's target: its data is missing, not necessarily its
+    ///   outputs (a working counter that cannot be trusted), and the
+    ///   supervisor goes on commanding through a short loss of feedback.
+    /// * A stop (the watchdog's, the emergency stop, a disable, the
+    ///   backend's own fault) is sent whatever the working counter says:
+    ///   stepped on the last state seen and on time alone
+    ///   ([`Stopper::step_blind`]) — quick stop until the bound, then (the
+    ///   brake's delay and) disable voltage; from Operation enabled a
+    ///   disable is "shutdown". Nothing is concluded from it: the axis
+    ///   counts as stopped only once its data shows it.
+    /// * Otherwise the outputs stay what they were.
+    fn blind(&mut self, cmd: &AxisCommand, mode: Mode, enable: bool) {
         if mode == Mode::Normal && enable && !self.fault_latch {
+            let following =
+                self.state.is_enabled() && !self.resync && self.outputs.mode == MODE_CSP;
+            let plausible = self.pos64.is_some_and(|p| {
+                cmd.target_position != INVALID_COUNTS
+                    && cmd
+                        .target_position
+                        .checked_sub(p)
+                        .is_some_and(|d| d.abs() <= MAX_TARGET_DISTANCE)
+            });
+            if following && plausible {
+                self.outputs.target_position = cmd.target_position as i32;
+            }
             return;
         }
         let target = self.cia_target(mode, enable, false, false);
@@ -384,25 +402,27 @@ impl AxisLogic {
         self.counters.blind_stop_cycles += 1;
     }
 
-    /// The data came back after a gap of [`GAP_CYCLES`] or more: the drive
-    /// held the last target it got meanwhile. If the command moved on
-    /// further than catching up in one cycle allows (more than
-    /// [`RESYNC_COUNTS`] + four cycles of its velocity from that target), it
-    /// is not jumped to — a 30 ms gap at 20 units/s would be 0.6 units in
-    /// one cycle: the drive is held at its actual position until the
-    /// command comes back near it. The supervisor plans from the drive's
-    /// position again when it does: a gap that long is a loss of feedback
-    /// to its engine, which aborts the motion, and an enable starts from the
-    /// actual position.
+    /// The data came back after a gap of [`GAP_CYCLES`] or more with the
+    /// drive still in Operation enabled, and the last target it got lies
+    /// further from the command's than catching up in one cycle allows
+    /// ([`RESYNC_COUNTS`] + four cycles of its velocity): it was lost
+    /// (its outputs frozen) while the command ran on — a 30 ms loss at 20
+    /// units/s would be 0.6 units in one cycle. It is never jumped there:
+    /// its target is its actual position and it gets the backend's fault
+    /// (the bounded stop, then disabled). The supervisor, whose engine took
+    /// the loss as one, enables it again from where it stands after a
+    /// reset. (A drive that did not ride the loss out in Operation enabled
+    /// follows its actual position anyway and gets the fault of a lost
+    /// drive: [`AxisLogic::lost`].)
     fn after_gap(&mut self, cmd: &AxisCommand) {
-        if self.resync || cmd.target_position == INVALID_COUNTS {
+        if !self.state.is_enabled() || self.resync || cmd.target_position == INVALID_COUNTS {
             return;
         }
         // the wire's targets are 32-bit: the step modulo 2^32
         let step = (cmd.target_position as i32).wrapping_sub(self.outputs.target_position);
-        if (f64::from(step)).abs() > self.resync_window(cmd) {
-            self.resync = true;
-            self.counters.resyncs += 1;
+        if f64::from(step).abs() > self.resync_window(cmd) {
+            self.fault_latch = true;
+            self.counters.gap_stops += 1;
         }
     }
 

@@ -297,8 +297,15 @@ fn no_data_keeps_outputs_and_reports_last_values() {
     let (o1, fb1) = a.step(&cmd(true, 42), Mode::Normal, Some(&i));
     assert_eq!(fb1.digital_inputs, DI_HOME_SWITCH | DI_MARKER_PULSE);
     assert_eq!(fb1.torque, -12.5);
+    // enabled and following: the target goes on, the rest stays
     let (o2, fb2) = a.step(&cmd(true, 99), Mode::Normal, None);
-    assert_eq!(o2, o1);
+    assert_eq!(
+        o2,
+        DriveOutputs {
+            target_position: 99,
+            ..o1
+        }
+    );
     assert_eq!(fb2.status_word, fb1.status_word | SW_NO_DATA);
     assert_eq!(fb2.position, 42);
 }
@@ -319,15 +326,16 @@ fn a_stop_without_data_is_sent_blind_on_time_alone() {
         Some(&inputs(State::OperationEnabled, 90)),
     );
     assert_eq!(o.controlword, 0x000F);
-    // enabled and following: nothing is stepped blind
+    // enabled and following: the target goes on, the state machine is not
+    // stepped blind
     let (o, _) = a.step(&cmd(true, 120), Mode::Normal, None);
-    assert_eq!((o.controlword, o.target_position), (0x000F, 100));
+    assert_eq!((o.controlword, o.target_position), (0x000F, 120));
     // the watchdog stop: quick stop until the bound (never judged ignored
     // without data), then disable voltage, the target held
     let words: Vec<u16> = (0..22)
-        .map(|_| a.step(&cmd(true, 120), Mode::WatchdogStop, None).0)
+        .map(|_| a.step(&cmd(true, 140), Mode::WatchdogStop, None).0)
         .map(|o| {
-            assert_eq!(o.target_position, 100);
+            assert_eq!(o.target_position, 120);
             o.controlword
         })
         .collect();
@@ -364,7 +372,7 @@ fn a_stop_without_data_is_sent_blind_on_time_alone() {
 }
 
 #[test]
-fn data_back_after_a_gap_never_jumps_to_a_command_that_ran_away() {
+fn without_data_a_following_drive_gets_the_command_and_after_a_loss_never_a_jump() {
     let mut a = logic();
     let fast = |t: i64| AxisCommand {
         target_velocity: 20_000.0, // 20 counts per cycle
@@ -378,40 +386,57 @@ fn data_back_after_a_gap_never_jumps_to_a_command_that_ran_away() {
         );
         assert_eq!(o.target_position, (1000 + 20 * k) as i32);
     }
-    // two cycles lost: caught up (three cycles' travel in one)
-    a.step(&fast(1100), Mode::Normal, None);
-    a.step(&fast(1120), Mode::Normal, None);
-    let (o, _) = a.step(
-        &fast(1140),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 1070)),
-    );
-    assert_eq!(o.target_position, 1140);
-    assert_eq!(a.counters.resyncs, 0);
-    // 30 cycles lost while the command runs on: held where the drive is
-    for k in 1..=30 {
-        a.step(&fast(1140 + 20 * k), Mode::Normal, None);
+    // no data (a working counter not to be trusted): the command's target
+    // goes on out, the controlword stays
+    for k in 5..35 {
+        let (o, fb) = a.step(&fast(1000 + 20 * k), Mode::Normal, None);
+        assert_eq!(
+            (o.target_position, o.controlword),
+            ((1000 + 20 * k) as i32, 0x000F)
+        );
+        assert_ne!(fb.status_word & SW_NO_DATA, 0);
     }
-    let (o, _) = a.step(
-        &fast(1760),
+    let (o, fb) = a.step(
+        &fast(1700),
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 1140)),
+        Some(&inputs(State::OperationEnabled, 1660)),
     );
-    assert_eq!(o.target_position, 1140, "not 620 counts in one cycle");
-    assert_eq!(a.counters.resyncs, 1);
-    let (o, _) = a.step(
-        &fast(1780),
+    assert_eq!(o.target_position, 1700);
+    assert_eq!(fb.status_word & SW_FAULT, 0);
+    // lost for 30 cycles (its outputs frozen) while the command ran on,
+    // back still in Operation enabled: not 600 counts in one cycle — its
+    // actual position, the backend's fault, the bounded stop
+    for k in 1..=30 {
+        a.lost();
+        let (o, _) = a.step(&fast(1700 + 20 * k), Mode::Normal, None);
+        assert_eq!(o.target_position, 1700, "frozen while lost");
+    }
+    let (o, fb) = a.step(
+        &fast(2320),
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 1140)),
+        Some(&inputs(State::OperationEnabled, 1700)),
     );
-    assert_eq!(o.target_position, 1140);
-    // the command planned from the drive's position: followed again
-    let (o, _) = a.step(
-        &fast(1160),
+    assert_eq!(o.target_position, 1700, "never 620 counts in one cycle");
+    assert_eq!(o.controlword, 0x0002, "quick stop");
+    assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
+    assert_eq!(a.counters.gap_stops, 1);
+    // a loss of two cycles only catches up: no fault
+    let mut a = logic();
+    a.step(
+        &fast(1000),
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 1140)),
+        Some(&inputs(State::OperationEnabled, 1000)),
     );
-    assert_eq!(o.target_position, 1160);
+    for t in [1020, 1040, 1060] {
+        a.lost();
+        a.step(&fast(t), Mode::Normal, None);
+    }
+    let (o, fb) = a.step(
+        &fast(1080),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1000)),
+    );
+    assert_eq!((o.target_position, fb.status_word & SW_FAULT), (1080, 0));
 }
 
 #[test]

@@ -359,7 +359,7 @@ impl Engine {
             }
             let (a, c) = (&sh.axis[k], &self.axes[k].counters);
             a.rejected.store(c.rejected_setpoints, Ordering::Relaxed);
-            a.resyncs.store(c.resyncs, Ordering::Relaxed);
+            a.gap_stops.store(c.gap_stops, Ordering::Relaxed);
             a.blind_stop_cycles
                 .store(c.blind_stop_cycles, Ordering::Relaxed);
             words::put_feedback(&mut self.fb_words, k, &fb);

@@ -80,7 +80,7 @@ pub(crate) struct AxisAtomics {
     pub stale: AtomicU64,
     pub rejected: AtomicU64,
     pub window_writes: AtomicU64,
-    pub resyncs: AtomicU64,
+    pub gap_stops: AtomicU64,
     pub blind_stop_cycles: AtomicU64,
 }
 
@@ -138,7 +138,7 @@ impl Shared {
                     stale: AtomicU64::new(0),
                     rejected: AtomicU64::new(0),
                     window_writes: AtomicU64::new(0),
-                    resyncs: AtomicU64::new(0),
+                    gap_stops: AtomicU64::new(0),
                     blind_stop_cycles: AtomicU64::new(0),
                 })
                 .collect(),
@@ -244,7 +244,7 @@ impl Shared {
                     no_data_stale: l(&a.stale),
                     rejected_setpoints: l(&a.rejected),
                     following_window_writes: l(&a.window_writes),
-                    resyncs: l(&a.resyncs),
+                    gap_stops: l(&a.gap_stops),
                     blind_stop_cycles: l(&a.blind_stop_cycles),
                 })
                 .collect(),
@@ -317,9 +317,10 @@ pub struct AxisStatus {
     pub rejected_setpoints: u64,
     /// SDO writes of 0x6065 (following error window) done.
     pub following_window_writes: u64,
-    /// Its data came back after a gap over which the command ran away: the
-    /// drive was held at its actual position, not jumped.
-    pub resyncs: u64,
+    /// Its data came back after a loss over which the command ran away:
+    /// the drive was stopped where it stood (the backend's fault), never
+    /// jumped.
+    pub gap_stops: u64,
     /// Cycles a stop was sent to its drive without its data.
     pub blind_stop_cycles: u64,
 }

@@ -61,7 +61,8 @@ pub fn summary(interface: &str, st: &BusStatus) -> String {
         "EtherCAT on {interface}: {} bus cycles, {} lost frame(s), {} late, {} working-counter \
          error(s), {} overrun(s), {} recovery(ies), {} drive loss(es), {} back in OP, {} \
          re-configured after a power cycle, {} SubDevice(s) needing a restart, {} stop(s) by \
-         the bus thread's own watchdog; bus round trip (frame out → inputs back): {}",
+         the bus thread's own watchdog, {} drive(s) stopped after a loss over which their command ran away; bus round \
+         trip (frame out → inputs back): {}",
         st.cycles,
         st.lost_frames,
         st.late_frames,
@@ -73,6 +74,7 @@ pub fn summary(interface: &str, st: &BusStatus) -> String {
         st.reconfigured,
         st.needs_restart,
         st.bus_watchdog_trips,
+        st.axes.iter().map(|a| a.gap_stops).sum::<u64>(),
         st.roundtrip
     )
 }

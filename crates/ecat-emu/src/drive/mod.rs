@@ -196,7 +196,10 @@ impl Drive {
 
     /// The targets recorded so far; the record starts empty again.
     pub fn take_targets(&mut self) -> Vec<i32> {
-        self.targets.as_mut().map(std::mem::take).unwrap_or_default()
+        self.targets
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
     }
 
     /// Wall-time step without process data: advances a running ramp only.
