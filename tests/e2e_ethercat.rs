@@ -582,9 +582,8 @@ fn a_drive_short_on_process_data_leaves_the_others_served() {
     assert_clean(&b.cfg.prefix);
 }
 
-/// R and S seeking (`tests/machines/unplug.toml`); the supervisor is
-/// killed and S's drive falls to SAFE-OP (AL error, OP refused) at the same
-/// moment: motion-io's watchdog stop must still reach R's and T's drives,
+/// R seeking (`tests/machines/unplug.toml`); the supervisor is killed and
+/// S's drive falls to SAFE-OP (AL error, OP refused) at the same moment: motion-io's watchdog stop must still reach R's and T's drives,
 /// which end in Switch on disabled within the stop's bound (50 ms of
 /// watchdog + 500 ms of quick stop at most), S's by its own reaction.
 #[test]
@@ -593,14 +592,12 @@ fn a_drive_short_on_process_data_killed_supervisor_the_others_switch_off_within_
     let Some(b) = family("unplug") else {
         return;
     };
+    // (home order: R first, S and T after it)
     let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
     assert!(
-        wait_for(Duration::from_secs(30), || {
-            b.drive(0).drive.velocity > 5.0 && b.drive(1).drive.velocity > 5.0
-        }),
-        "R and S never both seeking: {:?} {:?}\n{}",
+        wait_for(Duration::from_secs(30), || b.drive(0).drive.velocity > 5.0),
+        "R never seeking: {:?}\n{}",
         b.drive(0),
-        b.drive(1),
         w.stderr()
     );
     let emu = b.rig.emulator();

@@ -411,17 +411,24 @@ impl Emulator {
     /// (`false`: stops and forgets them).
     pub fn record_targets(&self, position: usize, on: bool) {
         if let Some(e) = self.chain().escs.get_mut(position) {
-            e.drive.record_targets(on);
+            e.targets = on.then(Vec::new);
         }
     }
 
     /// The targets drive `position` recorded so far (taken: the record
     /// starts empty again).
     pub fn take_targets(&self, position: usize) -> Vec<i32> {
+        let timed = self.take_timed_targets(position);
+        timed.into_iter().map(|(t, _)| t).collect()
+    }
+
+    /// The targets drive `position` recorded so far with when their frames
+    /// passed (taken: the record starts empty again).
+    pub fn take_timed_targets(&self, position: usize) -> Vec<(i32, Instant)> {
         self.chain()
             .escs
             .get_mut(position)
-            .map(|e| e.drive.take_targets())
+            .and_then(|e| e.targets.as_mut().map(std::mem::take))
             .unwrap_or_default()
     }
 

@@ -139,6 +139,10 @@ pub struct Esc {
     pub op_refused: Option<u16>,
     /// Clock drift, parts per million (the drive's `clock_ppm`).
     clock_ppm: f64,
+    /// While recording: the target position (0x607A) of every frame whose
+    /// outputs the drive took in cyclic synchronous position mode, and
+    /// when the frame passed.
+    pub targets: Option<Vec<(i32, Instant)>>,
     pub stats: EscStats,
 }
 
@@ -198,6 +202,7 @@ impl Esc {
             out_sm_off: false,
             op_refused: None,
             clock_ppm,
+            targets: None,
             stats: EscStats::default(),
         };
         e.reset_registers();
@@ -604,6 +609,9 @@ impl Esc {
                 let sm2 = self.sm(2);
                 let out = self.mem[usize::from(sm2.start)..sm2.end()].to_vec();
                 self.drive.apply_outputs(&out);
+                if let (Some(t), 8) = (&mut self.targets, self.drive.mode()) {
+                    t.push((self.drive.od.get_signed(0x607A, 0) as i32, now));
+                }
             }
             self.drive.cycle(valid);
             self.write_inputs();

@@ -52,10 +52,11 @@
 //!   backend's fault) is sent all the same, on the last state seen and on
 //!   time alone (`blind`): whatever the working counter says, the stop
 //!   reaches every drive that takes its outputs.
-//! * **Data back after a loss** of [`GAP_CYCLES`] or more cycles, the
-//!   drive still enabled but its command run away from the last target it
-//!   got: never jumped there — its target is its actual position and it
-//!   gets the backend's fault, the bounded stop (`after_gap`).
+//! * **Data back after a loss** longer than the supervisor's feedback
+//!   timeout (its engine aborted the motion meanwhile), the drive still
+//!   enabled but its command run away from the last target it got: never
+//!   jumped there — its target is its actual position and it gets the
+//!   backend's fault, the bounded stop (`after_gap`).
 //! * **Objects the layout lacks**: without 0x606C the velocity is the
 //!   position's change per cycle; without 0x6077 the torque is 0; without
 //!   0x60FD no input is ever reported; without touch probes no latch.
@@ -80,10 +81,8 @@ pub const MAX_TARGET_DISTANCE: i64 = 1 << 30;
 /// its velocity), counts.
 pub const RESYNC_COUNTS: i64 = 16;
 
-/// Missing cycles after which data that returns is checked for a command
-/// that ran away ([`AxisLogic`]'s `after_gap`): one or two (a lost frame
-/// on a loaded host) only let the target catch up a cycle or two, as a
-/// repeated set-point does.
+/// The fewest missing cycles after which data that returns is checked for
+/// a command that ran away ([`AxisSetup::gap_cycles`]).
 pub const GAP_CYCLES: u32 = 3;
 
 /// What the caller wants from all axes this cycle.
@@ -124,6 +123,9 @@ pub struct AxisSetup {
     pub brake_ms: u32,
     /// The drive homes the axis itself when asked.
     pub drive_homing: bool,
+    /// Cycles of missing data after which the supervisor's engine has
+    /// aborted the motion (its feedback timeout; at least [`GAP_CYCLES`]).
+    pub gap_cycles: u32,
 }
 
 impl AxisSetup {
@@ -138,6 +140,7 @@ impl AxisSetup {
             quick_stop_ms: 500,
             brake_ms: 0,
             drive_homing: false,
+            gap_cycles: 10,
         }
     }
 }
@@ -181,6 +184,8 @@ pub struct AxisLogic {
     /// late master repeated its set-point; disabling voltage on it would
     /// drop a moving axis).
     still: u32,
+    /// See [`AxisSetup::gap_cycles`].
+    gap_cycles: u32,
     pub counters: AxisCounters,
 }
 
@@ -223,6 +228,7 @@ impl AxisLogic {
             cycle_s,
             rest_velocity: 1.0 / cycle_s,
             still: 0,
+            gap_cycles: setup.gap_cycles.max(GAP_CYCLES),
             counters: AxisCounters::default(),
             layout: setup.layout,
         }
@@ -298,7 +304,7 @@ impl AxisLogic {
             fb.status_word |= SW_NO_DATA;
             return (self.outputs, fb);
         };
-        let gap = self.since_inputs > GAP_CYCLES;
+        let gap = self.since_inputs > self.gap_cycles;
         let prev = self.pos64;
         let pos64 = self.extend(inp.position);
         let velocity = if self.layout.present.velocity {
@@ -402,18 +408,21 @@ impl AxisLogic {
         self.counters.blind_stop_cycles += 1;
     }
 
-    /// The data came back after a gap of [`GAP_CYCLES`] or more with the
-    /// drive still in Operation enabled, and the last target it got lies
-    /// further from the command's than catching up in one cycle allows
-    /// ([`RESYNC_COUNTS`] + four cycles of its velocity): it was lost
-    /// (its outputs frozen) while the command ran on — a 30 ms loss at 20
+    /// The data came back after a loss longer than the supervisor's
+    /// feedback timeout ([`AxisSetup::gap_cycles`]: its engine has aborted
+    /// the motion and stops it on its own profile) with the drive still in
+    /// Operation enabled, and the last target the drive got lies further
+    /// from the command's than catching up in one cycle allows
+    /// ([`RESYNC_COUNTS`] + four cycles of its velocity): it was lost (its
+    /// outputs frozen) while the command ran on — a 30 ms loss at 20
     /// units/s would be 0.6 units in one cycle. It is never jumped there:
     /// its target is its actual position and it gets the backend's fault
-    /// (the bounded stop, then disabled). The supervisor, whose engine took
-    /// the loss as one, enables it again from where it stands after a
-    /// reset. (A drive that did not ride the loss out in Operation enabled
-    /// follows its actual position anyway and gets the fault of a lost
-    /// drive: [`AxisLogic::lost`].)
+    /// (the bounded stop, then disabled); the supervisor enables it again
+    /// from where it stands after a reset. A shorter loss, which the engine
+    /// rides out, is caught up: at most its feedback timeout's travel. (A
+    /// drive that did not ride the loss out in Operation enabled follows
+    /// its actual position anyway and gets the fault of a lost drive:
+    /// [`AxisLogic::lost`].)
     fn after_gap(&mut self, cmd: &AxisCommand) {
         if !self.state.is_enabled() || self.resync || cmd.target_position == INVALID_COUNTS {
             return;

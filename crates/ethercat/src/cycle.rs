@@ -18,6 +18,7 @@ use motion_rt::now_ns;
 use crate::axis::{AxisLogic, AxisSetup, Mode};
 use crate::capacity::MAX_SUBDEVICES;
 use crate::group::{Exchanged, OpGroup};
+use crate::handoff::HandOff;
 use crate::health::Devices;
 use crate::io::BusIo;
 use crate::jobs::{Done, Job};
@@ -88,7 +89,11 @@ pub(crate) struct Engine {
     expected_wkc: u16,
     cmd_words: Vec<u64>,
     fb_words: Vec<u64>,
+    /// The newest commands from motion-io, and this frame's (their targets
+    /// re-timed by the hand-off).
+    newest: Vec<AxisCommand>,
     cmds: Vec<AxisCommand>,
+    handoff: HandOff,
     mode: Mode,
     /// The bus thread's own watchdog: the generation of the newest command
     /// words, when a new one was last seen, the bound, whether it stops
@@ -141,6 +146,9 @@ impl Engine {
                     quick_stop_ms: cfg.keys.quick_stop_timeout_ms,
                     brake_ms: a.ethercat.brake_delay_ms,
                     drive_homing: p.homing.is_some(),
+                    gap_cycles: (cfg.feedback_timeout_ms * 1e-3 / cycle_s)
+                        .ceil()
+                        .clamp(0.0, 1e6) as u32,
                 })
             })
             .collect();
@@ -172,7 +180,9 @@ impl Engine {
             contrib,
             cmd_words: vec![0; words::len(n)],
             fb_words: vec![0; words::len(n)],
+            newest: vec![AxisCommand::ZERO; n],
             cmds: vec![AxisCommand::ZERO; n],
+            handoff: HandOff::new(n, cycle_s),
             mode: Mode::Normal,
             generation: 0,
             command_seen_ns: 0,
@@ -210,7 +220,7 @@ impl Engine {
                 MODE_EMERGENCY => Mode::Emergency,
                 _ => Mode::Normal,
             };
-            for (i, c) in self.cmds.iter_mut().enumerate() {
+            for (i, c) in self.newest.iter_mut().enumerate() {
                 *c = words::command(&self.cmd_words, i);
             }
             if self.cmd_words[0] != self.generation || self.command_seen_ns == 0 {
@@ -234,6 +244,15 @@ impl Engine {
         if trips {
             self.mode = Mode::WatchdogStop;
         }
+        self.cmds.copy_from_slice(&self.newest);
+        if self.mode == Mode::Normal {
+            self.handoff.frame(self.cmd_words[2], &mut self.cmds);
+        } else {
+            self.handoff.reset();
+        }
+        self.shared
+            .handoff_corrections
+            .store(self.handoff.corrections, Ordering::Relaxed);
     }
 
     /// One exchange; returns the DC wait to the next cycle, if any.

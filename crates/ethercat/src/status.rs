@@ -104,6 +104,9 @@ pub(crate) struct Shared {
     pub needs_restart: AtomicU64,
     /// Times the bus thread's own watchdog stopped the drives.
     pub bus_watchdog_trips: AtomicU64,
+    /// Frames whose command had to be other than the next in the
+    /// supervisor's sequence ([`crate::handoff`]).
+    pub handoff_corrections: AtomicU64,
     /// Per bus position: the health of the SubDevices that drive axes.
     pub sd: Vec<SdAtomics>,
     /// Bumped on every change of a SubDevice's health (the log's cue).
@@ -155,6 +158,7 @@ impl Shared {
             window_write_failures: AtomicU64::new(0),
             needs_restart: AtomicU64::new(0),
             bus_watchdog_trips: AtomicU64::new(0),
+            handoff_corrections: AtomicU64::new(0),
             sd: (0..MAX_SUBDEVICES)
                 .map(|_| SdAtomics {
                     health: AtomicU8::new(0),
@@ -224,6 +228,7 @@ impl Shared {
             recovery_failures: l(&self.recovery_failures),
             needs_restart: l(&self.needs_restart),
             bus_watchdog_trips: l(&self.bus_watchdog_trips),
+            handoff_corrections: l(&self.handoff_corrections),
             losses: self.sd.iter().map(|s| l(&s.losses)).sum(),
             returns: self.sd.iter().map(|s| l(&s.returns)).sum(),
             reconfigured: self.sd.iter().map(|s| l(&s.reconfigured)).sum(),
@@ -367,6 +372,10 @@ pub struct BusStatus {
     /// Times the bus thread's own watchdog stopped the drives (no command
     /// from motion-io within its bound).
     pub bus_watchdog_trips: u64,
+    /// Frames that could not carry the command following the previous
+    /// frame's in the supervisor's sequence (the clocks a cycle apart, or
+    /// a stall): their target stepped by 0 or two cycles' travel.
+    pub handoff_corrections: u64,
     /// Losses of SubDevices that drive axes (not answering, out of OP),
     /// returns to OP, and re-configurations after a power cycle.
     pub losses: u64,

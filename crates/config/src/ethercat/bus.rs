@@ -15,6 +15,8 @@ pub const DEFAULT_BUS_PRIORITY: i32 = 70;
 /// [`EthercatBus::new`]'s `watchdog_cycles`: `io_watchdog_cycles`'s default
 /// at a 1 ms cycle.
 pub const DEFAULT_WATCHDOG_CYCLES: u32 = 50;
+/// [`EthercatBus::new`]'s `feedback_timeout_ms`: the supervisor's default.
+pub const DEFAULT_FEEDBACK_TIMEOUT_MS: f64 = 10.0;
 
 /// One axis on the bus, in the bus's order.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -69,6 +71,11 @@ pub struct EthercatBus {
     /// bus thread has its own, of twice as many cycles (see
     /// `motion_ethercat::cycle`).
     pub watchdog_cycles: u32,
+    /// `feedback_timeout_ms` of the supervisor: how long its engines go on
+    /// through missing feedback before they abort the motion. A drive
+    /// whose data was lost longer is not sent after a command that ran on
+    /// (see `motion_ethercat::axis`).
+    pub feedback_timeout_ms: f64,
 }
 
 impl EthercatBus {
@@ -86,6 +93,7 @@ impl EthercatBus {
             priority: DEFAULT_BUS_PRIORITY,
             lock_memory: true,
             watchdog_cycles: DEFAULT_WATCHDOG_CYCLES,
+            feedback_timeout_ms: DEFAULT_FEEDBACK_TIMEOUT_MS,
         }
     }
 
@@ -160,6 +168,7 @@ impl EthercatBus {
             priority: priority.unwrap_or(DEFAULT_BUS_PRIORITY),
             lock_memory: machine.supervisor.lock_memory,
             watchdog_cycles: machine.supervisor.io_watchdog_cycles,
+            feedback_timeout_ms: machine.supervisor.feedback_timeout_ms,
         };
         Ok((bus, map))
     }

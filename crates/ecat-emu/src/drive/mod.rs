@@ -109,8 +109,6 @@ pub struct Drive {
     offset: f64,
     /// The ESC is in SAFE-OP or OP (a late mode display shows only then).
     operational: bool,
-    /// The target (0x607A) of every frame taken in CSP, while recording.
-    targets: Option<Vec<i32>>,
 }
 
 impl Drive {
@@ -134,7 +132,6 @@ impl Drive {
             homing: None,
             offset: 0.0,
             operational: false,
-            targets: None,
         };
         d.update_inputs();
         d
@@ -178,28 +175,10 @@ impl Drive {
             self.transitions(cw);
             self.show_mode();
             self.homing_bits(cw);
-            let target = self.od.get_signed(0x607A, 0) as i32;
-            if let (Some(t), 8) = (&mut self.targets, self.od.get(0x6061, 0) as u8) {
-                t.push(target);
-            }
         }
         self.last_cw = cw;
         self.step_plant(dt, outputs_valid);
         self.update_inputs();
-    }
-
-    /// Records the target of every frame taken in CSP (`false`: stops and
-    /// forgets them).
-    pub fn record_targets(&mut self, on: bool) {
-        self.targets = on.then(Vec::new);
-    }
-
-    /// The targets recorded so far; the record starts empty again.
-    pub fn take_targets(&mut self) -> Vec<i32> {
-        self.targets
-            .as_mut()
-            .map(std::mem::take)
-            .unwrap_or_default()
     }
 
     /// Wall-time step without process data: advances a running ramp only.
