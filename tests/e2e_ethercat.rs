@@ -214,6 +214,52 @@ fn slow(tag: &str, tweak: impl FnOnce(&mut [ecat_emu::DriveConfig])) -> Option<B
     Bus::start(tag, &machine, tweak)
 }
 
+/// `slow(tag, tweak)` homed by `motion-supervisor home`, once its drive
+/// seeks at 5 u/s: the bus and the running supervisor.
+fn seeking(tag: &str, tweak: impl FnOnce(&mut [ecat_emu::DriveConfig])) -> Option<(Bus, Running)> {
+    let b = slow(tag, tweak)?;
+    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
+    assert!(
+        wait_for(Duration::from_secs(30), || b.drive(0).drive.velocity > 4.0),
+        "homing never started: {:?}\n{}",
+        b.drive(0),
+        w.stderr()
+    );
+    Some((b, w))
+}
+
+/// How long from now until `done` holds (polled every millisecond), at
+/// most 5 s.
+fn time_until(mut done: impl FnMut() -> bool) -> Option<Duration> {
+    let t0 = Instant::now();
+    while t0.elapsed() < Duration::from_secs(5) {
+        if done() {
+            return Some(t0.elapsed());
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    None
+}
+
+/// `sig` to the bus's `motion-io`.
+fn signal_io(b: &Bus, sig: Signal) {
+    let io = find_process("motion-io", &b.cfg.prefix).expect("motion-io");
+    signal_pid(io, sig);
+}
+
+/// `motion-io` of `prefix` is gone within 10 s.
+#[track_caller]
+fn io_gone(prefix: &str) {
+    assert!(
+        wait_for(Duration::from_secs(10), || find_process(
+            "motion-io",
+            prefix
+        )
+        .is_none()),
+        "motion-io still runs"
+    );
+}
+
 /// Waits until axis `name` is in `phase` (status), or panics.
 #[track_caller]
 fn wait_phase(d: &Daemon, name: &str, phase: &str) {
@@ -392,30 +438,16 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
 #[test]
 fn killed_motion_io_the_drives_watchdog_stops_the_axis() {
     let _serial = serial();
-    let Some(b) = slow("ecat_killio", |_| {}) else {
+    let Some((b, w)) = seeking("ecat_killio", |_| {}) else {
         return;
     };
-    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
-    // into the seek, moving at 5 u/s
-    assert!(
-        wait_for(Duration::from_secs(30), || b.drive(0).drive.velocity > 4.0),
-        "homing never started: {:?}\n{}",
-        b.drive(0),
-        w.stderr()
-    );
-    let io = find_process("motion-io", &b.cfg.prefix).expect("motion-io");
-    signal_pid(io, Signal::SIGKILL);
-    let killed = Instant::now();
-    let mut stopped = None;
-    while killed.elapsed() < Duration::from_secs(5) {
-        let v = b.drive(0);
-        if v.drive.state == State::Fault && v.drive.velocity == 0.0 {
-            stopped = Some((killed.elapsed(), v));
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    let (after, v) = stopped.unwrap_or_else(|| panic!("drive not stopped: {:?}", b.drive(0)));
+    signal_io(&b, Signal::SIGKILL);
+    let after = time_until(|| {
+        let v = b.drive(0).drive;
+        v.state == State::Fault && v.velocity == 0.0
+    })
+    .unwrap_or_else(|| panic!("drive not stopped: {:?}", b.drive(0)));
+    let v = b.drive(0);
     eprintln!("drive stopped {after:?} after motion-io was killed: {v:?}");
     assert_eq!(v.al_status, 0x14, "SAFE-OP + error");
     assert_eq!(v.al_code, 0x001B, "SM watchdog");
@@ -442,34 +474,17 @@ fn killed_supervisor_stop_time(
     tag: &str,
     tweak: impl FnOnce(&mut [ecat_emu::DriveConfig]),
 ) -> Option<Duration> {
-    let b = slow(tag, tweak)?;
-    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
-    assert!(
-        wait_for(Duration::from_secs(30), || b.drive(0).drive.velocity > 4.0),
-        "homing never started: {:?}\n{}",
-        b.drive(0),
-        w.stderr()
-    );
+    let (b, w) = seeking(tag, tweak)?;
     signal_pid(w.pid() as i32, Signal::SIGKILL);
-    let killed = Instant::now();
-    let mut off = None;
-    while killed.elapsed() < Duration::from_secs(5) {
+    let off = time_until(|| {
         let v = b.drive(0).drive;
-        if v.state == State::SwitchOnDisabled && !v.enabled {
-            off = Some(killed.elapsed());
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    let off = off.unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
+        v.state == State::SwitchOnDisabled && !v.enabled
+    })
+    .unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
     let io = find_process("motion-io", &b.cfg.prefix);
     // motion-io outlives its supervisor by the stop and a second, then
     // leaves (it was spawned with --exit-with-supervisor)
-    assert!(wait_for(Duration::from_secs(10), || find_process(
-        "motion-io",
-        &b.cfg.prefix
-    )
-    .is_none()));
+    io_gone(&b.cfg.prefix);
     let run = w.finish();
     eprintln!("motion-io ({io:?}):\n{}", run.stderr);
     assert_clean(&b.cfg.prefix);
@@ -602,18 +617,9 @@ fn a_drive_short_on_process_data_killed_supervisor_the_others_switch_off_within_
     );
     let emu = b.rig.emulator();
     signal_pid(w.pid() as i32, Signal::SIGKILL);
-    let killed = Instant::now();
     emu.refuse_op(1, Some(al::SYNC_ERROR));
     emu.drop_out_of_op(1, Dropped::SafeOp(al::SYNC_ERROR));
-    let mut took = None;
-    while killed.elapsed() < Duration::from_secs(5) {
-        if off(&b, 0) && off(&b, 2) {
-            took = Some(killed.elapsed());
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    let took = took.unwrap_or_else(|| {
+    let took = time_until(|| off(&b, 0) && off(&b, 2)).unwrap_or_else(|| {
         panic!(
             "still powered: {:?} {:?}\n{}",
             b.drive(0),
@@ -637,11 +643,7 @@ fn a_drive_short_on_process_data_killed_supervisor_the_others_switch_off_within_
     );
     // motion-io's stop completes (a lost drive does not hold it up) and it
     // leaves a second later
-    assert!(wait_for(Duration::from_secs(10), || find_process(
-        "motion-io",
-        &b.cfg.prefix
-    )
-    .is_none()));
+    io_gone(&b.cfg.prefix);
     let run = w.finish();
     eprintln!("{}", run.stderr);
     assert_clean(&b.cfg.prefix);
@@ -655,28 +657,12 @@ fn a_drive_short_on_process_data_killed_supervisor_the_others_switch_off_within_
 #[test]
 fn a_stalled_motion_io_the_bus_thread_switches_the_drive_off_by_itself() {
     let _serial = serial();
-    let Some(b) = slow("ecat_stall", |_| {}) else {
+    let Some((b, w)) = seeking("ecat_stall", |_| {}) else {
         return;
     };
-    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
-    assert!(
-        wait_for(Duration::from_secs(30), || b.drive(0).drive.velocity > 4.0),
-        "homing never started: {:?}\n{}",
-        b.drive(0),
-        w.stderr()
-    );
-    let io = find_process("motion-io", &b.cfg.prefix).expect("motion-io");
-    signal_pid(io, Signal::SIGUSR1);
-    let stalled = Instant::now();
-    let mut took = None;
-    while stalled.elapsed() < Duration::from_secs(5) {
-        if off(&b, 0) {
-            took = Some(stalled.elapsed());
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    let took = took.unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
+    signal_io(&b, Signal::SIGUSR1);
+    let took =
+        time_until(|| off(&b, 0)).unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
     eprintln!(
         "motion-io's main loop stalled → the drive in Switch on disabled after {:.1} ms \
          (bus thread's own watchdog: 100 ms; quick stop bound 500 ms)",
@@ -691,11 +677,7 @@ fn a_stalled_motion_io_the_bus_thread_switches_the_drive_off_by_itself() {
     if let Some(pid) = find_process("motion-io", &b.cfg.prefix) {
         signal_pid(pid, Signal::SIGKILL);
     }
-    assert!(wait_for(Duration::from_secs(10), || find_process(
-        "motion-io",
-        &b.cfg.prefix
-    )
-    .is_none()));
+    io_gone(&b.cfg.prefix);
     assert_clean(&b.cfg.prefix);
 }
 

@@ -113,17 +113,24 @@ fn parse_watchdog_line(line: &str) -> (u64, f64) {
     (n.parse().unwrap(), ms.parse().unwrap())
 }
 
-fn watchdog_stop_and_exit(spin: bool) {
-    // A 20 ms silence is the watchdog's trigger: the tests take turns (a
-    // spinning motion-io of another test next to this one, on 2 vCPUs, can
-    // starve this test's commands that long) and pace like the supervisor.
-    let _serial = serial();
+/// The machine's config, a prefix of its own (tidied after a panic) and
+/// the supervisor played on it, the test's thread paced like the
+/// supervisor. A 20 ms silence is the watchdog's trigger: the tests take
+/// turns (a spinning motion-io of another test next to this one, on 2
+/// vCPUs, can starve this test's commands that long).
+fn played() -> (TempConfig, String, DomainGuard, SupervisorPeer) {
     pace_like_the_supervisor();
     let cfg = machine().write("iotest_unused");
     let prefix = unique_prefix("iotest");
-    let _guard = DomainGuard(prefix.clone());
+    let guard = DomainGuard(prefix.clone());
+    let sup = SupervisorPeer::new(&prefix);
+    (cfg, prefix, guard, sup)
+}
+
+fn watchdog_stop_and_exit(spin: bool) {
+    let _serial = serial();
     // --quiet: no start line to wait for, so the supervisor side comes first
-    let mut sup = SupervisorPeer::new(&prefix);
+    let (cfg, prefix, _guard, mut sup) = played();
     let mut args = vec![
         "--config",
         cfg.arg(),
@@ -259,11 +266,7 @@ fn a_full_stderr_never_delays_the_watchdog_stop() {
     use std::sync::Arc;
 
     let _serial = serial();
-    pace_like_the_supervisor();
-    let cfg = machine().write("iotest_unused");
-    let prefix = unique_prefix("iotest");
-    let _guard = DomainGuard(prefix.clone());
-    let mut sup = SupervisorPeer::new(&prefix);
+    let (cfg, prefix, _guard, mut sup) = played();
     // the pipe: small, its read end ours alone; a second, non-blocking
     // description of its write end to fill it with
     let mut fds = [0; 2];
