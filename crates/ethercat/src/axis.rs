@@ -554,7 +554,7 @@ impl AxisLogic {
 
     /// Where the CiA 402 machine walks the drive this cycle.
     /// (`seen`: from this cycle's data; else blind, see
-    /// [`blind_stop`](Self::blind_stop)).
+    /// [`blind`](Self::blind)).
     fn cia_target(&mut self, mode: Mode, enable: bool, at_rest: bool, seen: bool) -> Target {
         let stop = |s: &mut Stopper, state: State| {
             if seen {

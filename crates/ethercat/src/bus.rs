@@ -16,7 +16,7 @@
 //! 4. per axis: data valid only if the frame came back, the SubDevice is in
 //!    OP and the working counter matches (a shortfall explained by the
 //!    SubDevices out of OP — silent, or answering from SAFE-OP, PRE-OP —
-//!    leaves the others valid: [`crate::cycle::explained`]);
+//!    leaves the others valid: `cycle::explained`);
 //!    [`crate::axis::AxisLogic`] turns command + inputs into the next
 //!    outputs and the feedback (`SW_NO_DATA` and the last values otherwise,
 //!    counted per cause; a stop is sent without data too);

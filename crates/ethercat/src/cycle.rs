@@ -53,7 +53,7 @@ pub fn watchdog_ns(cfg: &EthercatBus) -> u64 {
 /// watchdog), which the next frames show. Anything else — a shortfall only
 /// SubDevices in OP can have caused, a counter above the expected one —
 /// leaves no SubDevice's data trusted (a stop is still sent: see
-/// `AxisLogic::blind_stop`).
+/// `AxisLogic::blind`).
 pub(crate) fn explained(
     wkc: u16,
     expected: u16,
