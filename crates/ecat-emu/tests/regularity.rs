@@ -70,7 +70,6 @@ impl Regularity {
 
 /// Jogs for `seconds` with the drive's clock `ppm` off; `None`: skipped.
 fn jog(ppm: f64, seconds: u64) -> Option<Regularity> {
-    Rig::pace();
     let mut d = drive("EMU-DRIFT");
     d.clock_ppm = ppm;
     d.plant.hard_stop = None;

@@ -59,7 +59,6 @@ fn two_moving(
     drive0: impl FnOnce(&mut ecat_emu::DriveConfig),
     tweak: impl FnOnce(&mut motion_config::EthercatBus),
 ) -> Option<Rig> {
-    Rig::pace();
     let mut d0 = drive("EMU-0");
     drive0(&mut d0);
     let mut r = rig_with(vec![d0, drive("EMU-1")], tweak)?;

@@ -246,6 +246,9 @@ pub fn start(
     tweak: impl FnOnce(&mut EthercatBus),
 ) -> Option<Result<Rig, String>> {
     let pair = VethPair::or_skip()?;
+    // the test's thread sends the commands: as the supervisor's, never off
+    // the CPU long enough for the bus thread's own watchdog (100 ms)
+    Rig::pace();
     let n = axes.len();
     let emu = emulator(&pair, drives);
     let mut cfg = EthercatBus::new(&pair.master, CYCLE_US, axes);
