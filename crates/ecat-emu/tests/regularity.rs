@@ -18,8 +18,8 @@
 //! * or where the hand-off moved the frames' sequence (a correction): every
 //!   other irregular frame must be one of those, and the corrections are at
 //!   most one per whole cycle the clocks drifted apart, plus one, plus one
-//!   per cycle the host took (the test cycle's missed deadlines, the bus
-//!   thread's overruns, lost and late frames).
+//!   per cycle the host took (the test cycle's missed deadlines and late
+//!   commands, the bus thread's overruns, lost and late frames).
 //!
 //! Before, with the newest command taken for every frame, 2–4 % of the
 //! frames at 1,000 ppm stepped by 0 or two cycles' travel, host or not.
@@ -52,8 +52,9 @@ struct Regularity {
     excused: usize,
     /// Frames the hand-off had to move back into its window.
     corrections: u64,
-    /// Cycles the host took: the test cycle's missed deadlines, the bus
-    /// thread's overruns, lost and late frames.
+    /// Cycles the host took: the test cycle's missed deadlines and its
+    /// commands published more than half a cycle late, the bus thread's
+    /// overruns, lost and late frames.
     host_cycles: u64,
 }
 
@@ -104,6 +105,7 @@ fn jog(ppm: f64, seconds: u64) -> Option<Regularity> {
     let mut g = judge(ppm, seconds, &t, &late);
     g.corrections = st.handoff_corrections - st0.handoff_corrections;
     g.host_cycles = missed
+        + late.len() as u64
         + (st.overruns - st0.overruns)
         + (st.lost_frames - st0.lost_frames)
         + (st.late_frames - st0.late_frames);

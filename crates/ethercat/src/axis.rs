@@ -72,7 +72,7 @@ use crate::drive_homing::{self, DriveHoming};
 use crate::objects::{di, MODE_CSP};
 use crate::pdo::{DriveInputs, DriveOutputs, PdoLayout};
 use crate::probe::{Edge, ProbeInputs, TouchProbes};
-use crate::stop::Stopper;
+use crate::stop::{Phase, Stopper};
 
 /// Largest distance between target and actual position, counts.
 pub const MAX_TARGET_DISTANCE: i64 = 1 << 30;
@@ -169,6 +169,9 @@ pub struct AxisLogic {
     /// Cycles since the last valid inputs (derived velocity).
     since_inputs: u32,
     state: State,
+    /// The state its data showed last (kept through a loss: a stop sent
+    /// without data goes on from there).
+    seen_state: State,
     outputs: DriveOutputs,
     last_feedback: AxisFeedback,
     kept_error: u16,
@@ -216,6 +219,7 @@ impl AxisLogic {
             pos32: 0,
             since_inputs: 1,
             state: State::NotReadyToSwitchOn,
+            seen_state: State::NotReadyToSwitchOn,
             outputs: DriveOutputs {
                 mode: MODE_CSP,
                 ..DriveOutputs::default()
@@ -273,14 +277,15 @@ impl AxisLogic {
     /// a drive that comes back no longer enabled while enable is still
     /// asked for gets the backend's fault — it is never enabled again by
     /// itself (a short loss the drive rode out in Operation enabled just
-    /// goes on).
+    /// goes on). A stop in progress goes on, blind, on the last state seen
+    /// (its outputs may still arrive): it reaches disable voltage at its
+    /// bound.
     pub fn lost(&mut self) {
         self.was_lost = true;
         self.cia = Cia402::new();
         if let Some(h) = &mut self.homing {
             h.forget();
         }
-        self.stopper.reset();
         self.state = State::NotReadyToSwitchOn;
         self.last_feedback.status_word &= !(SW_ENABLED | SW_DRIVE_HOMING | SW_DRIVE_HOMED);
     }
@@ -315,6 +320,7 @@ impl AxisLogic {
         };
         self.since_inputs = 1;
         self.state = State::from_statusword(inp.statusword);
+        self.seen_state = self.state;
         if std::mem::take(&mut self.was_lost) && enable && !self.state.is_enabled() {
             self.fault_latch = true;
         }
@@ -366,6 +372,8 @@ impl AxisLogic {
         let reset = cmd.control_word & CW_FAULT_RESET != 0;
         if (enable && !self.last_enable) || (reset && !self.last_reset) {
             self.fault_latch = false;
+            // asked for again: a stop in progress is over
+            self.stopper.reset();
             self.cia.request_fault_reset();
             self.counters.fault_resets += 1;
         }
@@ -404,7 +412,7 @@ impl AxisLogic {
             return;
         }
         let target = self.cia_target(mode, enable, false, false);
-        self.outputs.controlword = self.cia.step(self.state.statusword(), target);
+        self.outputs.controlword = self.cia.step(self.seen_state.statusword(), target);
         self.counters.blind_stop_cycles += 1;
     }
 
@@ -556,14 +564,22 @@ impl AxisLogic {
     /// (`seen`: from this cycle's data; else blind, see
     /// [`blind`](Self::blind)).
     fn cia_target(&mut self, mode: Mode, enable: bool, at_rest: bool, seen: bool) -> Target {
+        let seen_state = self.seen_state;
         let stop = |s: &mut Stopper, state: State| {
             if seen {
                 s.step(state, at_rest)
             } else {
-                s.step_blind(state)
+                s.step_blind(seen_state)
             }
         };
         match mode {
+            // commands back in the middle of a watchdog stop, enable still
+            // asked for: the stop goes on and the axis is faulted — never
+            // enabled again by itself
+            Mode::Normal if enable && !self.fault_latch && self.stopper.phase() != Phase::Idle => {
+                self.fault_latch = true;
+                stop(&mut self.stopper, self.state)
+            }
             Mode::Normal if enable && !self.fault_latch => {
                 self.stopper.reset();
                 Target::Enabled

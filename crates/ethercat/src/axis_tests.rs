@@ -272,6 +272,45 @@ fn watchdog_stop_quick_stops_then_disables_with_a_fault() {
 }
 
 #[test]
+fn commands_back_in_the_middle_of_a_watchdog_stop_never_enable_again() {
+    let mut a = logic();
+    a.step(
+        &cmd(true, 0),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 0)),
+    );
+    let (o, _) = a.step(
+        &cmd(true, 0),
+        Mode::WatchdogStop,
+        Some(&inputs(State::OperationEnabled, 0)),
+    );
+    assert_eq!(o.controlword, 0x0002);
+    // the drive ended its quick stop by itself; the commands come back
+    // before the stop saw it: enable still asked for, no edge
+    for _ in 0..5 {
+        let (o, fb) = a.step(
+            &cmd(true, 0),
+            Mode::Normal,
+            Some(&inputs(State::SwitchOnDisabled, 0)),
+        );
+        assert_eq!(o.controlword, 0x0000, "never walked to enabled");
+        assert_eq!(fb.status_word, SW_FAULT);
+    }
+    // a reset (the enable edge) and it enables
+    a.step(
+        &cmd(false, 0),
+        Mode::Normal,
+        Some(&inputs(State::SwitchOnDisabled, 0)),
+    );
+    let (o, fb) = a.step(
+        &cmd(true, 0),
+        Mode::Normal,
+        Some(&inputs(State::SwitchOnDisabled, 0)),
+    );
+    assert_eq!((o.controlword, fb.status_word), (0x0006, 0));
+}
+
+#[test]
 fn emergency_is_disable_voltage_and_a_fault() {
     let mut a = logic();
     a.step(
@@ -353,6 +392,32 @@ fn a_stop_without_data_is_sent_blind_on_time_alone() {
     assert_eq!(o.controlword, 0x0000);
     assert!(a.at_rest_and_disabled());
     assert_eq!(fb.status_word & (SW_ENABLED | SW_FAULT), SW_FAULT);
+
+    // lost (not answering) in the middle of a watchdog stop: the stop goes
+    // on from the last state seen — quick stop until the bound, not
+    // disable voltage at once
+    let mut a = AxisLogic::new(AxisSetup {
+        quick_stop_ms: 20,
+        ..AxisSetup::new(
+            PdoLayout::standard(TorqueLimits::PerDirection, false),
+            0.001,
+        )
+    });
+    a.step(
+        &cmd(true, 100),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 100)),
+    );
+    let words: Vec<u16> = (0..22)
+        .map(|_| {
+            a.lost();
+            a.step(&cmd(true, 100), Mode::WatchdogStop, None)
+                .0
+                .controlword
+        })
+        .collect();
+    assert!(words[..20].iter().all(|w| *w == 0x0002), "{words:?}");
+    assert_eq!(&words[20..], &[0x0000, 0x0000]);
 
     // a disable without data: "shutdown" at once; the emergency stop:
     // disable voltage at once
