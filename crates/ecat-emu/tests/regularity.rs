@@ -13,8 +13,8 @@
 //!
 //! * next to an event of the host: a frame that passed more than half a
 //!   cycle off its period (the bus thread late, a frame lost) or a command
-//!   published more than half a cycle after its deadline (the test's cycle
-//!   late) within three cycles — such frames are counted apart;
+//!   published more than a quarter cycle after its deadline (the test's
+//!   cycle late) within four cycles — such frames are counted apart;
 //! * or where the hand-off moved the frames' sequence (a correction): every
 //!   other irregular frame must be one of those, and the corrections are at
 //!   most one per whole cycle the clocks drifted apart, plus one, plus one
@@ -48,12 +48,12 @@ struct Regularity {
     repeated: usize,
     skipped: usize,
     other: usize,
-    /// Irregular steps within three cycles of an event of the host.
+    /// Irregular steps within four cycles of an event of the host.
     excused: usize,
     /// Frames the hand-off had to move back into its window.
     corrections: u64,
     /// Cycles the host took: the test cycle's missed deadlines and its
-    /// commands published more than half a cycle late, the bus thread's
+    /// commands published more than a quarter cycle late, the bus thread's
     /// overruns, lost and late frames.
     host_cycles: u64,
 }
@@ -96,7 +96,7 @@ fn jog(ppm: f64, seconds: u64) -> Option<Regularity> {
         a.target_position = p0 + i64::from(STEP) * k;
         a.target_velocity = f64::from(STEP) * 1000.0;
         r.backend.exchange(&r.cmd, &mut r.fb).expect("exchange");
-        if w.missed > 0 || motion_rt::now_ns() - w.deadline_ns > CYCLE_NS / 2 {
+        if w.missed > 0 || motion_rt::now_ns() - w.deadline_ns > CYCLE_NS / 4 {
             late.push(Instant::now());
         }
     }
@@ -132,11 +132,11 @@ fn judge(ppm: f64, seconds: u64, t: &[(i32, Instant)], late: &[Instant]) -> Regu
         })
         .collect();
     let near = |j: usize| {
-        let (lo, hi) = (j.saturating_sub(3), (j + 3).min(t.len() - 1));
+        let (lo, hi) = (j.saturating_sub(4), (j + 4).min(t.len() - 1));
         (lo..=hi).any(|i| off[i])
             || late
                 .iter()
-                .any(|p| t[j].1 + 3 * cycle >= *p && *p + 3 * cycle >= t[j].1)
+                .any(|p| t[j].1 + 4 * cycle >= *p && *p + 4 * cycle >= t[j].1)
     };
     let mut g = Regularity {
         ppm,
