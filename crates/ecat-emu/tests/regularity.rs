@@ -176,15 +176,30 @@ fn judge(ppm: f64, seconds: u64, t: &[(i32, Instant)], late: &[Instant]) -> Regu
 fn set_points_advance_regularly_over_a_drifting_clock() {
     let _t = turn();
     for ppm in [1000.0, -1000.0] {
-        let Some(g) = jog(ppm, 3) else { return };
-        assert!(g.frames > 2500, "{g:?}");
-        let own = (g.irregular - g.excused) as u64;
-        assert!(
-            own <= g.corrections,
-            "{own} irregular frames away from the host's events, {} corrections: {g:?}",
-            g.corrections
-        );
-        assert!(g.corrections <= g.bound(), "{g:?}");
+        // a host that takes more than 1 % of the cycles (other builds and
+        // tests on 2 vCPUs) can take them where no event shows: such an
+        // attempt that fails measures the host and is made again (at most
+        // three)
+        for attempt in 1..=3 {
+            let Some(g) = jog(ppm, 3) else { return };
+            assert!(g.frames > 2500, "{g:?}");
+            let own = (g.irregular - g.excused) as u64;
+            let holds = own <= g.corrections && g.corrections <= g.bound();
+            if !holds && g.host_cycles * 100 > g.frames as u64 && attempt < 3 {
+                eprintln!(
+                    "attempt {attempt}: the host took {} cycles: again",
+                    g.host_cycles
+                );
+                continue;
+            }
+            assert!(
+                own <= g.corrections,
+                "{own} irregular frames away from the host's events, {} corrections: {g:?}",
+                g.corrections
+            );
+            assert!(g.corrections <= g.bound(), "{g:?}");
+            break;
+        }
     }
 }
 

@@ -385,10 +385,23 @@ fn unplugged_subdevice_is_no_data_then_recovers_after_replug() {
 #[test]
 fn watchdog_stop_ramps_down_then_disables_with_a_fault() {
     let _t = turn();
-    let Some(mut r) = rig(1) else { return };
-    r.enable(0);
-    // 30 units/s; the commands stop while the axis moves
-    r.move_to(0, 4_000, 30);
+    // A host that stalls the bus thread or the emulator long enough makes
+    // the drive lost while it moves (and, after more than the feedback
+    // timeout, stopped where it stands): such an attempt tests the host,
+    // not the stop, and is made again (at most three).
+    let mut r = None;
+    for attempt in 1..=3 {
+        let Some(mut rig) = rig(1) else { return };
+        rig.enable(0);
+        // 30 units/s; the commands stop while the axis moves
+        rig.move_to(0, 4_000, 30);
+        if rig.backend.bus_status().losses == 0 || attempt == 3 {
+            r = Some(rig);
+            break;
+        }
+        eprintln!("attempt {attempt}: the drive was lost while it moved: again");
+    }
+    let Some(mut r) = r else { return };
     let mut fb = FeedbackFrame::ZERO;
     let t0 = Instant::now();
     let mut calls = 0;
