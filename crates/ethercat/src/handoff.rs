@@ -19,28 +19,33 @@
 //! command's:
 //!
 //! * 0: the newest command's target;
-//! * 1 or 2 (not arrived yet): the newest target plus as many cycles of the
-//!   newest velocity (exact at constant speed; off by at most 2·a·T² while
-//!   accelerating);
+//! * 1 (not arrived yet): the newest target plus one cycle of the newest
+//!   velocity (exact at constant speed; off by at most ½·a·T² while
+//!   accelerating). Never further: a position the supervisor has not
+//!   commanded yet reaches its feedback no sooner than it commands it, so
+//!   its plausibility check never sees the axis ahead of its commands;
 //! * −1 or −2 (newer ones arrived too): the target of that command, kept
 //!   from the last three.
 //!
 //! Host jitter moves the lead by one from frame to frame; the two clocks'
 //! drift moves it for good, a cycle every 1/drift frames. Only that trend is
-//! corrected: when the lead has been 1 or more (−1 or less) in every frame
-//! of [`TREND_FRAMES`], the frames' sequence is moved back by one — one
-//! frame steps by 0 (the bus clock ahead) or by two cycles' travel
-//! (behind), once per 1/drift frames (10,000 at 100 ppm). A lead beyond ±2
-//! (a host stall of two cycles or more) is corrected at once.
+//! corrected, towards a lead of 0 or 1 — the newest command, or one cycle
+//! past it when it is late: no more delay than taking the newest. When the
+//! lead has been 1 or more in every frame of [`TREND_FRAMES`], or below 0
+//! in most of them, the frames' sequence is moved by one — one frame steps
+//! by 0 (the bus clock ahead) or by two cycles' travel (behind), once per
+//! 1/drift frames (10,000 at 100 ppm). A lead beyond the window (a host
+//! stall of a cycle or more) is corrected at once.
 //!
 //! Pure and allocation-free per frame (the per-axis memory is allocated
 //! once); commands without a sequence (0) pass through unchanged.
 
 use motion_frames::{AxisCommand, INVALID_COUNTS};
 
-/// How far the frames' sequence may be from the newest command's: two
-/// cycles ahead (extrapolated) or behind (a kept command).
-pub const WINDOW: i64 = 2;
+/// How far the frames' sequence may be from the newest command's: one
+/// cycle ahead (extrapolated), two behind (a kept command).
+pub const AHEAD: i64 = 1;
+pub const BEHIND: i64 = 2;
 /// Frames over which a lead that never came back to 0 is a trend.
 pub const TREND_FRAMES: u32 = 256;
 
@@ -57,9 +62,10 @@ pub struct HandOff {
     seqs: [u64; 3],
     targets: [Vec<i64>; 3],
     newest: usize,
-    /// The smallest and largest lead over the trend's frames so far.
+    /// The smallest lead over the trend's frames so far, and how many of
+    /// them were behind (below 0).
     low: i64,
-    high: i64,
+    behind: u32,
     frames: u32,
     /// Frames whose sequence had to be moved.
     pub corrections: u64,
@@ -75,7 +81,7 @@ impl HandOff {
             targets: [vec![0; axes], vec![0; axes], vec![0; axes]],
             newest: 0,
             low: i64::MAX,
-            high: i64::MIN,
+            behind: 0,
             frames: 0,
             corrections: 0,
         }
@@ -87,7 +93,7 @@ impl HandOff {
         self.frame = None;
         self.frames = 0;
         self.low = i64::MAX;
-        self.high = i64::MIN;
+        self.behind = 0;
     }
 
     /// This frame's commands: `cmds` are the newest, of sequence `seq`;
@@ -111,9 +117,9 @@ impl HandOff {
         }
         let want = self.frame.map_or(seq, |f| f.wrapping_add(1));
         let mut lead = (want as i64).wrapping_sub(seq as i64);
-        if !(-WINDOW..=WINDOW).contains(&lead) {
+        if !(-BEHIND..=AHEAD).contains(&lead) {
             self.corrections += 1;
-            lead = lead.clamp(-WINDOW, WINDOW);
+            lead = lead.clamp(-BEHIND, AHEAD);
         }
         lead = self.trend(lead);
         self.frame = Some(seq.wrapping_add_signed(lead));
@@ -125,25 +131,25 @@ impl HandOff {
     /// The lead after the trend's correction, if one is due.
     fn trend(&mut self, lead: i64) -> i64 {
         self.low = self.low.min(lead);
-        self.high = self.high.max(lead);
+        self.behind += u32::from(lead < 0);
         self.frames += 1;
         if self.frames < TREND_FRAMES {
             return lead;
         }
         let step = if self.low >= 1 {
             -1
-        } else if self.high <= -1 {
+        } else if self.behind > TREND_FRAMES / 2 {
             1
         } else {
             0
         };
         self.frames = 0;
         self.low = i64::MAX;
-        self.high = i64::MIN;
+        self.behind = 0;
         if step != 0 {
             self.corrections += 1;
         }
-        (lead + step).clamp(-WINDOW, WINDOW)
+        (lead + step).clamp(-BEHIND, AHEAD)
     }
 
     /// Axis `k`'s target `lead` cycles from the newest command `c` (of
@@ -265,16 +271,32 @@ mod tests {
     }
 
     #[test]
-    fn a_stall_beyond_two_cycles_is_corrected_at_once() {
+    fn a_lag_is_taken_back_to_the_newest_once() {
+        // a bus stall of one cycle leaves the frames a command behind the
+        // newest: after TREND_FRAMES frames one frame steps two cycles,
+        // then every frame carries the newest command again
+        let mut h = HandOff::new(1, 0.001);
+        let mut newest: Vec<u64> = (1..=10).collect();
+        newest.extend(12..12 + 2 * u64::from(TREND_FRAMES));
+        let t = frames(&mut h, &newest);
+        let last = *newest.last().unwrap() as i64;
+        assert_eq!(*t.last().unwrap(), 5 * last, "the newest again");
+        assert_eq!(h.corrections, 1);
+        let steps: Vec<i64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        assert_eq!(steps.iter().filter(|s| **s != 5).count(), 1, "{steps:?}");
+    }
+
+    #[test]
+    fn a_stall_beyond_the_window_is_corrected_at_once() {
         let mut h = HandOff::new(1, 0.001);
         // the bus stalled three cycles: the newest is 4 ahead
         let t = frames(&mut h, &[1, 2, 3, 7, 8]);
         assert_eq!(t, [5, 10, 15, 25, 30]);
         assert_eq!(h.corrections, 1);
-        // the commands stopped: two cycles extrapolated, then held
+        // the commands stopped: one cycle extrapolated, then held
         let mut h = HandOff::new(1, 0.001);
         let t = frames(&mut h, &[1, 2, 3, 3, 3, 3, 3]);
-        assert_eq!(t, [5, 10, 15, 20, 25, 25, 25]);
+        assert_eq!(t, [5, 10, 15, 20, 20, 20, 20]);
     }
 
     #[test]
