@@ -72,7 +72,7 @@ use crate::drive_homing::{self, DriveHoming};
 use crate::objects::{di, MODE_CSP};
 use crate::pdo::{DriveInputs, DriveOutputs, PdoLayout};
 use crate::probe::{Edge, ProbeInputs, TouchProbes};
-use crate::stop::{Phase, Stopper};
+use crate::stop::Stopper;
 
 /// Largest distance between target and actual position, counts.
 pub const MAX_TARGET_DISTANCE: i64 = 1 << 30;
@@ -573,10 +573,10 @@ impl AxisLogic {
             }
         };
         match mode {
-            // commands back in the middle of a watchdog stop, enable still
-            // asked for: the stop goes on and the axis is faulted — never
-            // enabled again by itself
-            Mode::Normal if enable && !self.fault_latch && self.stopper.phase() != Phase::Idle => {
+            // commands back in the middle of a watchdog stop of an enabled
+            // drive, enable still asked for: the stop goes on and the axis
+            // is faulted — never enabled again by itself
+            Mode::Normal if enable && !self.fault_latch && self.stopper.stopping() => {
                 self.fault_latch = true;
                 stop(&mut self.stopper, self.state)
             }

@@ -9,7 +9,7 @@
 //!    an SDO write);
 //! 2. take the newest commands from `motion-io` (seqlock, never blocks);
 //!    none new for twice motion-io's watchdog is the watchdog stop, run by
-//!    the bus thread itself ([`crate::cycle::watchdog_ns`]);
+//!    the bus thread itself ([`crate::cycle::watchdog_cycles`]);
 //! 3. write the outputs prepared last cycle into the process image, exchange
 //!    it (LRW + AL status of every SubDevice in one frame, + the DC time with
 //!    DC) with a deadline of `reply_timeout`;
@@ -268,7 +268,7 @@ fn run_cycles(
             io.receive(wake);
         }
         let start = now_ns();
-        engine.read_commands(start);
+        engine.read_commands();
         let dc_wait = engine.cycle(io, group, md, start);
         // next deadline: the DC reference clock, else the free-running period
         let now = now_ns();

@@ -29,15 +29,19 @@ use crate::status::Shared;
 use crate::words::{self, FLAG_BUS_WATCHDOG, FLAG_RUNNING, MODE_EMERGENCY, MODE_WATCHDOG_STOP};
 use motion_frames::{SW_DRIVE_LOST, SW_ENABLED};
 
-/// The bound of the bus thread's own watchdog: twice motion-io's
-/// (`io_watchdog_cycles` cycles, [`EthercatBus::watchdog_cycles`]), so
-/// motion-io's own watchdog — which says why in the log — acts first when
-/// the supervisor falls silent, and this one only when motion-io's main
-/// loop cannot (blocked, stalled, or gone without stopping). With the
-/// defaults 100 ms; the drives are then in Switch on disabled within that
-/// plus the bounded stop (`quick_stop_timeout_ms` + a brake's delay).
-pub fn watchdog_ns(cfg: &EthercatBus) -> u64 {
-    2 * u64::from(cfg.watchdog_cycles.max(1)) * cfg.cycle().as_nanos() as u64
+/// The bound of the bus thread's own watchdog, in bus cycles it ran:
+/// twice motion-io's (`io_watchdog_cycles`, [`EthercatBus::watchdog_cycles`]),
+/// so motion-io's own watchdog — which says why in the log — acts first
+/// when the supervisor falls silent, and this one only when motion-io's
+/// main loop cannot (blocked, stalled, or gone without stopping). Counted
+/// in cycles the bus thread ran, not in time: a host that held both
+/// threads off the CPU is no silence of motion-io's (the bus thread, back
+/// first, would otherwise stop the drives before motion-io had its turn).
+/// With the defaults 100 cycles (100 ms, longer if cycles were late); the
+/// drives are then in Switch on disabled within that plus the bounded stop
+/// (`quick_stop_timeout_ms` + a brake's delay).
+pub fn watchdog_cycles(cfg: &EthercatBus) -> u64 {
+    2 * u64::from(cfg.watchdog_cycles.max(1))
 }
 
 /// A working counter `wkc` short of `expected` is explained by the
@@ -96,11 +100,11 @@ pub(crate) struct Engine {
     handoff: HandOff,
     mode: Mode,
     /// The bus thread's own watchdog: the generation of the newest command
-    /// words, when a new one was last seen, the bound, whether it stops
-    /// the drives now.
+    /// words, the bus cycles run since a new one came, the bound, whether
+    /// it stops the drives now.
     generation: u64,
-    command_seen_ns: u64,
-    watchdog_ns: u64,
+    silent_cycles: u64,
+    watchdog_cycles: u64,
     watchdog: bool,
     window_written: Vec<Option<u32>>,
     window_pending: Vec<bool>,
@@ -185,8 +189,8 @@ impl Engine {
             handoff: HandOff::new(n, cycle_s),
             mode: Mode::Normal,
             generation: 0,
-            command_seen_ns: 0,
-            watchdog_ns: watchdog_ns(cfg),
+            silent_cycles: 0,
+            watchdog_cycles: watchdog_cycles(cfg),
             watchdog: false,
             window_written,
             window_pending: vec![false; n],
@@ -205,12 +209,12 @@ impl Engine {
     }
 
     /// Takes the newest commands from `motion-io` (never blocks; a failed
-    /// read keeps the previous ones) at `now`, and applies the bus
-    /// thread's own watchdog: no new command for [`watchdog_ns`] while
-    /// they ask for normal operation (motion-io's main loop blocked, or
-    /// gone without stopping) is the watchdog stop, run here without
-    /// motion-io, until a new command comes.
-    pub fn read_commands(&mut self, now: u64) {
+    /// read keeps the previous ones), once per bus cycle, and applies the
+    /// bus thread's own watchdog: no new command for [`watchdog_cycles`]
+    /// bus cycles while they ask for normal operation (motion-io's main
+    /// loop blocked, or gone without stopping) is the watchdog stop, run
+    /// here without motion-io, until a new command comes.
+    pub fn read_commands(&mut self) {
         if self.shared.commands.published() == 0 {
             return; // nothing from motion-io yet: disabled
         }
@@ -223,9 +227,9 @@ impl Engine {
             for (i, c) in self.newest.iter_mut().enumerate() {
                 *c = words::command(&self.cmd_words, i);
             }
-            if self.cmd_words[0] != self.generation || self.command_seen_ns == 0 {
+            if self.cmd_words[0] != self.generation {
                 self.generation = self.cmd_words[0];
-                self.command_seen_ns = now;
+                self.silent_cycles = 0;
             }
         } else {
             // keep the previous commands
@@ -233,8 +237,8 @@ impl Engine {
                 .command_read_failures
                 .fetch_add(1, Ordering::Relaxed);
         }
-        let silent = now.saturating_sub(self.command_seen_ns) > self.watchdog_ns;
-        let trips = silent && self.mode == Mode::Normal;
+        self.silent_cycles += 1;
+        let trips = self.silent_cycles > self.watchdog_cycles && self.mode == Mode::Normal;
         if trips && !self.watchdog {
             self.shared
                 .bus_watchdog_trips

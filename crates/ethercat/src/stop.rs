@@ -105,6 +105,12 @@ impl Stopper {
         self.ended
     }
 
+    /// A stop of a drive that was enabled (or in Quick stop active) when it
+    /// began is in progress or done, not yet reset.
+    pub fn stopping(&self) -> bool {
+        self.phase != Phase::Idle && self.ended != Some(Ended::NotEnabled)
+    }
+
     /// No stop wanted (any more): the next one starts from the beginning.
     pub fn reset(&mut self) {
         self.phase = Phase::Idle;
