@@ -29,10 +29,8 @@
 //!
 //! Host jitter moves the lead by one from frame to frame; the two clocks'
 //! drift moves it for good, a cycle every 1/drift frames. Only that trend is
-//! corrected, towards a lead of 0 or 1 — the newest command, or one cycle
-//! past it when it is late: no more delay than taking the newest. When the
-//! lead has been 1 or more in every frame of [`TREND_FRAMES`], or below 0
-//! in most of them, the frames' sequence is moved by one — one frame steps
+//! corrected: when the lead has been 1 (−1 or less) in every frame of
+//! [`TREND_FRAMES`], the frames' sequence is moved by one — one frame steps
 //! by 0 (the bus clock ahead) or by two cycles' travel (behind), once per
 //! 1/drift frames (10,000 at 100 ppm). A lead beyond the window (a host
 //! stall of a cycle or more) is corrected at once.
@@ -62,10 +60,9 @@ pub struct HandOff {
     seqs: [u64; 3],
     targets: [Vec<i64>; 3],
     newest: usize,
-    /// The smallest lead over the trend's frames so far, and how many of
-    /// them were behind (below 0).
+    /// The smallest and largest lead over the trend's frames so far.
     low: i64,
-    behind: u32,
+    high: i64,
     frames: u32,
     /// Frames whose sequence had to be moved.
     pub corrections: u64,
@@ -81,7 +78,7 @@ impl HandOff {
             targets: [vec![0; axes], vec![0; axes], vec![0; axes]],
             newest: 0,
             low: i64::MAX,
-            behind: 0,
+            high: i64::MIN,
             frames: 0,
             corrections: 0,
         }
@@ -93,7 +90,7 @@ impl HandOff {
         self.frame = None;
         self.frames = 0;
         self.low = i64::MAX;
-        self.behind = 0;
+        self.high = i64::MIN;
     }
 
     /// This frame's commands: `cmds` are the newest, of sequence `seq`;
@@ -131,21 +128,21 @@ impl HandOff {
     /// The lead after the trend's correction, if one is due.
     fn trend(&mut self, lead: i64) -> i64 {
         self.low = self.low.min(lead);
-        self.behind += u32::from(lead < 0);
+        self.high = self.high.max(lead);
         self.frames += 1;
         if self.frames < TREND_FRAMES {
             return lead;
         }
         let step = if self.low >= 1 {
             -1
-        } else if self.behind > TREND_FRAMES / 2 {
+        } else if self.high <= -1 {
             1
         } else {
             0
         };
         self.frames = 0;
         self.low = i64::MAX;
-        self.behind = 0;
+        self.high = i64::MIN;
         if step != 0 {
             self.corrections += 1;
         }
@@ -271,16 +268,18 @@ mod tests {
     }
 
     #[test]
-    fn a_lag_is_taken_back_to_the_newest_once() {
-        // a bus stall of one cycle leaves the frames a command behind the
-        // newest: after TREND_FRAMES frames one frame steps two cycles,
-        // then every frame carries the newest command again
+    fn a_lag_that_lasts_is_taken_back_a_cycle_at_a_time() {
+        // two bus stalls of one cycle leave the frames two commands behind
+        // the newest: after TREND_FRAMES frames one frame steps two cycles,
+        // then the frames keep one command behind the newest (the next
+        // window would take that back too)
         let mut h = HandOff::new(1, 0.001);
         let mut newest: Vec<u64> = (1..=10).collect();
-        newest.extend(12..12 + 2 * u64::from(TREND_FRAMES));
+        newest.extend(12..=20);
+        newest.extend(22..22 + 2 * u64::from(TREND_FRAMES));
         let t = frames(&mut h, &newest);
         let last = *newest.last().unwrap() as i64;
-        assert_eq!(*t.last().unwrap(), 5 * last, "the newest again");
+        assert_eq!(*t.last().unwrap(), 5 * (last - 1), "one behind");
         assert_eq!(h.corrections, 1);
         let steps: Vec<i64> = t.windows(2).map(|w| w[1] - w[0]).collect();
         assert_eq!(steps.iter().filter(|s| **s != 5).count(), 1, "{steps:?}");
