@@ -36,6 +36,14 @@ struct History {
     /// The interval that ended there, when it was judged (the drive
     /// followed): its average velocity, units/s, and length, s.
     interval: Option<(f64, f64)>,
+    /// The drive followed the last command. A command it did not follow
+    /// (its power stage off, or the drive homing itself while the command
+    /// follows its readings) says nothing about where the drive is: the
+    /// first command it follows again is no step from there. Those
+    /// readings jump whenever the drive redefines its position, and which
+    /// frame shows the redefined one — the last of its homing or the
+    /// first after — is the frames' timing, not the engine's.
+    followed: bool,
 }
 
 /// The monitor's own stop in progress.
@@ -216,6 +224,7 @@ impl Monitor {
         self.hist = History {
             last: Some((c.now_ns, cmd.position)),
             interval: judged,
+            followed: self.following,
         };
         Ok(())
     }
@@ -253,7 +262,8 @@ impl Monitor {
             v_bound * TOLERANCE + 1e-12,
         )?;
         self.soft_limits(c)?;
-        let Some((t0, p0)) = self.hist.last else {
+        // Steps and accelerations only from a command the drive followed.
+        let Some((t0, p0)) = self.hist.last.filter(|_| self.hist.followed) else {
             return Ok(None);
         };
         let eps = POSITION_ROUNDING * (1.0 + p.abs().max(p0.abs()));
