@@ -119,7 +119,20 @@ fn play(late: usize, handback: u32, lost: &dyn Fn(u64) -> bool) -> Result<(), St
     )
 }
 
-fn play_drive(mut d: Drive, late: usize, lost: &dyn Fn(u64) -> bool) -> Result<(), String> {
+fn play_drive(d: Drive, late: usize, lost: &dyn Fn(u64) -> bool) -> Result<(), String> {
+    play_tampered(d, late, lost, 0.0)
+}
+
+/// As [`play_drive`], the engine's commands from the first after the
+/// drive's homing on moved by `jump` (a bug in the engine, played: a
+/// profile started off the drive's position).
+fn play_tampered(
+    mut d: Drive,
+    late: usize,
+    lost: &dyn Fn(u64) -> bool,
+    jump: f64,
+) -> Result<(), String> {
+    let (mut homing_before, mut handed_back) = (false, false);
     let mut axis = Axis::new(cfg());
     let mut mon = Monitor::new(&cfg());
     let mut queue: Vec<Feedback> = vec![d.feedback(); late + 1];
@@ -132,7 +145,13 @@ fn play_drive(mut d: Drive, late: usize, lost: &dyn Fn(u64) -> bool) -> Result<(
         let fb = queue.remove(0);
         let fb = (!lost(k)).then_some(fb);
         let now = k * MS;
-        let cmd = axis.step(now, fb.as_ref(), &req);
+        let mut cmd = axis.step(now, fb.as_ref(), &req);
+        let homing = axis.status().phase == Phase::DriveHoming;
+        handed_back |= homing_before && !homing;
+        if handed_back {
+            cmd.position += jump;
+        }
+        homing_before = homing;
         let out = mon.check(&Cycle {
             now_ns: now,
             feedback: fb.as_ref(),
@@ -178,6 +197,27 @@ fn the_position_redefined_in_the_frame_that_ends_homing_mode_is_no_step() {
             ..Drive::default()
         };
         play_drive(d, late, &|_| false).unwrap_or_else(|e| panic!("late {late}: {e}"));
+    }
+}
+
+/// The first command after the drive's homing is still judged: from where
+/// the drive is. A profile that starts off the drive's position trips the
+/// step check (0.1 in a cycle: 100 u/s against the homing speeds' 2) —
+/// its later steps are all in bounds.
+#[test]
+fn a_jump_away_from_the_drive_at_the_hand_back_trips_the_step_check() {
+    for late_redefinition in [false, true] {
+        let d = Drive {
+            raw: 40.0,
+            handback: 1,
+            late_redefinition,
+            ..Drive::default()
+        };
+        let r = play_tampered(d, 1, &|_| false, 0.1);
+        assert!(
+            r.as_ref().is_err_and(|e| e.contains("invariant: Step")),
+            "{r:?}"
+        );
     }
 }
 
