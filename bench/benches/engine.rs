@@ -29,7 +29,7 @@
 //! `cycle/1`, `cycle/8`, `cycle/32`, `cycle/64`.
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
-use motion_harness::engine::{
+use motion_bench::engine::{
     homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
 use motion_homing::{Axis, Phase};

@@ -14,8 +14,7 @@
 use ecat_emu::{DriveConfig, Emulator, EmulatorConfig, SubDeviceView, VethPair};
 use motion_config::{AxisEntry, EthercatDrive, MachineConfig};
 
-use crate::generated::checked;
-use crate::machines::{Machine, TempConfig};
+use crate::machines::{checked, Machine, TempConfig};
 
 /// The pair and, once started, the emulator; both go away on drop
 /// (emulator first: it leaves the namespace before it is deleted).

@@ -8,15 +8,17 @@
 //! reported); so does SIGINT/SIGTERM.
 
 use crate::cli::Opts;
+use motion_bench::bins::Binaries;
 use motion_bench::cyclictest::{self, CtHistogram};
-use motion_bench::drive::{self, runs, Binaries, Repeated};
 use motion_bench::ecat::{self, BusRun, EcatRig};
+use motion_bench::homing::Repeated;
 use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine};
 use motion_bench::outcome;
 use motion_bench::proc::{self, Running};
 use motion_bench::slice::Slice;
 use motion_bench::table::us;
+use motion_bench::{drive, runs};
 use motion_bench::{histogram, plot::RGBColor};
 use std::collections::BTreeSet;
 use std::path::Path;
