@@ -8,6 +8,7 @@
 //! run the [`slices`], merge and judge them ([`report`]), print, write the
 //! [`files`].
 
+mod bus;
 mod cli;
 mod files;
 mod report;

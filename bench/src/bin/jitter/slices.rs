@@ -7,10 +7,11 @@
 //! The first failure of any tool ends the slices (what ran is still
 //! reported); so does SIGINT/SIGTERM.
 
+use crate::bus::{bus_run, BusRun};
 use crate::cli::Opts;
 use motion_bench::bins::Binaries;
 use motion_bench::cyclictest::{self, CtHistogram};
-use motion_bench::ecat::{self, BusRun, EcatRig};
+use motion_bench::ecat::{self, EcatRig};
 use motion_bench::homing::Repeated;
 use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine};
@@ -268,7 +269,7 @@ fn home_while(
 /// motion-io's bus round trip from the summary it logged (kept in `c`),
 /// as the progress line shows it.
 fn bus(c: &mut Collected, stderr: &str) -> String {
-    let Some(b) = ecat::bus_run(stderr) else {
+    let Some(b) = bus_run(stderr) else {
         let w = "EtherCAT: motion-io reported no bus summary in a slice";
         c.warnings.insert(w.into());
         return "; bus round trip not reported".into();
