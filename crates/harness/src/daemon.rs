@@ -151,12 +151,19 @@ pub fn stop_run(r: Running, timeout: Duration) -> Ended {
     r.wait(timeout, Duration::from_secs(5))
 }
 
+/// What the daemon logs when its cycle monitor stops an axis.
+pub const MONITOR_TRIPPED: &str = "the cycle monitor tripped";
+
 /// A test's daemon: `motion-supervisor run --config CFG`, stopped with
-/// SIGTERM when dropped (a failed test leaves no daemon behind).
+/// SIGTERM when dropped (a failed test leaves no daemon behind). Its end
+/// (stop or drop) fails the test if the cycle monitor stopped an axis —
+/// it never trips in normal operation — unless the test expects it
+/// ([`Daemon::allow_monitor_trips`]).
 pub struct Daemon {
     running: Option<Running>,
     pub prefix: String,
     motionctl: PathBuf,
+    monitor_trips_allowed: bool,
 }
 
 impl Daemon {
@@ -166,7 +173,14 @@ impl Daemon {
             running: Some(spawn_supervisor(&["run", "--config", cfg.arg()])),
             prefix: cfg.prefix.clone(),
             motionctl: test_bin("motionctl"),
+            monitor_trips_allowed: false,
         }
+    }
+
+    /// The test provokes what the cycle monitor must stop: its trips do
+    /// not fail the test.
+    pub fn allow_monitor_trips(&mut self) {
+        self.monitor_trips_allowed = true;
     }
 
     /// Starts the daemon and waits (20 s at most) until it answers with the
@@ -233,15 +247,33 @@ impl Daemon {
 
     /// SIGTERM and the daemon's exit (external I/O processes may still hold
     /// the domain: check it with `assert_clean` once they are gone too).
+    #[track_caller]
     pub fn stop(mut self) -> Ended {
-        self.running.take().expect("running").stop()
+        let ended = self.running.take().expect("running").stop();
+        no_trip(self.monitor_trips_allowed, &ended.stderr);
+        ended
+    }
+}
+
+/// Panics when the daemon's log shows a trip of its cycle monitor and none
+/// was allowed.
+#[track_caller]
+fn no_trip(allowed: bool, stderr: &str) {
+    if let Some(line) = stderr.lines().find(|l| l.contains(MONITOR_TRIPPED)) {
+        assert!(
+            allowed,
+            "the cycle monitor tripped in this test: {line}\n{stderr}"
+        );
     }
 }
 
 impl Drop for Daemon {
     fn drop(&mut self) {
         if let Some(r) = self.running.take() {
-            let _ = r.stop();
+            let ended = r.stop();
+            if !std::thread::panicking() {
+                no_trip(self.monitor_trips_allowed, &ended.stderr);
+            }
         }
     }
 }
