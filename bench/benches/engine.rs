@@ -40,7 +40,7 @@
 //! `profile/*` (e.g. `profile/plan_scurve`).
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
-use motion_harness::engine::{
+use motion_bench::engine::{
     homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
 use motion_homing::profile::{Kinematics, Profile, Ramp};
