@@ -17,7 +17,7 @@
 //! worth (64) per timed batch, so the axis's state is in the cache as in
 //! the cycle; `engine_step/seek_cold` streams its copies from memory
 //! instead (criterion's growing `SmallInput` batches), which is what the
-//! step measurements before issue 14 did: that figure is bounded by the
+//! step measurements of the first benches did: that figure is bounded by the
 //! size of `Axis` over the memory bandwidth (≈ 1.7 KB per step).
 //!
 //! `cargo bench -p motion-bench --bench engine` (≈ 20 s of measuring).
@@ -40,7 +40,7 @@
 //! `profile/*` (e.g. `profile/plan_scurve`).
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
-use motion_harness::engine::{
+use motion_bench::engine::{
     homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
 use motion_homing::profile::{Kinematics, Profile, Ramp};
