@@ -86,8 +86,7 @@ fn broken_by_the_host(run: &Ended) -> bool {
         .axes
         .iter()
         .any(|a| a.er && a.err == 12 && matches!(a.exerr, 40 | 45 | 46));
-    let counted = !run.stderr.contains(" 0 drive loss(es)")
-        || motion_harness::ecat::bus_run(&run.stderr).is_some_and(|r| r.lost > 0);
+    let counted = !run.stderr.contains(" 0 drive loss(es)") || bus_summary(&run.stderr).0 > 0;
     lost_axis && counted
 }
 
@@ -155,9 +154,25 @@ fn family(machine: &str) -> Option<Bus> {
 /// (The machines' cycle: 1 ms.)
 fn host_delay_cycles(v: &HomeReport, stderr: &str) -> u64 {
     const CYCLE_US: f64 = 1000.0;
-    let bus = motion_harness::ecat::bus_run(stderr).unwrap_or_default();
-    let round_trip = (bus.max / CYCLE_US).ceil().max(1.0) as u64 - 1;
-    bus.lost + round_trip + v.run.latency.deadline_misses
+    let (lost, max_us) = bus_summary(stderr);
+    let round_trip = (max_us / CYCLE_US).ceil().max(1.0) as u64 - 1;
+    lost + round_trip + v.run.latency.deadline_misses
+}
+
+/// motion-io's lost frames and worst bus round trip (us), from the summary
+/// it logs at exit (`…, N lost frame(s), … / max X us`); 0 where absent.
+fn bus_summary(stderr: &str) -> (u64, f64) {
+    let Some(line) = stderr.lines().rev().find(|l| l.contains("lost frame(s)")) else {
+        return (0, 0.0);
+    };
+    let lost = (line.split(", "))
+        .find(|p| p.ends_with("lost frame(s)"))
+        .and_then(|p| p.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0);
+    let max_us = (line.rsplit("/ max ").next())
+        .and_then(|t| t.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0.0);
+    (lost, max_us)
 }
 
 #[test]
