@@ -38,14 +38,56 @@ use nix::sys::signal::Signal;
 /// Returns the report and motion-io's / the supervisor's stderr.
 fn home(b: &Bus) -> (HomeReport, String) {
     let t0 = Instant::now();
-    let (v, run) = home_all(&b.cfg);
+    let (v, stderr) = home_unbroken(b);
+    assert!(v.run.latency.cycles > 500, "{:#?}", v.run.latency);
     eprintln!(
         "home over EtherCAT took {:.1} s; I/O round trip {:?}; stderr:\n{}",
         t0.elapsed().as_secs_f64(),
         v.run.latency.io_roundtrip_us,
-        run.stderr
+        stderr
     );
-    (v, run.stderr)
+    (v, stderr)
+}
+
+/// `home --json` on the bus, exit 0, nothing left behind. A homing the
+/// host broke — the emulator or the bus thread descheduled for longer than
+/// the feedback timeout, so an axis ended with its feedback or its drive
+/// lost (ERR 12 / EXERR 40, 45; 46 homing by the drive) and motion-io
+/// counted the loss — is made again, at most twice more: the subject is
+/// the homing, not a starved host. Any other failure, or a third broken
+/// homing, fails the test.
+fn home_unbroken(b: &Bus) -> (HomeReport, String) {
+    let mut attempt = 0;
+    loop {
+        attempt += 1;
+        let run = supervisor(&["home", "--json", "--config", b.cfg.arg()]);
+        assert_clean(&b.cfg.prefix);
+        if run.code() == Some(1) && attempt < 3 && broken_by_the_host(&run) {
+            eprintln!(
+                "attempt {attempt}: the host broke the homing (a loss), again:\n{}",
+                run.stderr
+            );
+            continue;
+        }
+        let v: HomeReport = run.expect_code(0).report();
+        return (v, run.stderr.clone());
+    }
+}
+
+/// An axis ended with its feedback or its drive lost (a drive homing
+/// itself: also with its homing mode left, 46 — a lost drive comes back in
+/// its own mode), and motion-io counted lost frames or a lost drive in
+/// that run.
+fn broken_by_the_host(run: &Ended) -> bool {
+    let Ok(v) = serde_json::from_str::<HomeReport>(run.stdout.trim()) else {
+        return false;
+    };
+    let lost_axis = v
+        .axes
+        .iter()
+        .any(|a| a.er && a.err == 12 && matches!(a.exerr, 40 | 45 | 46));
+    let counted = !run.stderr.contains(" 0 drive loss(es)") || bus_summary(&run.stderr).0 > 0;
+    lost_axis && counted
 }
 
 /// Set-points still on their way when the engine ended a move, at most:
@@ -106,6 +148,33 @@ fn family(machine: &str) -> Option<Bus> {
     )
 }
 
+/// Cycles by which this run's host delayed what the drives reported, as
+/// the run counted them: motion-io's lost frames and its worst bus round
+/// trip beyond one cycle, the supervisor's deadline misses.
+/// (The machines' cycle: 1 ms.)
+fn host_delay_cycles(v: &HomeReport, stderr: &str) -> u64 {
+    const CYCLE_US: f64 = 1000.0;
+    let (lost, max_us) = bus_summary(stderr);
+    let round_trip = (max_us / CYCLE_US).ceil().max(1.0) as u64 - 1;
+    lost + round_trip + v.run.latency.deadline_misses
+}
+
+/// motion-io's lost frames and worst bus round trip (us), from the summary
+/// it logs at exit (`…, N lost frame(s), … / max X us`); 0 where absent.
+fn bus_summary(stderr: &str) -> (u64, f64) {
+    let Some(line) = stderr.lines().rev().find(|l| l.contains("lost frame(s)")) else {
+        return (0, 0.0);
+    };
+    let lost = (line.split(", "))
+        .find(|p| p.ends_with("lost frame(s)"))
+        .and_then(|p| p.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0);
+    let max_us = (line.rsplit("/ max ").next())
+        .and_then(|t| t.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0.0);
+    (lost, max_us)
+}
+
 #[test]
 fn switch_family() {
     let _serial = serial();
@@ -127,8 +196,17 @@ fn switch_family() {
     // reaches the engine up to three cycles later (the drive's inputs lag
     // its outputs by a bus cycle; bus and supervisor clocks' phase on the
     // way in and out), and two more for a lost frame: up to 3.84.
+    // A loaded host delays the latch further, by what the run counted:
+    // each frame lost, each bus round trip beyond a cycle, each cycle the
+    // supervisor woke late is a cycle more of travel (0.02) before the
+    // engine can see it — never less than the stopping distance.
     let raw = value(bb.final_raw, bb);
-    assert!((3.7 - COUNT..=3.84 + COUNT).contains(&raw), "{bb:#?}");
+    let late = host_delay_cycles(&v, &stderr);
+    let most = 3.84 + 0.02 * late as f64;
+    assert!(
+        (3.7 - COUNT..=most + COUNT).contains(&raw),
+        "rest {raw} beyond [3.7, {most}] ({late} cycles of host delay counted)\n{bb:#?}"
+    );
     assert_close!(bb, final_position, raw - 3.3, COUNT);
     drive_at(&b, 1, bb);
 }
@@ -944,28 +1022,9 @@ fn drive_side_homing_in_mode_6() {
     let Some(b) = Bus::start("ecat_drivehome", &machine, |_| {}) else {
         return;
     };
-    // A homing the host broke (the bus thread or the emulator descheduled
-    // for several cycles: the drive counted lost, its homing aborted 12/46,
-    // the summary counts the loss) is made again, at most twice more: the
-    // subject here is the drive's homing, not a starved host. Any other
-    // failure fails the test.
-    let mut attempt = 0;
-    let (v, stderr) = loop {
-        attempt += 1;
-        let run = supervisor(&["home", "--json", "--config", b.cfg.arg()]);
-        let lost = !run.stderr.contains(" 0 drive loss(es)");
-        if run.status.and_then(|s| s.code()) == Some(1) && lost && attempt < 3 {
-            eprintln!(
-                "attempt {attempt}: a drive was lost (host stall), again:\n{}",
-                run.stderr
-            );
-            assert_clean(&b.cfg.prefix);
-            continue;
-        }
-        let v: HomeReport = run.expect_code(0).report();
-        assert_clean(&b.cfg.prefix);
-        break (v, run.stderr);
-    };
+    // a homing the host broke (the drive counted lost, its homing aborted
+    // 12/46) is made again: see `home_unbroken`
+    let (v, stderr) = home_unbroken(&b);
     assert!(
         stderr.contains("drive homing: method 19 (positive home switch)"),
         "{stderr}"

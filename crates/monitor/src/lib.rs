@@ -19,7 +19,7 @@
 //! |---|---|---|
 //! | 1 velocity | the command's velocity | the speed bound: the cap that applies — `max_speed`; `unhomed_speed` too while not homed; a jog's or move's own speed; the homing speeds while homing; for a stream, 0 from `stream_timeout_ms` after its last setpoint arrived — and after the cap drops (a stop, a fault, an end), the speed allowed before, decaying at the deceleration that motion's stops reach at least (SS1 ramp monitoring) |
 //! | 2 acceleration | change of the commanded positions' velocity from one interval to the next, over the longer interval | while the speed grows: the operation's acceleration, `stream_acceleration`, Home Acceleration; while it shrinks: the operation's deceleration, `max_deceleration`, Home Deceleration, `stream_acceleration` (the largest that applies); braking harder only to end on a soft limit |
-//! | 3 step | first divided difference of the commanded positions | the speed bound at the start of the interval |
+//! | 3 step | first divided difference of the commanded positions, from the command the drive followed last — after commands it did not follow (power off, its own homing), from its newest reading | the speed bound at the start of the interval |
 //! | 4 soft limit | the command in axis coordinates while homed (linear, `travel_limits`) | inside; once outside (it never should be), never further out |
 //! | 5 enable | the power stage asked on | only after an explicit enable, home, jog, move or stream since the last drive fault, dropped power stage, lost drive, shutdown, or disable come to rest |
 //! | 6 gantry | the distance between a gantry's sides | within `max_skew` of where they stood together (not while homing) |

@@ -36,6 +36,15 @@ struct History {
     /// The interval that ended there, when it was judged (the drive
     /// followed): its average velocity, units/s, and length, s.
     interval: Option<(f64, f64)>,
+    /// The drive followed the last command. A command it did not follow
+    /// (its power stage off, or the drive homing itself while the command
+    /// follows its readings) says nothing about where the drive is: the
+    /// first command it follows again is a step from the drive's newest
+    /// reading, not from that command. (A drive homing itself redefines
+    /// its position; which frame shows the redefined one — the last of
+    /// its homing or the first after — is the frames' timing, and the
+    /// command held at the reading before is in the old frame.)
+    followed: bool,
 }
 
 /// The monitor's own stop in progress.
@@ -68,6 +77,8 @@ pub struct Monitor {
     following: bool,
     /// The raw → axis offset while homed, as of this cycle.
     reference: Option<f64>,
+    /// The drive's position in its newest valid feedback (raw).
+    reading: Option<f64>,
     tripped: Option<Tripped>,
     trips: u32,
     /// The axis's configuration: an accepted operation's left-out
@@ -92,6 +103,7 @@ impl Monitor {
             undo: History::default(),
             following: false,
             reference: None,
+            reading: None,
             tripped: None,
             trips: 0,
             cfg: *cfg,
@@ -121,6 +133,11 @@ impl Monitor {
             op.resolve(&self.cfg);
         }
         self.reference = c.reference.filter(|_| c.status.homed);
+        if let Some(f) = c.feedback {
+            if f.position.is_finite() && f.velocity.is_finite() {
+                self.reading = Some(f.position);
+            }
+        }
         if self.tripped.is_some() {
             if ev.accepted == Some(Operation::Reset) {
                 self.untrip();
@@ -216,6 +233,7 @@ impl Monitor {
         self.hist = History {
             last: Some((c.now_ns, cmd.position)),
             interval: judged,
+            followed: self.following,
         };
         Ok(())
     }
@@ -253,7 +271,14 @@ impl Monitor {
             v_bound * TOLERANCE + 1e-12,
         )?;
         self.soft_limits(c)?;
-        let Some((t0, p0)) = self.hist.last else {
+        // The step from the command the drive followed last; after commands
+        // it did not follow, from where it is (its newest reading) over the
+        // interval since the last command.
+        let from = match self.hist.last {
+            Some((t, _)) if !self.hist.followed => self.reading.map(|r| (t, r)),
+            last => last,
+        };
+        let Some((t0, p0)) = from else {
             return Ok(None);
         };
         let eps = POSITION_ROUNDING * (1.0 + p.abs().max(p0.abs()));
