@@ -316,6 +316,7 @@ fn operations_make_no_allocation() {
             accel: Some(500.0),
             decel: Some(500.0),
             lease: Some(time::ns_to_s(300 * T)),
+            jerk: None,
         })
     };
     let mv = |target: f64, supersede: bool| {
@@ -326,6 +327,7 @@ fn operations_make_no_allocation() {
             accel: Some(500.0),
             decel: Some(500.0),
             supersede,
+            jerk: None,
         })
     };
     // (step, request) of the script; every other step is empty.
@@ -432,6 +434,7 @@ fn operations_make_no_allocation() {
                 accel: Some(500.0),
                 decel: Some(500.0),
                 lease: Some(time::ns_to_s(5_000 * T)),
+                jerk: None,
             })),
             1500 => op(Operation::Reset),
             1510 => op(jog(-5.0)),
@@ -458,6 +461,7 @@ fn move_outside() -> Operation {
         accel: Some(500.0),
         decel: Some(500.0),
         supersede: false,
+        jerk: None,
     })
 }
 

@@ -24,7 +24,7 @@ use crate::axis::state::State;
 use crate::axis::Axis;
 use crate::codes::*;
 use crate::config::AxisConfiguration;
-use crate::op_limits::JOG_LEASE_NS;
+use crate::op_limits::{JOG_LEASE_NS, MAX_JERK};
 
 /// Execution collision.
 pub(super) const COLLISION: Code = (ERR_EXECUTION_COLLISION, 0);
@@ -127,6 +127,15 @@ impl Axis {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_DECELERATION));
         }
         Ok(())
+    }
+
+    /// A jog's or move's jerk: 0 (a trapezoid) ..= `MAX_JERK` (13 / 8).
+    pub(super) fn check_jerk(&self, jerk: f64) -> Result<(), Code> {
+        if (0.0..=MAX_JERK).contains(&jerk) {
+            Ok(())
+        } else {
+            Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_JERK))
+        }
     }
 
     /// A jog's lease: 50 ms ..= 5 s.
