@@ -1,5 +1,5 @@
 //! Engine benchmarks (criterion): one `Axis::step` in the middle of a homing
-//! leg, and one whole cycle's compute (`Core::step` + `Core::fill`) for 1, 8,
+//! leg and of a move (`engine_step/move_trapezoid`, `move_scurve`), and one whole cycle's compute (`Core::step` + `Core::fill`) for 1, 8,
 //! 32 and 64 axes. Goals: ≤ 50 ns per axis step, ≤ 10 µs for a 64-axis
 //! cycle. A summary table against the goals is printed at the end.
 //!
@@ -37,7 +37,7 @@
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use motion_harness::engine::{
-    homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
+    homing_core, move_state, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
 use motion_homing::profile::{Kinematics, Profile, Ramp};
 use motion_homing::{Axis, Phase};
@@ -108,6 +108,25 @@ fn engine_step(c: &mut Criterion) {
                 b.iter_batched_ref(|| state.axis.clone(), step, BatchSize::SmallInput)
             });
         }
+    }
+    // A move's step, trapezoid against S-curve (jerk: the demo axis's
+    // acceleration 500 reached in 50 ms), in the acceleration phase.
+    for (name, jerk) in [("move_trapezoid", 0.0), ("move_scurve", 10_000.0)] {
+        let state = move_state(jerk);
+        let step = |axis: &mut Axis| {
+            axis.step(
+                black_box(state.now),
+                Some(black_box(&state.feedback)),
+                black_box(&state.request),
+            )
+        };
+        g.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || state.axis.clone(),
+                step,
+                BatchSize::NumIterations(CYCLE_AXES),
+            )
+        });
     }
     g.finish();
 }
@@ -271,6 +290,8 @@ fn summary(dir: &Path, since: SystemTime) {
         ("engine_step/seek".into(), 1, Some(50.0)),
         ("engine_step/torque_detect".into(), 1, Some(50.0)),
         ("engine_step/seek_cold".into(), 1, None),
+        ("engine_step/move_trapezoid".into(), 1, Some(50.0)),
+        ("engine_step/move_scurve".into(), 1, None),
     ];
     for what in ["plan", "plan_turn", "stop_at", "sample"] {
         for kind in ["trapezoid", "scurve"] {

@@ -350,7 +350,7 @@ operations! {
         moves: true,
         held: false,
         all: false,
-        summary: "MAM: a trapezoidal move to Target (or by it); done when MoveStatus drops",
+        summary: "MAM: a move to Target (or by it), S-curve with a Jerk; done when MoveStatus drops",
     }
     /// The supervised stream starts: from now on the axis follows the
     /// setpoints of `Request::setpoint`, interpolated to the cycle, each one
@@ -489,13 +489,15 @@ crate::op_spec! {
     /// from its exact state (position, velocity, acceleration); each
     /// number left out keeps the running motion's.
     pub struct ChangeSpec {
-        /// Speed (magnitude), units/s; a jog keeps its direction.
+        /// Speed (magnitude), units/s; a jog keeps its direction. Left out:
+        /// the running motion's.
         speed: Option<f64> = Param::new("Speed", Unit::Speed).flag("speed", "V"),
-        /// Acceleration, units/s².
+        /// Acceleration, units/s²; left out: the running motion's.
         accel: Option<f64> = Param::new("Accel", Unit::Acceleration).flag("accel", "A"),
-        /// Deceleration, units/s².
+        /// Deceleration, units/s²; left out: the running motion's.
         decel: Option<f64> = Param::new("Decel", Unit::Acceleration).flag("decel", "D"),
-        /// Jerk, units/s³ (> 0: an S-curve; 0: a trapezoid).
+        /// Jerk, units/s³ (> 0: an S-curve; 0: a trapezoid); left out: the
+        /// running motion's.
         jerk: Option<f64> = Param::new("Jerk", Unit::Jerk).flag("jerk", "J"),
     }
 }
@@ -615,7 +617,9 @@ pub struct Setpoint {
 ///
 /// A caller that passed an operation in a step reads this after the step:
 /// `id` changed → accepted (it is then the operation described); `id`
-/// unchanged → refused, `refused` holds the ERR / EXERR. A refusal is the
+/// unchanged → refused, `refused` holds the ERR / EXERR. An operation
+/// answered in place ([`OpKind::in_place`]: a change) keeps `id`: accepted
+/// when `refused` is `None` after the step. A refusal is the
 /// instruction's error, not an axis fault: it sets nothing else and leaves
 /// the running operation (and the axis's ER) as they were.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
