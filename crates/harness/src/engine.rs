@@ -177,8 +177,10 @@ pub fn move_state(jerk: f64) -> Captured {
     use motion_homing::{HomeSequence, MoveSpec, Operation};
     let m = demo();
     let a = m.axes.iter().find(|a| a.name == "X").expect("demo axis X");
+    // Immediate homing derives no speed bound: the homing speed is it.
     let mut axis = Axis::new(motion_homing::AxisConfig {
         home_sequence: HomeSequence::Immediate,
+        max_speed: a.engine.max_speed.max(a.engine.home_speed),
         ..a.engine
     });
     let mut plant = Plant::new(a.sim);

@@ -8,10 +8,12 @@
 //!
 //! Per move: its duration; the following error `command − actual` (the
 //! actual position is the plant's answer to the previous cycle's command,
-//! as the supervisor sees it) — its largest magnitude and its largest
-//! change from one cycle to the next (what a drive's position loop sees as
-//! a kick); and the plant's torque (its inertia term: % rated per unit/s²
-//! of commanded acceleration) — its largest change per cycle.
+//! as the supervisor sees it) — its largest magnitude, and the largest
+//! second difference of it from cycle to cycle (the plant follows in one
+//! cycle, so the error is v·T and this is the commanded jerk × T³: the
+//! kick a drive's loop sees where the acceleration steps); and the plant's
+//! torque (inertia, friction and load terms, % rated) — its largest change
+//! per cycle.
 //!
 //! `cargo run --release -p motion-bench --bin following [-- --distance 40 --jerk 5000 --jerk 20000]`
 
@@ -36,7 +38,7 @@ struct Row {
     jerk: f64,
     duration_s: f64,
     max_error: f64,
-    max_error_step: f64,
+    max_error_jolt: f64,
     max_torque_step: f64,
 }
 
@@ -48,16 +50,19 @@ fn measure(
     distance: f64,
     jerk: f64,
 ) -> Row {
+    // Immediate homing derives no speed bound: the homing speed is it.
     let mut axis = Axis::new(AxisConfig {
         home_sequence: HomeSequence::Immediate,
+        max_speed: cfg.max_speed.max(cfg.home_speed),
         ..cfg
     });
     let mut plant = Plant::new(sim);
     let dt = cycle_ns as f64 * 1e-9;
     let mut fb = plant.feedback();
     let mut started = None;
-    let (mut max_error, mut max_error_step, mut max_torque_step) = (0.0f64, 0.0f64, 0.0f64);
-    let mut prev: Option<(f64, f64)> = None;
+    let (mut max_error, mut max_error_jolt, mut max_torque_step) = (0.0f64, 0.0f64, 0.0f64);
+    // The previous error, its change, and the previous torque.
+    let mut prev: Option<(f64, Option<f64>, f64)> = None;
     for k in 0..1_000_000u64 {
         let s = *axis.status();
         let mut req = Request {
@@ -77,22 +82,34 @@ fn measure(
             }));
         }
         let cmd = axis.step(k * cycle_ns, Some(&fb), &req);
+        if started == Some(k) {
+            let op = axis.status().op;
+            assert!(
+                op.refused.is_none(),
+                "the move was refused: {:?}",
+                op.refused
+            );
+        }
         if let Some(k0) = started {
             // `fb` is what the engine saw: the answer to the last command.
             let error = cmd.position - fb.position;
             let torque = fb.torque;
             max_error = max_error.max(error.abs());
-            if let Some((e0, t0)) = prev {
-                max_error_step = max_error_step.max((error - e0).abs());
+            let mut change = None;
+            if let Some((e0, c0, t0)) = prev {
+                change = Some(error - e0);
+                if let Some(c0) = c0 {
+                    max_error_jolt = max_error_jolt.max((error - e0 - c0).abs());
+                }
                 max_torque_step = max_torque_step.max((torque - t0).abs());
             }
-            prev = Some((error, torque));
+            prev = Some((error, change, torque));
             if k > k0 + 1 && !axis.status().moving && error == 0.0 {
                 return Row {
                     jerk,
                     duration_s: (k - k0) as f64 * dt,
                     max_error,
-                    max_error_step,
+                    max_error_jolt,
                     max_torque_step,
                 };
             }
@@ -121,7 +138,7 @@ fn main() {
         "jerk u/s³",
         "time s",
         "max |cmd − actual| u",
-        "max |Δ error| per cycle u",
+        "max |Δ² error| per cycle u",
         "max |Δ torque| per cycle %"
     );
     for jerk in std::iter::once(0.0).chain(o.jerk.iter().copied()) {
@@ -133,7 +150,7 @@ fn main() {
         };
         println!(
             "{name:>12} {:>10.3} {:>22.6} {:>26.6} {:>24.3}",
-            r.duration_s, r.max_error, r.max_error_step, r.max_torque_step
+            r.duration_s, r.max_error, r.max_error_jolt, r.max_torque_step
         );
     }
 }

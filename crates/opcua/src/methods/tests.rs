@@ -240,7 +240,15 @@ fn operations_decode_with_their_bounds() {
     let names: Vec<&str> = mv.inputs.iter().map(|a| a.name).collect();
     assert_eq!(
         names,
-        ["Target", "Relative", "Speed", "Accel", "Decel", "Supersede", "Jerk"]
+        [
+            "Target",
+            "Relative",
+            "Speed",
+            "Accel",
+            "Decel",
+            "Supersede",
+            "Jerk"
+        ]
     );
     let call = decode(
         mv,
