@@ -75,58 +75,42 @@ const CYCLE_AXES: u64 = 64;
 
 fn engine_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("engine_step");
+    // Each iteration steps a fresh copy of the captured axis (the copy is
+    // made outside the timed loop), with the feedback the plant gave. The
+    // copies of a batch are as many as a cycle's axes (`NumIterations`):
+    // the step as the cycle runs it, with the axis's state in the cache.
+    // `seek_cold` is the same with criterion's `SmallInput` batches, which
+    // grow with the iteration count (to tens of MB of copies): each step
+    // then streams its copy from memory, and the figure is about
+    // `size_of::<Axis>()` / memory bandwidth, not the step. Shown, without
+    // a goal, because earlier measurements were made so.
+    let mut time = |name: &str, state: &Captured, batch: BatchSize| {
+        let step = |axis: &mut Axis| {
+            axis.step(
+                black_box(state.now),
+                Some(black_box(&state.feedback)),
+                black_box(&state.request),
+            )
+        };
+        g.bench_function(name, |b| {
+            b.iter_batched_ref(|| state.axis.clone(), step, batch)
+        });
+    };
+    let cycle = BatchSize::NumIterations(CYCLE_AXES);
     for (name, state, phase) in [
         ("seek", seek_state(), Phase::Seek),
         ("torque_detect", torque_state(), Phase::Seek),
     ] {
         check(&format!("engine_step/{name}"), &state, phase);
-        // Each iteration steps a fresh copy of the captured axis (the copy
-        // is made outside the timed loop), with the feedback the plant gave.
-        // The copies of a batch are as many as a cycle's axes: the step as
-        // the cycle runs it, with the axis's state in the cache.
-        let step = |axis: &mut Axis| {
-            axis.step(
-                black_box(state.now),
-                Some(black_box(&state.feedback)),
-                black_box(&state.request),
-            )
-        };
-        g.bench_function(name, |b| {
-            b.iter_batched_ref(
-                || state.axis.clone(),
-                step,
-                BatchSize::NumIterations(CYCLE_AXES),
-            )
-        });
+        time(name, &state, cycle);
         if name == "seek" {
-            // The same with criterion's `SmallInput` batches, which grow
-            // with the iteration count (to tens of MB of copies): each step
-            // then streams its copy from memory, and the figure is about
-            // `size_of::<Axis>()` / memory bandwidth, not the step. Shown,
-            // without a goal, because earlier measurements were made so.
-            g.bench_function("seek_cold", |b| {
-                b.iter_batched_ref(|| state.axis.clone(), step, BatchSize::SmallInput)
-            });
+            time("seek_cold", &state, BatchSize::SmallInput);
         }
     }
     // A move's step, trapezoid against S-curve (jerk: the demo axis's
     // acceleration 500 reached in 50 ms), in the acceleration phase.
     for (name, jerk) in [("move_trapezoid", 0.0), ("move_scurve", 10_000.0)] {
-        let state = move_state(jerk);
-        let step = |axis: &mut Axis| {
-            axis.step(
-                black_box(state.now),
-                Some(black_box(&state.feedback)),
-                black_box(&state.request),
-            )
-        };
-        g.bench_function(name, |b| {
-            b.iter_batched_ref(
-                || state.axis.clone(),
-                step,
-                BatchSize::NumIterations(CYCLE_AXES),
-            )
-        });
+        time(name, &move_state(jerk), cycle);
     }
     g.finish();
 }

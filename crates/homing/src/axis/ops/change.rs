@@ -35,7 +35,7 @@ impl Axis {
         let State::Motion(m) = self.state else {
             return Err((ERR_EXECUTION_COLLISION, EX_NOTHING_TO_CHANGE));
         };
-        if c.speed.is_some_and(|s| !(s > 0.0)) {
+        if c.speed.is_some_and(|s| s.is_nan() || s <= 0.0) {
             // A magnitude: a jog keeps its direction.
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_SPEED));
         }
