@@ -225,6 +225,7 @@ fn home(r: &mut Rig) {
 
 fn held_jog(r: &mut Rig, speed: f64, cycles: u16, every: u16, max_decel: f64) {
     let jog = Operation::Jog(JogSpec {
+        jerk: None,
         speed,
         lease: Some((300 * MS) as f64 * 1e-9),
         accel: Some(500.0),
