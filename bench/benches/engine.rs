@@ -1,5 +1,6 @@
 //! Engine benchmarks (criterion): one `Axis::step` in the middle of a homing
-//! leg, one cycle monitor's verdict on that step's command
+//! leg and of a move (`engine_step/move_trapezoid`, `move_scurve`), one
+//! cycle monitor's verdict on that step's command
 //! (`engine_step/monitor`: `Monitor::check`, what the cycle adds per axis
 //! between the engine and the frame), and one whole cycle's compute
 //! (`Core::step` + `Core::fill`, the monitors included) for 1, 8, 32 and 64
@@ -41,7 +42,7 @@
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use motion_bench::engine::{
-    homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
+    homing_core, move_state, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
 use motion_homing::profile::{Kinematics, Profile, Ramp};
 use motion_homing::{Axis, Command, Phase, Status};
@@ -80,15 +81,16 @@ const CYCLE_AXES: u64 = 64;
 
 fn engine_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("engine_step");
-    for (name, state, phase) in [
-        ("seek", seek_state(), Phase::Seek),
-        ("torque_detect", torque_state(), Phase::Seek),
-    ] {
-        check(&format!("engine_step/{name}"), &state, phase);
-        // Each iteration steps a fresh copy of the captured axis (the copy
-        // is made outside the timed loop), with the feedback the plant gave.
-        // The copies of a batch are as many as a cycle's axes: the step as
-        // the cycle runs it, with the axis's state in the cache.
+    // Each iteration steps a fresh copy of the captured axis (the copy is
+    // made outside the timed loop), with the feedback the plant gave. The
+    // copies of a batch are as many as a cycle's axes (`NumIterations`):
+    // the step as the cycle runs it, with the axis's state in the cache.
+    // `seek_cold` is the same with criterion's `SmallInput` batches, which
+    // grow with the iteration count (to tens of MB of copies): each step
+    // then streams its copy from memory, and the figure is about
+    // `size_of::<Axis>()` / memory bandwidth, not the step. Shown, without
+    // a goal, because earlier measurements were made so.
+    let mut time = |name: &str, state: &Captured, batch: BatchSize| {
         let step = |axis: &mut Axis| {
             axis.step(
                 black_box(state.now),
@@ -97,22 +99,24 @@ fn engine_step(c: &mut Criterion) {
             )
         };
         g.bench_function(name, |b| {
-            b.iter_batched_ref(
-                || state.axis.clone(),
-                step,
-                BatchSize::NumIterations(CYCLE_AXES),
-            )
+            b.iter_batched_ref(|| state.axis.clone(), step, batch)
         });
+    };
+    let cycle = BatchSize::NumIterations(CYCLE_AXES);
+    for (name, state, phase) in [
+        ("seek", seek_state(), Phase::Seek),
+        ("torque_detect", torque_state(), Phase::Seek),
+    ] {
+        check(&format!("engine_step/{name}"), &state, phase);
+        time(name, &state, cycle);
         if name == "seek" {
-            // The same with criterion's `SmallInput` batches, which grow
-            // with the iteration count (to tens of MB of copies): each step
-            // then streams its copy from memory, and the figure is about
-            // `size_of::<Axis>()` / memory bandwidth, not the step. Shown,
-            // without a goal, because earlier measurements were made so.
-            g.bench_function("seek_cold", |b| {
-                b.iter_batched_ref(|| state.axis.clone(), step, BatchSize::SmallInput)
-            });
+            time("seek_cold", &state, BatchSize::SmallInput);
         }
+    }
+    // A move's step, trapezoid against S-curve (jerk: the demo axis's
+    // acceleration 500 reached in 50 ms), in the acceleration phase.
+    for (name, jerk) in [("move_trapezoid", 0.0), ("move_scurve", 10_000.0)] {
+        time(name, &move_state(jerk), cycle);
     }
     g.finish();
 }
@@ -340,6 +344,8 @@ fn summary(dir: &Path, since: SystemTime) {
         ("engine_step/seek".into(), 1, Some(50.0)),
         ("engine_step/torque_detect".into(), 1, Some(50.0)),
         ("engine_step/seek_cold".into(), 1, None),
+        ("engine_step/move_trapezoid".into(), 1, Some(50.0)),
+        ("engine_step/move_scurve".into(), 1, None),
         ("engine_step/monitor".into(), 1, Some(50.0)),
     ];
     for what in ["plan", "plan_turn", "stop_at", "sample"] {

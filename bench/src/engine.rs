@@ -1,7 +1,8 @@
 //! Engine states for the engine bench, reached by real homing against
 //! the sim plants (never built by hand, so they are states the engine
 //! really passes through): one axis's step inputs captured mid-homing
-//! ([`seek_state`], [`torque_state`]), and a whole [`Core`] of `n` axes
+//! ([`seek_state`], [`torque_state`]) or mid-move ([`move_state`]:
+//! trapezoid or S-curve), and a whole [`Core`] of `n` axes
 //! homing ([`homing_core`] of [`repeated_demo`]). The engine bench
 //! (`bench/benches/engine.rs`) times these.
 
@@ -166,4 +167,58 @@ pub fn phases(core: &Core) -> String {
         .map(|(n, k)| format!("{k} {n}"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Axis X of the demo machine homed where it stands (immediate), enabled,
+/// and ten cycles into a move of +40 units at its home speed and
+/// acceleration — in the acceleration phase, where an S-curve samples a
+/// segment with jerk: `jerk` 0 plans a trapezoid, above 0 an S-curve.
+pub fn move_state(jerk: f64) -> Captured {
+    use motion_homing::{HomeSequence, MoveSpec, Operation};
+    let m = demo();
+    let a = m.axes.iter().find(|a| a.name == "X").expect("demo axis X");
+    // Immediate homing derives no speed bound: the homing speed is it.
+    let mut axis = Axis::new(motion_homing::AxisConfig {
+        home_sequence: HomeSequence::Immediate,
+        max_speed: a.engine.max_speed.max(a.engine.home_speed),
+        ..a.engine
+    });
+    let mut plant = Plant::new(a.sim);
+    let dt_ns = m.supervisor.cycle_ns();
+    let dt = dt_ns as f64 * 1e-9;
+    let mut fb = plant.feedback();
+    let mut started = None;
+    for k in 0..10_000u64 {
+        let now = k * dt_ns;
+        let s = *axis.status();
+        let mut request = Request {
+            home: s.servo_action,
+            ..Request::default()
+        };
+        if k == 1 {
+            request.op = Some(Operation::Enable);
+        }
+        if s.homed && s.servo_action && started.is_none() {
+            started = Some(k);
+            request.op = Some(Operation::Move(MoveSpec {
+                target: 40.0,
+                relative: true,
+                jerk: Some(jerk),
+                ..MoveSpec::to(0.0)
+            }));
+        }
+        if started.is_some_and(|s0| k == s0 + 10) {
+            assert!(axis.status().moving, "the move runs");
+            return Captured {
+                axis,
+                feedback: fb,
+                now,
+                request,
+                cycle: k,
+            };
+        }
+        let cmd = axis.step(now, Some(&fb), &request);
+        fb = plant.step(&cmd, dt);
+    }
+    panic!("axis X: the move never started");
 }

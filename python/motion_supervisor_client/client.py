@@ -244,16 +244,23 @@ class Supervisor:
         return self.operate("reset", axes)
 
     def move(self, axis: str, *args, **params) -> ControlResponse:
-        """MAM: a trapezoidal move of `axis`; the parameters are the
-        engine's (`OPERATIONS["move"]`, in order: the target first) —
-        `move("X", 12.5)`, `move("X", 2, relative=True, speed=5)`."""
+        """MAM: a move of `axis` (an S-curve with `jerk` above 0); the
+        parameters are the engine's (`OPERATIONS["move"]`, in order: the
+        target first) — `move("X", 12.5)`, `move("X", 2, relative=True,
+        speed=5)`, `move("X", 40, jerk=20000)`."""
         return self.operate("move", [axis], *args, **params)
+
+    def change(self, axis: str, **params) -> ControlResponse:
+        """MCD: new dynamics for the jog or move `axis` runs now (the
+        engine's `OPERATIONS["change"]`: speed, accel, decel, jerk; each
+        left out keeps the running motion's) — `change("X", speed=5)`."""
+        return self.operate("change", [axis], **params)
 
     def jog(self, axis: str, *args, **params) -> "Jog":
         """MAJ, hold to run: a Jog of `axis` whose lease the caller renews
         (`Jog.renew`, `Jog.hold`); it stops when the renewals stop. The
         parameters are the engine's (`OPERATIONS["jog"]`): speed, lease
-        (s), accel, decel — `jog("X", -2.0)`."""
+        (s), accel, decel, jerk — `jog("X", -2.0)`."""
         return Jog(self, self.operate("jog", [axis], *args, **params))
 
     def stream(self, axes, owner: str = "python") -> "SetpointStream":

@@ -169,6 +169,7 @@ fn engine(r: &mut Reader<'_>, sup: &SupervisorConfig) -> AxisConfig {
         stream_acceleration: d.stream_acceleration,
         stream_timeout_ns: d.stream_timeout_ns,
         stream_unhomed: d.stream_unhomed,
+        jerk: d.jerk,
         home_reverse_at_limit: r.bool(&HOME_REVERSE_AT_LIMIT),
         // set by the EtherCAT keys (`drive_homing`)
         drive_homing: false,

@@ -158,6 +158,8 @@ fn lockstep_checks(gantry: &str, sides: &[usize], axes: &[AxisEntry], problems: 
             ),
             ("home_torque_time", e.home_torque_time == f.home_torque_time),
             ("travel", e.travel == f.travel),
+            // A jog or move of the gantry plans every side alike.
+            ("jerk", e.jerk == f.jerk),
             ("home_order", a.home_order == b.home_order),
         ];
         for (key, ok) in same {

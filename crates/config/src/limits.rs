@@ -14,6 +14,8 @@ pub const POSITION: f64 = 1e9;
 pub const SPEED: f64 = 1e6;
 /// Accelerations and decelerations, units/s².
 pub const ACCELERATION: f64 = 1e9;
+/// Jerks, units/s³: the most an operation may ask for.
+pub const JERK: f64 = motion_homing::MAX_JERK;
 /// Largest |position| in counts: positions travel as i64 counts and are
 /// converted through f64, exact up to 2^53.
 pub const MAX_COUNTS: f64 = 9.0e15;

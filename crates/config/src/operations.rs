@@ -1,7 +1,7 @@
 //! The keys of the operations around homing (declared in
 //! [`crate::keytable::operations`]):
 //! `unhomed_speed`, `limit_switches`, `max_deceleration`,
-//! `stream_acceleration`, `stream_timeout_ms`, `stream_unhomed`
+//! `stream_acceleration`, `stream_timeout_ms`, `stream_unhomed`, `jerk`
 //! (`travel_limits` and `max_speed` are read with the homing keys).
 //!
 //! A number left out takes its default from the homing attributes, and the
@@ -33,4 +33,5 @@ pub(crate) fn keys(r: &mut Reader<'_>, engine: &mut AxisConfig) {
     let ms = r.f64_in(&STREAM_TIMEOUT_MS);
     engine.stream_timeout_ns = (ms * 1e6).round() as u64;
     engine.stream_unhomed = r.bool(&STREAM_UNHOMED);
+    engine.jerk = r.f64_in(&JERK_KEY);
 }

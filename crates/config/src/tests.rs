@@ -607,3 +607,31 @@ home_deceleration = 500.0
     }
     assert_eq!(lines.len(), 6, "{lines:#?}");
 }
+
+/// `jerk`: 0 when left out (trapezoids), read when given, refused when
+/// negative; a gantry's sides must agree on it (they jog and move alike).
+#[test]
+fn the_jerk_key() {
+    let base = r#"
+[[axis]]
+name = "X"
+home_sequence = "immediate"
+home_speed = 20.0
+home_acceleration = 400.0
+home_deceleration = 500.0
+"#;
+    let m = parse(base).unwrap_or_else(|p| panic!("{p:#?}"));
+    assert_eq!(m.axes[0].engine.jerk, 0.0);
+    let m = parse(&format!("{base}jerk = 20000.0\n")).unwrap_or_else(|p| panic!("{p:#?}"));
+    assert_eq!(m.axes[0].engine.jerk, 20_000.0);
+    for bad in ["-1.0", "inf", "2e12"] {
+        let lines = problems_of(&format!("{base}jerk = {bad}\n"));
+        has(&lines, "axis X: jerk: ");
+    }
+    let one_side = GANTRY_TOML.replacen("name = \"Y1\"\n", "name = \"Y1\"\njerk = 1000.0\n", 1);
+    assert_ne!(one_side, GANTRY_TOML);
+    let lines = problems_of(&one_side);
+    has(&lines, "axis Y2: jerk: gantry Y: differs from side Y1");
+    let both = one_side.replacen("name = \"Y2\"\n", "name = \"Y2\"\njerk = 1000.0\n", 1);
+    parse(&both).unwrap_or_else(|p| panic!("{p:#?}"));
+}

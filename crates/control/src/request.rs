@@ -353,6 +353,7 @@ mod tests {
                     lease: Some(0.5),
                     accel: None,
                     decel: Some(40.0),
+                    jerk: None,
                 }),
             },
             Request::JogRenew {

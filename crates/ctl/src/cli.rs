@@ -3,7 +3,7 @@
 use crate::spec_args::SpecArgs;
 use clap::{Args, Parser, Subcommand};
 use motion_config::args::{axis, runtime_dir, seconds, service_prefix};
-use motion_control::{JogSpec, MoveSpec};
+use motion_control::{ChangeSpec, JogSpec, MoveSpec};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -67,7 +67,7 @@ pub enum Command {
     /// MAJ, hold to run: jog AXIS (or a gantry) while this command runs;
     /// Ctrl-C/SIGTERM, --for, `stop`, a limit or a fault end it.
     Jog(JogArgs),
-    /// MAM: a trapezoidal move of AXIS (or a gantry) to P or by D; waits
+    /// MAM: a move (trapezoidal, or an S-curve with a jerk) of AXIS (or a gantry) to P or by D; waits
     /// like `home` (exit 0 only when it ended at the target).
     Move(MoveArgs),
     /// Play a CSV file of timed setpoints ("t,p1[,p2...]": s, units; one
@@ -82,6 +82,10 @@ pub enum Command {
     /// max_speed and stream_acceleration on the supervisor's own clock; a
     /// file it cannot follow within them stops it (1019 / 3 or 4).
     Stream(StreamArgs),
+    /// MCD: new speed, acceleration, deceleration or jerk for the jog or
+    /// move AXIS (or a gantry) runs now, re-planned from where it is; each
+    /// left out keeps the running motion's.
+    Change(ChangeArgs),
 }
 
 #[derive(Debug, Args)]
@@ -126,7 +130,7 @@ pub struct JogArgs {
     #[arg(value_name = "AXIS", value_parser = axis)]
     pub axis: String,
     /// The jog's parameters (the engine's `JogSpec`): --speed V [--accel
-    /// A] [--decel D].
+    /// A] [--decel D] [--jerk J].
     #[command(flatten)]
     pub jog: SpecArgs<JogSpec>,
     /// Stop after S seconds.
@@ -142,12 +146,25 @@ pub struct MoveArgs {
     #[arg(value_name = "AXIS", value_parser = axis)]
     pub axis: String,
     /// The move's parameters (the engine's `MoveSpec`): (--to P | --by D)
-    /// [--speed V] [--accel A] [--decel D] and its switches.
+    /// [--speed V] [--accel A] [--decel D] [--jerk J] and its switches.
     #[command(flatten)]
     pub spec: SpecArgs<MoveSpec>,
     /// Return once the move is accepted, without following it.
     #[arg(long)]
     pub no_wait: bool,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ChangeArgs {
+    /// The axis or gantry whose jog or move changes.
+    #[arg(value_name = "AXIS", value_parser = axis)]
+    pub axis: String,
+    /// The new dynamics (the engine's `ChangeSpec`): [--speed V] [--accel
+    /// A] [--decel D] [--jerk J].
+    #[command(flatten)]
+    pub spec: SpecArgs<ChangeSpec>,
     #[arg(long)]
     pub json: bool,
 }
@@ -213,6 +230,7 @@ impl Command {
             Command::Jog(a) => a.json,
             Command::Move(a) => a.json,
             Command::Stream(a) => a.json,
+            Command::Change(a) => a.json,
             Command::Stats(a) => a.json,
             Command::Trace(a) => a.json,
         }

@@ -848,6 +848,31 @@ pub const TABLE: &[Code] = &[
         .ours()
         .cause("The cycle monitor stopped the axis: a command broke one of its invariants.")
         .remedy("See the EXERR's row; `reset`."),
+    code(
+        ERR_PARAMETER_OUT_OF_RANGE,
+        EX_PARAM_JERK,
+        &[R],
+        "parameter out of range: jerk",
+    )
+    .ours()
+    .cause(
+        "A jog, move or change asked for a negative or infinite jerk (0 plans a trapezoid, \
+         above 0 an S-curve).",
+    )
+    .remedy("Give a jerk of 0 or more units/s³, or leave it out for the axis's `jerk`."),
+    code(
+        ERR_EXECUTION_COLLISION,
+        EX_NOTHING_TO_CHANGE,
+        &[R],
+        "change: no jog or move runs on the axis",
+    )
+    .ours()
+    .cause(
+        "A change of dynamics (MCD) on an axis that neither jogs nor moves: at rest, \
+         stopping, or homing's abort coming to rest. (Homing itself refuses with 16, a \
+         stream with 3 / 0.)",
+    )
+    .remedy("Change a motion while it runs; start a new jog or move with the dynamics instead."),
 ];
 
 /// The row of `(err, exerr)`: its own, else the one for any EXERR of `err`.

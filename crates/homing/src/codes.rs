@@ -119,6 +119,12 @@ pub const EX_PARAM_LEASE: u16 = 6;
 /// No speed bound: `max_speed` is not set and the homing derives none
 /// (an immediate, absolute or passive homing): nothing may move the axis.
 pub const EX_PARAM_NO_MAX_SPEED: u16 = 7;
+/// The jerk: negative or not finite (0 is a trapezoid).
+pub const EX_PARAM_JERK: u16 = 8;
+
+// EXERR under ERR 3.
+/// A change of dynamics (MCD) with no jog or move running to change.
+pub const EX_NOTHING_TO_CHANGE: u16 = 1;
 
 // EXERR under ERR 1019.
 pub const EX_SETPOINT_NOT_FINITE: u16 = 1;

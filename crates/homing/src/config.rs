@@ -301,6 +301,11 @@ pub struct AxisConfig {
     /// `axis::drive_homing`). The drive's homing method and speeds are the
     /// I/O process's to set; the engine only asks and watches.
     pub drive_homing: bool,
+    /// Jerk of jogs, moves and their normal stops, units/s³ (the `jerk`
+    /// key; a request's own `jerk` overrides it): an S-curve, whose
+    /// acceleration ramps at this rate instead of stepping. `0.0`:
+    /// trapezoidal. A fault's stop never uses it (`axis::ops`).
+    pub jerk: f64,
 }
 
 impl Default for AxisConfig {
@@ -353,6 +358,7 @@ impl Default for AxisConfig {
             stream_unhomed: false,
             home_reverse_at_limit: false,
             drive_homing: false,
+            jerk: 0.0,
         }
     }
 }

@@ -49,7 +49,7 @@ pub use config::*;
 pub use io::*;
 pub use op_limits::{
     effective_max_deceleration, effective_stream_acceleration, effective_stream_timeout_ns,
-    effective_unhomed_speed, OpLimits,
+    effective_unhomed_speed, OpLimits, MAX_JERK,
 };
 // Every operation, its verbs and its spec types, whatever the table adds.
 pub use operation::*;

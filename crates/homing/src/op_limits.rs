@@ -16,6 +16,11 @@ pub const STREAM_ACCELERATION_FACTOR: f64 = 10.0;
 /// longer one is no longer "hold to run".
 pub const JOG_LEASE_NS: (u64, u64) = (50_000_000, 5_000_000_000);
 
+/// Largest jerk a jog, move or change may ask for, units/s³ (the `jerk`
+/// key's bound too): an acceleration of 1e9 units/s² reached in a
+/// millisecond. Beyond it a plan's numbers lose their meaning.
+pub const MAX_JERK: f64 = 1e12;
+
 fn positive(x: f64) -> Option<f64> {
     (x.is_finite() && x > 0.0).then_some(x)
 }

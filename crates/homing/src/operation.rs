@@ -350,7 +350,7 @@ operations! {
         moves: true,
         held: false,
         all: false,
-        summary: "MAM: a trapezoidal move to Target (or by it); done when MoveStatus drops",
+        summary: "MAM: a move to Target (or by it), S-curve with a Jerk; done when MoveStatus drops",
     }
     /// The supervised stream starts: from now on the axis follows the
     /// setpoints of `Request::setpoint`, interpolated to the cycle, each one
@@ -390,6 +390,28 @@ operations! {
         all: true,
         summary: "MAS: stop the axis",
     }
+    /// MCD: new dynamics for the jog or move that runs now ([`ChangeSpec`]),
+    /// re-planned from its exact state. Answered in place: accepted, the
+    /// motion keeps its operation's id (its client follows it on); refused,
+    /// `Status::op.refused` holds why and the motion runs on unchanged.
+    Change(ChangeSpec) = 9 {
+        name: "change",
+        title: "Change",
+        client: true,
+        moves: true,
+        held: false,
+        all: false,
+        summary: "MCD: new speed, acceleration, deceleration or jerk for the running jog or move",
+    }
+}
+
+impl OpKind {
+    /// Answered in place: an accepted one leaves `Status::op.id` as it was
+    /// (the running motion keeps its id); only `Status::op.refused` tells
+    /// (cleared when accepted, set when refused).
+    pub const fn in_place(self) -> bool {
+        matches!(self, OpKind::Change)
+    }
 }
 
 /// A motion's acceleration (a jog's, a move's): one parameter, whichever
@@ -401,6 +423,10 @@ const ACCEL: Param = Param::new("Accel", Unit::Acceleration)
 const DECEL: Param = Param::new("Decel", Unit::Acceleration)
     .or(Fallback::HomeDeceleration)
     .flag("decel", "D");
+/// A motion's jerk: an S-curve when above 0.
+const JERK: Param = Param::new("Jerk", Unit::Jerk)
+    .or(Fallback::Jerk)
+    .flag("jerk", "J");
 
 crate::op_spec! {
     /// MAJ / MC_Jog, hold to run: runs in the sign of `speed` until stopped
@@ -419,6 +445,9 @@ crate::op_spec! {
         accel: Option<f64> = ACCEL,
         /// Deceleration, units/s²; left out: the axis's `home_deceleration`.
         decel: Option<f64> = DECEL,
+        /// Jerk, units/s³ (> 0: an S-curve; 0: a trapezoid); left out: the
+        /// axis's `jerk`.
+        jerk: Option<f64> = JERK,
     }
 }
 
@@ -449,6 +478,27 @@ crate::op_spec! {
         /// Replace a jog or move in progress (without it such an axis
         /// refuses with ERR 3).
         supersede: bool = Param::new("Supersede", Unit::None).flag("supersede", ""),
+        /// Jerk, units/s³ (> 0: an S-curve; 0: a trapezoid); left out: the
+        /// axis's `jerk`.
+        jerk: Option<f64> = JERK,
+    }
+}
+
+crate::op_spec! {
+    /// MCD: new dynamics for the jog or move that runs now, re-planned
+    /// from its exact state (position, velocity, acceleration); each
+    /// number left out keeps the running motion's.
+    pub struct ChangeSpec {
+        /// Speed (magnitude), units/s; a jog keeps its direction. Left out:
+        /// the running motion's.
+        speed: Option<f64> = Param::new("Speed", Unit::Speed).flag("speed", "V"),
+        /// Acceleration, units/s²; left out: the running motion's.
+        accel: Option<f64> = Param::new("Accel", Unit::Acceleration).flag("accel", "A"),
+        /// Deceleration, units/s²; left out: the running motion's.
+        decel: Option<f64> = Param::new("Decel", Unit::Acceleration).flag("decel", "D"),
+        /// Jerk, units/s³ (> 0: an S-curve; 0: a trapezoid); left out: the
+        /// running motion's.
+        jerk: Option<f64> = Param::new("Jerk", Unit::Jerk).flag("jerk", "J"),
     }
 }
 
@@ -460,15 +510,20 @@ pub struct Dynamics {
     pub speed: f64,
     pub accel: f64,
     pub decel: f64,
+    /// units/s³: 0 plans trapezoids, above 0 S-curves.
+    pub jerk: f64,
 }
 
 impl Dynamics {
-    fn of(speed: Option<f64>, accel: Option<f64>, decel: Option<f64>) -> Self {
+    fn of(speed: Option<f64>, accel: Option<f64>, decel: Option<f64>, jerk: Option<f64>) -> Self {
         let n = |x: Option<f64>| x.unwrap_or(f64::NAN);
         Dynamics {
             speed: n(speed),
             accel: n(accel),
             decel: n(decel),
+            // No default configured (an engine without the `jerk` key): a
+            // trapezoid, as before jerk existed.
+            jerk: jerk.unwrap_or(0.0),
         }
     }
 }
@@ -481,12 +536,13 @@ impl JogSpec {
             lease: None,
             accel: None,
             decel: None,
+            jerk: None,
         }
     }
 
-    /// The signed speed and the acceleration, deceleration.
+    /// The signed speed and the acceleration, deceleration, jerk.
     pub fn dynamics(&self) -> Dynamics {
-        Dynamics::of(Some(self.speed), self.accel, self.decel)
+        Dynamics::of(Some(self.speed), self.accel, self.decel, self.jerk)
     }
 
     /// The lease to the nearest ns (0 when left out or not a positive
@@ -510,12 +566,35 @@ impl MoveSpec {
             accel: None,
             decel: None,
             supersede: false,
+            jerk: None,
         }
     }
 
-    /// The speed, acceleration and deceleration.
+    /// The speed, acceleration, deceleration and jerk.
     pub fn dynamics(&self) -> Dynamics {
-        Dynamics::of(self.speed, self.accel, self.decel)
+        Dynamics::of(self.speed, self.accel, self.decel, self.jerk)
+    }
+}
+
+impl ChangeSpec {
+    /// A change of nothing (every number left out): add what changes.
+    pub fn none() -> Self {
+        ChangeSpec {
+            speed: None,
+            accel: None,
+            decel: None,
+            jerk: None,
+        }
+    }
+
+    /// The running motion's dynamics `d` with what this change gives.
+    pub fn applied_to(&self, d: Dynamics) -> Dynamics {
+        Dynamics {
+            speed: self.speed.unwrap_or(d.speed),
+            accel: self.accel.unwrap_or(d.accel),
+            decel: self.decel.unwrap_or(d.decel),
+            jerk: self.jerk.unwrap_or(d.jerk),
+        }
     }
 }
 
@@ -538,7 +617,9 @@ pub struct Setpoint {
 ///
 /// A caller that passed an operation in a step reads this after the step:
 /// `id` changed → accepted (it is then the operation described); `id`
-/// unchanged → refused, `refused` holds the ERR / EXERR. A refusal is the
+/// unchanged → refused, `refused` holds the ERR / EXERR. An operation
+/// answered in place ([`OpKind::in_place`]: a change) keeps `id`: accepted
+/// when `refused` is `None` after the step. A refusal is the
 /// instruction's error, not an axis fault: it sets nothing else and leaves
 /// the running operation (and the axis's ER) as they were.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -109,6 +109,8 @@ pub enum Fallback {
     HomeDeceleration,
     /// [`JOG_LEASE_S`].
     JogLease,
+    /// The axis's `jerk` (0: trapezoidal).
+    Jerk,
 }
 
 impl Fallback {
@@ -120,6 +122,7 @@ impl Fallback {
             Fallback::HomeAcceleration => Some("the axis's home_acceleration"),
             Fallback::HomeDeceleration => Some("the axis's home_deceleration"),
             Fallback::JogLease => Some("0.5 s"),
+            Fallback::Jerk => Some("the axis's jerk"),
         }
     }
 
@@ -131,6 +134,7 @@ impl Fallback {
             Fallback::HomeAcceleration => Some(cfg.home_acceleration),
             Fallback::HomeDeceleration => Some(cfg.home_deceleration),
             Fallback::JogLease => Some(JOG_LEASE_S),
+            Fallback::Jerk => Some(cfg.jerk),
         }
     }
 }

@@ -285,10 +285,11 @@ fn coordination_feedback_trouble_and_references_make_no_allocation() {
     assert_eq!(during, 0, "allocator calls inside the engine");
 }
 
-/// The operations around homing: enable, home, jog (renewed, to the soft
+/// The operations around homing: enable, home, jog (an S-curve, renewed, to the soft
 /// limit, by lease), moves (superseded, refused), the stream at the cycle
 /// rate and at 100 Hz with a refused setpoint, a limit switch hit, a drive
-/// fault, reset, disable, and refusals of every kind.
+/// fault, reset, disable, an S-curve move changed (MCD), and refusals of
+/// every kind.
 #[test]
 fn operations_make_no_allocation() {
     const T: u64 = 1_000_000;
@@ -310,12 +311,14 @@ fn operations_make_no_allocation() {
         ..PlantConfig::default()
     });
     let mut fb = plant.feedback();
+    // S-curves (jerk) for the first jog and move, trapezoids after.
     let jog = |speed: f64| {
         Operation::Jog(JogSpec {
             speed,
             accel: Some(500.0),
             decel: Some(500.0),
             lease: Some(time::ns_to_s(300 * T)),
+            jerk: (speed > 10.0).then_some(20_000.0),
         })
     };
     let mv = |target: f64, supersede: bool| {
@@ -326,8 +329,15 @@ fn operations_make_no_allocation() {
             accel: Some(500.0),
             decel: Some(500.0),
             supersede,
+            jerk: (!supersede).then_some(5_000.0),
         })
     };
+    // MCD on the S-curve move, then on nothing (refused).
+    let change = Operation::Change(ChangeSpec {
+        speed: Some(10.0),
+        jerk: Some(3_000.0),
+        ..ChangeSpec::none()
+    });
     // (step, request) of the script; every other step is empty.
     let sp = |t_ms: u64, p: f64| Request {
         setpoint: Some(Setpoint {
@@ -354,6 +364,7 @@ fn operations_make_no_allocation() {
                 ..Request::default()
             },
             800 => op(mv(-5.0, false)),
+            810 | 1450 => op(change),
             850 => op(jog(5.0)),
             860 => op(mv(2.0, true)),
             1500 => op(Operation::StreamStart),
@@ -388,6 +399,7 @@ fn operations_make_no_allocation() {
     let mut during = 0;
     // Jogging, moving, streaming, a refused setpoint, a drive fault: seen.
     let mut seen = [false; 5];
+    let mut changed = false;
     for k in 0..3200u64 {
         let req = script(k);
         let mut cmd = Command::default();
@@ -399,6 +411,7 @@ fn operations_make_no_allocation() {
             plant.inject_fault();
         }
         let s = axis.status();
+        changed |= k == 810 && s.moving && s.op.refused.is_none();
         for (i, b) in [
             s.jogging,
             s.moving,
@@ -413,6 +426,7 @@ fn operations_make_no_allocation() {
         }
     }
     assert_eq!(seen, [true; 5]);
+    assert!(changed, "the change was accepted");
     // The unhomed part: a jog into the limit switch and a reset.
     let mut axis = Axis::new(AxisConfig {
         max_deceleration: 2000.0,
@@ -432,6 +446,7 @@ fn operations_make_no_allocation() {
                 accel: Some(500.0),
                 decel: Some(500.0),
                 lease: Some(time::ns_to_s(5_000 * T)),
+                jerk: None,
             })),
             1500 => op(Operation::Reset),
             1510 => op(jog(-5.0)),
@@ -458,6 +473,7 @@ fn move_outside() -> Operation {
         accel: Some(500.0),
         decel: Some(500.0),
         supersede: false,
+        jerk: None,
     })
 }
 

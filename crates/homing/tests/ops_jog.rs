@@ -126,6 +126,7 @@ fn the_lease_keeps_a_renewed_jog_and_stops_one_that_is_not() {
         accel: Some(500.0),
         decel: Some(500.0),
         lease: Some(secs(100 * MS)),
+        jerk: None,
     });
     let id = r.op(lease).unwrap();
     for k in 1..=1000 {
@@ -184,6 +185,7 @@ fn unhome_during_a_jog_drops_the_limit_and_slows_to_the_cap() {
         accel: Some(500.0),
         decel: Some(500.0),
         lease: Some(secs(5_000 * MS)),
+        jerk: None,
     });
     r.op(fast).unwrap();
     r.run(100);
@@ -229,6 +231,7 @@ fn a_jog_checks_every_operand() {
             accel: Some(accel),
             decel: Some(decel),
             lease: Some(secs(lease_ns)),
+            jerk: None,
         })
     };
     let p = ERR_PARAMETER_OUT_OF_RANGE;

@@ -30,6 +30,7 @@ fn long_jog(speed: f64) -> Operation {
         accel: Some(500.0),
         decel: Some(500.0),
         lease: Some(secs(5_000 * MS)),
+        jerk: None,
     })
 }
 

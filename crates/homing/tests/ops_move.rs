@@ -40,6 +40,7 @@ fn a_move_lands_exactly_on_its_target_with_pc() {
         accel: Some(500.0),
         decel: Some(500.0),
         supersede: false,
+        jerk: None,
     }))
     .unwrap();
     assert!(r.run_until(1000, |s| s.op.pc));
@@ -63,6 +64,7 @@ fn targets_outside_the_travel_limits_are_refused_while_homed() {
             accel: Some(500.0),
             decel: Some(500.0),
             supersede: false,
+            jerk: None,
         })
     };
     assert_eq!(r.op(by(10.5)), target);
@@ -102,6 +104,7 @@ fn a_move_on_a_jogging_or_moving_axis_needs_supersede() {
         accel: Some(500.0),
         decel: Some(500.0),
         supersede: true,
+        jerk: None,
     });
     let id = r.op(sup).unwrap();
     assert!(r.axis.status().moving && !r.axis.status().jogging);
@@ -141,6 +144,7 @@ fn a_supersede_that_could_not_stop_inside_the_limits_is_refused() {
         accel: Some(2000.0),
         decel: Some(2000.0),
         lease: Some(secs(5_000 * MS)),
+        jerk: None,
     }))
     .unwrap();
     while r.cmd_axis() < 9.4 {
@@ -153,6 +157,7 @@ fn a_supersede_that_could_not_stop_inside_the_limits_is_refused() {
         accel: Some(500.0),
         decel: Some(500.0),
         supersede: true,
+        jerk: None,
     });
     assert_eq!(
         r.op(back),
@@ -219,6 +224,7 @@ fn cyclic_axes_move_the_shortest_way_and_have_no_travel_limits() {
         accel: Some(5000.0),
         decel: Some(5000.0),
         supersede: false,
+        jerk: None,
     });
     r.op(m).unwrap();
     assert!(r.run_until(1000, |s| s.op.pc));
@@ -232,6 +238,7 @@ fn cyclic_axes_move_the_shortest_way_and_have_no_travel_limits() {
         accel: Some(5000.0),
         decel: Some(5000.0),
         supersede: false,
+        jerk: None,
     }))
     .unwrap();
     assert!(r.run_until(20_000, |s| s.op.pc));
@@ -242,6 +249,7 @@ fn cyclic_axes_move_the_shortest_way_and_have_no_travel_limits() {
         accel: Some(5000.0),
         decel: Some(5000.0),
         lease: Some(secs(5_000 * MS)),
+        jerk: None,
     }))
     .unwrap();
     r.run(4000);
@@ -268,6 +276,7 @@ fn without_a_speed_bound_nothing_moves_but_homing_still_works() {
         accel: Some(1e9),
         decel: Some(500.0),
         supersede: false,
+        jerk: None,
     });
     assert_eq!(r.op(fast), none);
     assert_eq!(r.op(move_to(5.0)), none);

@@ -50,8 +50,7 @@ fn sane_op() -> impl Strategy<Value = Operation> {
                 speed: if neg { -s } else { s },
                 accel: Some(a),
                 decel: Some(d),
-                lease: Some(secs(lease * MS)),
-            })
+                lease: Some(secs(lease * MS)), jerk: None, })
         }),
         2 => (dynamics, -15.0..15.0f64, any::<bool>(), any::<bool>()).prop_map(
             |((speed, accel, decel), target, relative, supersede)| Operation::Move(MoveSpec {
@@ -60,8 +59,7 @@ fn sane_op() -> impl Strategy<Value = Operation> {
                 speed: Some(speed),
                 accel: Some(accel),
                 decel: Some(decel),
-                supersede,
-            })
+                supersede, jerk: None, })
         ),
         1 => Just(Operation::StreamStart),
         1 => Just(Operation::StreamEnd),
@@ -296,8 +294,7 @@ fn wild_op() -> impl Strategy<Value = Operation> {
                 speed,
                 lease,
                 accel,
-                decel,
-            })
+                decel, jerk: None, })
         ),
         2 => (wild(), any::<bool>(), maybe_wild(), maybe_wild(), maybe_wild(), any::<bool>())
             .prop_map(|(target, relative, speed, accel, decel, supersede)| {
@@ -307,8 +304,7 @@ fn wild_op() -> impl Strategy<Value = Operation> {
                     speed,
                     accel,
                     decel,
-                    supersede,
-                })
+                    supersede, jerk: None, })
             }),
         1 => Just(Operation::StreamStart),
         1 => Just(Operation::StreamEnd),

@@ -143,7 +143,7 @@ fn op(max_decel: f64) -> impl Strategy<Value = Operation> {
     let dynamics = (1.0..40.0f64, 100.0..5000.0f64, 0.05..1.0f64);
     prop_oneof![
         2 => (dynamics.clone(), any::<bool>(), 50u64..600).prop_map(move |((s, a, d), neg, lease)| {
-            Operation::Jog(JogSpec {
+            Operation::Jog(JogSpec { jerk: None,
                 speed: if neg { -s } else { s },
                 lease: Some((lease * MS) as f64 * 1e-9),
                 accel: Some(a),
@@ -151,7 +151,7 @@ fn op(max_decel: f64) -> impl Strategy<Value = Operation> {
             })
         }),
         3 => (dynamics, -45.0..45.0f64, any::<bool>(), any::<bool>()).prop_map(
-            move |((speed, accel, d), target, relative, supersede)| Operation::Move(MoveSpec {
+            move |((speed, accel, d), target, relative, supersede)| Operation::Move(MoveSpec { jerk: None,
                 target: if relative { target / 4.0 } else { target },
                 relative,
                 speed: Some(speed),
@@ -225,6 +225,7 @@ fn home(r: &mut Rig) {
 
 fn held_jog(r: &mut Rig, speed: f64, cycles: u16, every: u16, max_decel: f64) {
     let jog = Operation::Jog(JogSpec {
+        jerk: None,
         speed,
         lease: Some((300 * MS) as f64 * 1e-9),
         accel: Some(500.0),

@@ -59,6 +59,7 @@ fn ready(cfg: AxisConfig) -> Rig {
 
 fn jog(speed: f64, accel: f64) -> Operation {
     Operation::Jog(JogSpec {
+        jerk: None,
         speed,
         lease: Some((2_000 * MS) as f64 * 1e-9),
         accel: Some(accel),
@@ -185,6 +186,7 @@ fn an_acceleration_spike_within_the_speed_cap_trips_the_acceleration_check() {
     let mut r = ready(axis());
     // accelerating at 100 towards 20: 1 u/s more in one cycle is 1000 u/s²
     r.step(op(Operation::Move(MoveSpec {
+        jerk: None,
         target: 9.0,
         relative: false,
         speed: Some(20.0),

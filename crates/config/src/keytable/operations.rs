@@ -2,7 +2,7 @@
 //! stream, the stops). `travel_limits` and `max_speed` are in `axis.rs`.
 
 use super::{keys, Key, Kind, Section::Axis};
-use crate::limits::{ACCELERATION, SPEED};
+use crate::limits::{ACCELERATION, JERK, SPEED};
 
 keys! {
     GROUP {
@@ -60,4 +60,15 @@ keys! {
         .meaning("The setpoint stream may drive the axis while it is not homed (without soft \
                   limits); otherwise a stream needs HomedStatus (ERR 1019 / EXERR 7).")
         .example("false");
+    JERK_KEY: Key::new(Axis, "jerk", Kind::Number)
+        .num(0.0)
+        .range(0.0, JERK)
+        .unit("units/s³")
+        .fixed()
+        .meaning("Jerk of jogs, moves and their normal stops (S-curve, jerk-limited: the \
+                  acceleration ramps instead of stepping); `0`: trapezoidal. The default of \
+                  `jog`/`move --jerk`. A fault's stop (limit switch, drive fault, lost feedback, \
+                  a refused setpoint) never uses it: it takes the shortest stop \
+                  `max_deceleration` allows. A gantry's sides must agree.")
+        .example("20000.0");
 }

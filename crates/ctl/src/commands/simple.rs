@@ -1,10 +1,10 @@
 use super::{client_error, fail, EXIT_FAILED, EXIT_OK};
-use crate::cli::AxesArgs;
+use crate::cli::{AxesArgs, ChangeArgs};
 use motion_control::*;
 use motion_report::print_json;
 use std::time::Duration;
 
-/// What `stop` / `unhome` / `enable` / `disable` / `reset` send.
+/// What `stop` / `unhome` / `enable` / `disable` / `reset` / `change` send.
 pub enum Simple {
     /// A control-plane request (`REQ_STOP`, `REQ_UNHOME`).
     Kind(u32),
@@ -44,4 +44,15 @@ pub fn axes(client: &mut Client, what: Simple, a: &AxesArgs) -> i32 {
         println!("{what}: {}", names.join(" "));
     }
     EXIT_OK
+}
+
+/// `change AXIS [--speed V] [--accel A] [--decel D] [--jerk J]` (MCD): one
+/// request, answered at once (the motion it changes goes on; `move` or
+/// `jog` follows it).
+pub fn change(client: &mut Client, a: &ChangeArgs) -> i32 {
+    let named = AxesArgs {
+        axes: vec![a.axis.clone()],
+        json: a.json,
+    };
+    axes(client, Simple::Op(Operation::Change(a.spec.spec)), &named)
 }

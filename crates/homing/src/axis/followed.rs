@@ -7,7 +7,7 @@
 //! it back — the same numbers, bit for bit. The memory belongs to the
 //! profile: replacing the profile ([`Followed::set`]) forgets it.
 
-use crate::profile::Profile;
+use crate::profile::{Kinematics, Profile};
 
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Followed {
@@ -50,6 +50,13 @@ impl Followed {
             Some((t, p, v)) if t == now => (p, v),
             _ => self.profile.sample(now),
         }
+    }
+
+    /// Commanded position, velocity and acceleration at `now`: the exact
+    /// state a re-plan starts from (the same position and velocity as
+    /// [`Followed::at`], bit for bit).
+    pub fn state(&self, now: u64) -> Kinematics {
+        self.profile.state(now)
     }
 
     pub fn is_done(&self, now: u64) -> bool {

@@ -350,6 +350,7 @@ pub fn jog(speed: f64) -> Operation {
         accel: Some(500.0),
         decel: Some(500.0),
         lease: Some(secs(500 * MS)),
+        jerk: None,
     })
 }
 
@@ -362,6 +363,7 @@ pub fn move_to(target: f64) -> Operation {
         accel: Some(500.0),
         decel: Some(500.0),
         supersede: false,
+        jerk: None,
     })
 }
 

@@ -186,7 +186,7 @@ fn a_home_call_carries_its_timeout_and_refusals_say_why() {
 fn operations_decode_with_their_bounds() {
     let jog = spec("Jog", Scope::Axis).unwrap();
     let names: Vec<&str> = jog.inputs.iter().map(|a| a.name).collect();
-    assert_eq!(names, ["Speed", "Duration", "Accel", "Decel"]);
+    assert_eq!(names, ["Speed", "Duration", "Accel", "Decel", "Jerk"]);
     assert_eq!(
         decode(jog, Some("X"), &[Variant::from(-5.0), Variant::from(0.5)]),
         Ok(Call::Operate {
@@ -240,7 +240,15 @@ fn operations_decode_with_their_bounds() {
     let names: Vec<&str> = mv.inputs.iter().map(|a| a.name).collect();
     assert_eq!(
         names,
-        ["Target", "Relative", "Speed", "Accel", "Decel", "Supersede"]
+        [
+            "Target",
+            "Relative",
+            "Speed",
+            "Accel",
+            "Decel",
+            "Supersede",
+            "Jerk"
+        ]
     );
     let call = decode(
         mv,

@@ -43,6 +43,9 @@ pub(super) struct Pending {
     then: Then,
     /// A motion (jog, move, stream): a gantry accepts it whole or not at all.
     motion: bool,
+    /// Answered in place (a change): accepted when the engine left no
+    /// refusal, the running motion's id unchanged.
+    in_place: bool,
 }
 
 /// Operations that move the axis (or take it over to be moved).
@@ -123,6 +126,7 @@ impl Core {
             mask,
             then,
             motion: is_motion(&op),
+            in_place: op.kind().in_place(),
         });
         for i in named(mask, n) {
             let slot = &mut self.slots[i];
@@ -183,7 +187,8 @@ impl Core {
             let mut accepted = 0u64;
             for i in named(p.mask, n) {
                 let s = self.slots[i].status().op;
-                if s.id != self.slots[i].op_before {
+                let in_place = p.in_place && s.refused.is_none();
+                if in_place || s.id != self.slots[i].op_before {
                     accepted |= 1 << i;
                     p.ack.axes[i] = AxisAck::Accepted;
                     p.ack.op_ids[i] = s.id;
@@ -211,6 +216,8 @@ impl Core {
         }
         let undo = match p.then {
             Then::Own(_) => Operation::StreamEnd,
+            // A change accepted by some sides only: those sides would run
+            // on with other dynamics than the rest, so they stop too.
             _ => Operation::Stop,
         };
         for i in named(accepted, self.slots.len()) {

@@ -140,6 +140,7 @@ fn a_gantry_side_faulting_during_a_reset_stops_the_other_side() {
             lease: Some(0.5),
             accel: Some(100.0),
             decel: Some(100.0),
+            jerk: None,
         });
         b.op(0b11, jog, 42);
         b.run(100);

@@ -56,6 +56,7 @@ fn gantry_sides_that_move_apart_are_stopped_together_by_their_monitors() {
                 lease: Some(5.0),
                 accel: Some(500.0),
                 decel: Some(500.0),
+                jerk: None,
             }),
             token: 77,
         },

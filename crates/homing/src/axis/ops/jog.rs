@@ -4,17 +4,18 @@
 //! client that dies, hangs or loses its connection stops the axis within
 //! its lease.
 //!
-//! Planned from the current command state:
+//! Planned from the current command state (position, velocity and — for
+//! an S-curve, `jerk` above 0 — acceleration), with the jog's ramp:
 //!
 //! * homed, linear, with travel limits: as a move to the limit in its
-//!   direction at the jog's speed, acceleration and deceleration
-//!   (`Profile::move_to`): it cruises like a jog and, when its stopping
+//!   direction at the jog's speed, acceleration, deceleration and jerk
+//!   (`Profile::move_from`): it cruises like a jog and, when its stopping
 //!   distance reaches the limit, decelerates to rest exactly on it, ending
 //!   normally (`StopCause::SoftLimit`, PC). Planned at once, not cycle by
 //!   cycle, so a late step cannot carry it past the limit. (Worked example:
 //!   20 units/s, deceleration 500 units/s² → stopping distance
 //!   20² / (2·500) = 0.4: the deceleration starts at limit − 0.4.)
-//! * otherwise (not homed, cyclic, no limits): `Profile::jog` to ±speed,
+//! * otherwise (not homed, cyclic, no limits): `Profile::jog_from` to ±speed,
 //!   cruising until stopped. While not homed the speed is capped by
 //!   `unhomed_speed` (a faster jog is refused: 13 / 1).
 //!
@@ -29,7 +30,7 @@ use crate::axis::state::State;
 use crate::axis::Axis;
 use crate::codes::*;
 use crate::operation::{Dynamics, OpKind, StopCause};
-use crate::profile::Profile;
+use crate::profile::{Kinematics, Profile, Ramp};
 
 impl Axis {
     /// MAJ: the jog's dynamics (defaults resolved, the speed signed) and
@@ -39,23 +40,26 @@ impl Axis {
             speed,
             accel,
             decel,
+            jerk,
         } = d;
         self.motion_gate()?;
         self.jog_collides()?;
         self.check_dynamics(speed, accel, decel)?;
+        self.check_jerk(jerk)?;
         self.check_lease(lease_ns)?;
         self.switch_allows(speed)?;
         let jog = Jog {
             speed,
             accel,
             decel,
+            jerk,
             lease_ns,
             lease_until: now.saturating_add(lease_ns),
             limited: false,
             planned_speed: speed,
         };
-        let (t, p, v) = self.motion_state(now);
-        let (profile, jog) = self.plan_jog(t, p, v, jog)?;
+        let (t, k) = self.motion_state(now);
+        let (profile, jog) = self.plan_jog(t, k, jog)?;
         let op = self.accept_op(OpKind::Jog);
         self.profile.set(profile);
         self.state = State::Motion(Motion {
@@ -65,26 +69,36 @@ impl Axis {
         Ok(())
     }
 
-    /// The jog's profile from command state `(p, v)` at `t` under the
-    /// current reference: to the travel limit in its direction when limits
-    /// are enforced (refused 13 / 4 when that limit is reached already, or
-    /// when the axis could not stop inside from where it is), else a cruise
-    /// at the speed the cap allows.
-    fn plan_jog(&self, t: u64, p: f64, v: f64, mut jog: Jog) -> Result<(Profile, Jog), Code> {
+    /// The jog's profile from command state `k` at `t` under the current
+    /// reference: to the travel limit in its direction when limits are
+    /// enforced (refused 13 / 4 when that limit is reached already, or when
+    /// the axis could not stop inside from where it is), else a cruise at
+    /// the speed the cap allows.
+    pub(super) fn plan_jog(
+        &self,
+        t: u64,
+        k: Kinematics,
+        mut jog: Jog,
+    ) -> Result<(Profile, Jog), Code> {
         let speed = jog.speed.abs().min(self.speed_cap());
         jog.planned_speed = speed;
+        let ramp = Ramp {
+            accel: jog.accel,
+            decel: jog.decel,
+            jerk: jog.jerk,
+        };
         let Some((lo, hi)) = self.soft_limits_raw() else {
             jog.limited = false;
             let target = speed.copysign(jog.speed);
-            return Ok((Profile::jog(t, p, v, target, jog.accel, jog.decel), jog));
+            return Ok((Profile::jog_from(t, k, target, ramp), jog));
         };
         let limit = if jog.speed > 0.0 { hi } else { lo };
-        if (limit - p) * jog.speed.signum() <= self.half_count() {
+        if (limit - k.p) * jog.speed.signum() <= self.half_count() {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET));
         }
-        self.stop_fits(p, v, jog.decel)?;
+        self.stop_fits(k, jog.decel, jog.jerk)?;
         jog.limited = true;
-        let profile = Profile::move_to(t, p, v, limit, speed, jog.accel, jog.decel);
+        let profile = Profile::move_from(t, k, limit, speed, ramp);
         Ok((profile, jog))
     }
 
@@ -101,7 +115,7 @@ impl Axis {
     /// One step of a jog: the lease, the limit reached, a new reference.
     pub(super) fn advance_jog(&mut self, now: u64, op: u32, j: Jog) {
         if now > j.lease_until {
-            self.halt(now, op, j.decel, StopCause::LeaseExpired, true);
+            self.halt(now, op, j.decel, j.jerk, StopCause::LeaseExpired, true);
             return;
         }
         if j.limited && self.profile.is_done(now) {
@@ -116,8 +130,8 @@ impl Axis {
         if limited == j.limited && speed == j.planned_speed {
             return;
         }
-        let (t, p, v) = self.motion_state(now);
-        match self.plan_jog(t, p, v, j) {
+        let (t, k) = self.motion_state(now);
+        match self.plan_jog(t, k, j) {
             Ok((profile, jog)) => {
                 self.profile.set(profile);
                 self.state = State::Motion(Motion {
@@ -126,7 +140,7 @@ impl Axis {
                 });
             }
             // Homed again beyond (or too close to) the limit it heads for.
-            Err(_) => self.halt(now, op, j.decel, StopCause::SoftLimit, true),
+            Err(_) => self.halt(now, op, j.decel, j.jerk, StopCause::SoftLimit, true),
         }
     }
 }

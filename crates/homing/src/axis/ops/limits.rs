@@ -25,7 +25,7 @@ use crate::axis::Axis;
 use crate::codes::*;
 use crate::config::TravelMode;
 use crate::operation::StopCause;
-use crate::profile::Profile;
+use crate::profile::{stop_displacement, Kinematics, Profile};
 
 impl Axis {
     /// The travel limits as raw positions, while they are enforced: homed,
@@ -58,49 +58,60 @@ impl Axis {
         self.soft_limits_raw().or(self.ops.limits_before)
     }
 
-    /// A stop from `(p, v)` at time `t` at `decel`, ending at or inside
-    /// `limits` (raw): past the end a stop at `decel` would reach, it ends
-    /// exactly on the limit (decelerating harder); an axis already at or
-    /// beyond the limit it moves towards stops at once.
+    /// A stop from state `k` at time `t` at `decel` and `jerk` (0: a
+    /// trapezoid's), ending at or inside `limits` (raw): past the end a
+    /// stop at `decel` would reach, it ends exactly on the limit
+    /// (decelerating harder: `Profile::stop_at_from`, which keeps the jerk
+    /// where a jerk-limited stop ends there and drops it where none does);
+    /// an axis already at or beyond the limit it moves towards stops at
+    /// once.
     pub(super) fn stop_within(
         t: u64,
-        p: f64,
-        v: f64,
+        k: Kinematics,
         decel: f64,
+        jerk: f64,
         limits: Option<(f64, f64)>,
     ) -> Profile {
-        let plain = Profile::stop(t, p, v, decel);
+        let plain = Profile::stop_from(t, k, decel, jerk);
         let Some((lo, hi)) = limits else {
             return plain;
         };
-        let limit = if v > 0.0 {
+        // The direction the stop goes: the velocity's, or (at rest with an
+        // S-curve's acceleration left) where the stop ends.
+        let dir = if k.v != 0.0 {
+            k.v
+        } else {
+            plain.end_position() - k.p
+        };
+        let limit = if dir > 0.0 {
             hi
-        } else if v < 0.0 {
+        } else if dir < 0.0 {
             lo
         } else {
             return plain;
         };
-        if (plain.end_position() - limit) * v <= 0.0 {
+        if (plain.end_position() - limit) * dir <= 0.0 {
             plain
-        } else if (limit - p) * v > 0.0 {
-            Profile::stop_at(t, p, v, limit)
+        } else if (limit - k.p) * dir > 0.0 && k.v != 0.0 {
+            Profile::stop_at_from(t, k, limit, jerk)
         } else {
-            Profile::hold(t, p)
+            Profile::hold(t, k.p)
         }
     }
 
-    /// A motion that starts from `(p, v)` and must first stop at `decel`
-    /// (a reversal, a new target behind) stays inside the travel limits it
-    /// is inside of; else refused 13 / 4.
-    pub(super) fn stop_fits(&self, p: f64, v: f64, decel: f64) -> Result<(), Code> {
+    /// A motion that starts from state `k` and must first stop at `decel`
+    /// and `jerk` (a reversal, a new target behind, a change of dynamics)
+    /// stays inside the travel limits it is inside of; else refused 13 / 4.
+    pub(super) fn stop_fits(&self, k: Kinematics, decel: f64, jerk: f64) -> Result<(), Code> {
         let Some((lo, hi)) = self.soft_limits_raw() else {
             return Ok(());
         };
-        if v == 0.0 {
+        let d = stop_displacement(k.v, k.a, decel, jerk);
+        if d == 0.0 {
             return Ok(());
         }
-        let end = p + v * v.abs() / (2.0 * decel);
-        let out = (v > 0.0 && p <= hi && end > hi) || (v < 0.0 && p >= lo && end < lo);
+        let (p, end) = (k.p, k.p + d);
+        let out = (d > 0.0 && p <= hi && end > hi) || (d < 0.0 && p >= lo && end < lo);
         if out {
             Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET))
         } else {
@@ -137,7 +148,7 @@ impl Axis {
         if !(neg || pos) || self.status.faulted {
             return false;
         }
-        let (_, _, v) = self.motion_state(now);
+        let v = self.motion_state(now).1.v;
         if (v > 0.0 && pos) || (v < 0.0 && neg) {
             return self.op_fault(
                 now,

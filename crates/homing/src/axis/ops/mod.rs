@@ -10,6 +10,7 @@
 //!   axis 5/1, no feedback 12/40, servo off 5) and the operand checks (13);
 //! * `power`: enable, disable, reset, the drive's faults and power stage;
 //! * `jog`, `moves`, `stream`: each motion, its start and its progress;
+//!   `change`: MCD, new dynamics for the running jog or move;
 //!   `follower`: the stream's bounded follower (one cycle of arithmetic);
 //! * `limits`: software travel limits (homed, linear) and the hardware
 //!   limit switches;
@@ -39,6 +40,15 @@
 //!   when it began, also when the fault that caused it cleared HomedStatus
 //!   in the same step. A motion that could not be stopped inside from where
 //!   it is (a reversal, a supersede) is refused.
+//! * **Which stops keep the jerk.** A normal stop of a jog or move (MAS, a
+//!   jog's lease, a jog ended by its client, a disable, a move superseded
+//!   by a stop, a jog meeting a travel limit) is planned with the motion's
+//!   jerk: an S-curve motion ends as an S-curve. A fault's stop (a limit
+//!   switch, a drive fault, lost or implausible feedback, a refused
+//!   setpoint) and every stop of the stream are planned with jerk 0: the
+//!   shortest stop the deceleration allows (the acceleration steps once,
+//!   at its start). A fault during a jerk-limited stop plans a new one
+//!   with jerk 0 from where the stop is.
 //! * **A stop can stop what was commanded.** A fault's stop brakes at
 //!   `max_deceleration` or harder: a stream's at the larger of
 //!   `max_deceleration` and `stream_acceleration` (no configuration rule
@@ -52,6 +62,7 @@
 //!   fault or a dropped power stage withdraws the enable request in every
 //!   state; a reset excuses only the fault it was asked to clear (`power`).
 
+mod change;
 mod follower;
 mod jog;
 mod limits;
@@ -65,6 +76,7 @@ use super::intake::Sample;
 use super::state::State;
 use super::Axis;
 use crate::operation::{OpKind, OpStatus, Operation, Setpoint, StopCause};
+use crate::profile::Kinematics;
 use motion::{Halt, Motion, Run};
 pub(super) use power::Power;
 
@@ -110,9 +122,13 @@ impl Axis {
                 self.stop_op(now);
                 Ok(())
             }
+            Operation::Change(c) => self.change_op(now, &c),
         };
-        if let Err(code) = result {
-            self.status.op.refused = Some(code);
+        match result {
+            Err(code) => self.status.op.refused = Some(code),
+            // Answered in place: the running motion keeps its id.
+            Ok(()) if op.kind().in_place() => self.status.op.refused = None,
+            Ok(()) => {}
         }
     }
 
@@ -161,23 +177,27 @@ impl Axis {
         }
     }
 
-    /// The command state a motion continues from: time, raw position,
-    /// velocity. A stream's command is made step by step (`follower`), so
-    /// a stream continues from the last command, at the previous step,
-    /// with the velocity it had then: a stop planned from there continues
-    /// the motion the drive was last given.
-    fn motion_state(&mut self, now: u64) -> (u64, f64, f64) {
+    /// The command state a motion continues from: time, and raw position,
+    /// velocity and acceleration (the exact state of the profile: a re-plan
+    /// from it steps in none of them). A stream's command is made step by
+    /// step (`follower`), so a stream continues from the last command, at
+    /// the previous step, with the velocity it had then (its acceleration
+    /// taken as 0: its stops have no jerk): a stop planned from there
+    /// continues the motion the drive was last given.
+    fn motion_state(&mut self, now: u64) -> (u64, Kinematics) {
         if let State::Motion(Motion {
             run: Run::Stream(st),
             ..
         }) = self.state
         {
             if let Some(t) = self.ops.prev_step_ns {
-                return (t, self.last_command.position, st.velocity);
+                return (
+                    t,
+                    Kinematics::moving(self.last_command.position, st.velocity),
+                );
             }
         }
-        let (p, v) = self.profile.at(now);
-        (now, p, v)
+        (now, self.profile.state(now))
     }
 
     /// A stream's stops brake at the larger of `max_deceleration` and
@@ -211,31 +231,51 @@ impl Axis {
         }
     }
 
-    /// Brings the motion to rest at `decel`, inside the travel limits that
-    /// apply now (or that applied when a stop in progress began),
-    /// answering for operation `op`; `normal`: PC at rest.
-    fn halt(&mut self, now: u64, op: u32, decel: f64, cause: StopCause, normal: bool) {
+    /// The jerk of the running motion (a jog's or move's own, a stop's);
+    /// 0 for a stream and at rest.
+    fn running_jerk(&self) -> f64 {
+        match self.state {
+            State::Motion(Motion {
+                run: Run::Jog(j), ..
+            }) => j.jerk,
+            State::Motion(Motion {
+                run: Run::Move(m), ..
+            }) => m.jerk,
+            State::Motion(Motion {
+                run: Run::Halt(h), ..
+            }) => h.jerk,
+            _ => 0.0,
+        }
+    }
+
+    /// Brings the motion to rest at `decel` and `jerk` (0: the shortest
+    /// stop), inside the travel limits that apply now (or that applied
+    /// when a stop in progress began), answering for operation `op`;
+    /// `normal`: PC at rest.
+    fn halt(&mut self, now: u64, op: u32, decel: f64, jerk: f64, cause: StopCause, normal: bool) {
         let limits = match self.state {
             State::Motion(Motion {
                 run: Run::Halt(h), ..
             }) => h.limits,
             _ => self.stop_limits(),
         };
-        let (t, p, v) = self.motion_state(now);
-        self.profile.set(Self::stop_within(t, p, v, decel, limits));
+        let (t, k) = self.motion_state(now);
+        self.profile
+            .set(Self::stop_within(t, k, decel, jerk, limits));
         self.status.last_stop = cause;
         self.state = State::Motion(Motion {
             op,
             run: Run::Halt(Halt {
                 normal,
                 decel,
+                jerk,
                 limits,
             }),
         });
     }
 
-    /// A normal stop of a jog, move or stream with its own deceleration,
-    /// answering for `op` (`None`: the motion's own operation). False when
+    /// A normal stop of a jog, move or stream with its own deceleration
+    /// and jerk (a stream's: none), answering for `op` (`None`: the motion's own operation). False when
     /// there was none to stop (idle, homing, or already stopping).
     pub(super) fn stop_motion(&mut self, now: u64, op: Option<u32>, cause: StopCause) -> bool {
         let State::Motion(m) = self.state else {
@@ -244,16 +284,16 @@ impl Axis {
         if matches!(m.run, Run::Halt(_)) {
             return false;
         }
-        let decel = self.running_decel();
-        self.halt(now, op.unwrap_or(m.op), decel, cause, true);
+        let (decel, jerk) = (self.running_decel(), self.running_jerk());
+        self.halt(now, op.unwrap_or(m.op), decel, jerk, cause, true);
         true
     }
 
     /// An axis fault while an operation moves the axis: ER with its code,
     /// `faulted`, the cause shown, the operation ended without PC; the axis
-    /// stops at `max_deceleration` or harder (a stream's: see
-    /// `stream_decel`; a stop in progress goes on if it brakes at least as
-    /// hard), inside the travel limits that applied when the stop began —
+    /// stops at `max_deceleration` or harder with jerk 0, the shortest stop
+    /// (a stream's: see `stream_decel`; a stop in progress goes on if it
+    /// brakes at least as hard without jerk), inside the travel limits that applied when the stop began —
     /// or, with `power_off`, the drive no longer follows: the power stage
     /// is switched off and the command holds where the axis is.
     pub(super) fn op_fault(
@@ -276,7 +316,7 @@ impl Axis {
         }
         let decel = self.limits.max_deceleration.max(self.running_decel());
         match m.run {
-            Run::Halt(h) if h.decel >= decel => {
+            Run::Halt(h) if h.decel >= decel && h.jerk == 0.0 => {
                 // The stop under way already brakes that hard: it goes on,
                 // as a fault's.
                 self.status.last_stop = cause;
@@ -285,7 +325,7 @@ impl Axis {
                     run: Run::Halt(Halt { normal: false, ..h }),
                 });
             }
-            _ => self.halt(now, m.op, decel, cause, false),
+            _ => self.halt(now, m.op, decel, 0.0, cause, false),
         }
         true
     }

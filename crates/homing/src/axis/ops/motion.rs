@@ -31,6 +31,8 @@ pub(in crate::axis) struct Jog {
     pub speed: f64,
     pub accel: f64,
     pub decel: f64,
+    /// units/s³; 0: a trapezoid.
+    pub jerk: f64,
     pub lease_ns: u64,
     /// The jog stops (normally) once `now` passes this, unless renewed.
     pub lease_until: u64,
@@ -48,6 +50,8 @@ pub(in crate::axis) struct MoveRun {
     pub speed: f64,
     pub accel: f64,
     pub decel: f64,
+    /// units/s³; 0: a trapezoid.
+    pub jerk: f64,
     /// The speed planned (the asked one, or less under the unhomed cap).
     pub planned_speed: f64,
 }
@@ -106,6 +110,9 @@ pub(in crate::axis) struct Halt {
     pub normal: bool,
     /// Its deceleration: a fault during the stop brakes at least as hard.
     pub decel: f64,
+    /// Its jerk: the motion's for a normal stop, 0 for a fault's (and a
+    /// stream's). A fault during a jerk-limited stop plans a new one at 0.
+    pub jerk: f64,
     /// The travel limits (raw) it stays inside: those that applied when it
     /// began, whatever happens to the reference while it runs.
     pub limits: Option<(f64, f64)>,

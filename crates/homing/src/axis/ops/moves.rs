@@ -1,6 +1,7 @@
-//! MAM: a trapezoidal move (`Profile::move_to`) from the current command
-//! state to rest at a target, PC when the command is there (the profile
-//! returns the target bit for bit at its end).
+//! MAM: a move (`Profile::move_from`: a trapezoid, or with `jerk` above 0
+//! an S-curve) from the current command state (position, velocity,
+//! acceleration) to rest at a target, PC when the command is there (the
+//! profile returns the target bit for bit at its end).
 //!
 //! * The target is an axis position (`relative`: a distance from the
 //!   current command position); on a cyclic axis an absolute target is
@@ -24,6 +25,17 @@ use crate::operation::{Dynamics, MoveSpec, OpKind};
 use crate::position::nearest_cyclic;
 use crate::profile::Profile;
 
+impl MoveRun {
+    /// How the move changes its speed.
+    pub(super) fn ramp(&self) -> crate::profile::Ramp {
+        crate::profile::Ramp {
+            accel: self.accel,
+            decel: self.decel,
+            jerk: self.jerk,
+        }
+    }
+}
+
 impl Axis {
     /// MAM: the move as asked, and its dynamics (defaults resolved).
     pub(super) fn move_op(&mut self, now: u64, a: &MoveSpec, d: Dynamics) -> Result<(), Code> {
@@ -33,20 +45,22 @@ impl Axis {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NOT_FINITE));
         }
         self.check_dynamics(d.speed, d.accel, d.decel)?;
-        let (t, p, v) = self.motion_state(now);
-        let target = self.move_target(a, p)?;
-        self.switch_allows(target - p)?;
-        self.stop_fits(p, v, d.decel)?;
+        self.check_jerk(d.jerk)?;
+        let (t, k) = self.motion_state(now);
+        let target = self.move_target(a, k.p)?;
+        self.switch_allows(target - k.p)?;
+        self.stop_fits(k, d.decel, d.jerk)?;
         let mv = MoveRun {
             target,
             speed: d.speed,
             accel: d.accel,
             decel: d.decel,
+            jerk: d.jerk,
             planned_speed: d.speed,
         };
         let op = self.accept_op(OpKind::Move);
         self.profile
-            .set(Profile::move_to(t, p, v, target, d.speed, d.accel, d.decel));
+            .set(Profile::move_from(t, k, target, d.speed, mv.ramp()));
         self.state = State::Motion(Motion {
             op,
             run: Run::Move(mv),
@@ -94,10 +108,9 @@ impl Axis {
         if speed == mv.planned_speed {
             return;
         }
-        let (t, p, v) = self.motion_state(now);
-        self.profile.set(Profile::move_to(
-            t, p, v, mv.target, speed, mv.accel, mv.decel,
-        ));
+        let (t, k) = self.motion_state(now);
+        self.profile
+            .set(Profile::move_from(t, k, mv.target, speed, mv.ramp()));
         self.state = State::Motion(Motion {
             op,
             run: Run::Move(MoveRun {

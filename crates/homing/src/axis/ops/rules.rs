@@ -7,10 +7,11 @@
 //! | enable, jog, move, stream start | 16 homing in process · 20 faulted · 12/12 shutdown · 5/1 not a servo axis · 12/40 no valid feedback |
 //! | jog, move, stream start | also 5 servo off (not enabled, or a disable in progress) |
 //! | jog, move, stream start | 13/7 no speed bound (no `max_speed`, none derived from the homing speeds) |
-//! | jog | 3 on a moving or streaming axis (a jog on a jogging axis replaces it) · 13/1..3, 13/6 operands · 9 towards a tripped limit switch · 13/4 towards a travel limit already reached, or a stop that would end outside |
-//! | move | 3 on a jogging or moving axis without `supersede`, on a streaming axis · 13/5 target not finite · 13/1..3 operands · 13/4 target outside the travel limits (or ±`max_position`), or a stop that would end outside · 9 towards a tripped limit switch |
+//! | jog | 3 on a moving or streaming axis (a jog on a jogging axis replaces it) · 13/1..3, 13/6, 13/8 operands · 9 towards a tripped limit switch · 13/4 towards a travel limit already reached, or a stop that would end outside |
+//! | move | 3 on a jogging or moving axis without `supersede`, on a streaming axis · 13/5 target not finite · 13/1..3, 13/8 operands · 13/4 target outside the travel limits (or ±`max_position`), or a stop that would end outside · 9 towards a tripped limit switch |
 //! | stream start | 3 on an axis in motion (stopping too) · then 13/7 as above · 1019/7 not homed (unless `stream_unhomed`) · 13/1 a speed cap of 0 (unhomed, no `unhomed_speed`) · 13/3 no `max_deceleration` |
 //! | setpoint (an axis fault, 1019) | 1 not finite · 2 outside the travel limits · 3 faster than the speed cap (unhomed: `unhomed_speed`) on the program's timeline, or the command held back by it further than it can follow · 4 a change of velocity above `stream_acceleration` on the program's timeline, or the command held back by it further than it can follow · 5 nothing for `stream_timeout_ms` since the last one arrived · 6 out of order · 7 not homed |
+//! | change (`change.rs`) | as jog's first two rows, then 3 streaming · 3/1 no jog or move runs · 13/1..3, 13/8 operands · 13/4 a stop that would end outside |
 //! | reset | 16 homing in process |
 //! | disable, stop, stream end | never |
 //!
@@ -24,7 +25,7 @@ use crate::axis::state::State;
 use crate::axis::Axis;
 use crate::codes::*;
 use crate::config::AxisConfiguration;
-use crate::op_limits::JOG_LEASE_NS;
+use crate::op_limits::{JOG_LEASE_NS, MAX_JERK};
 
 /// Execution collision.
 pub(super) const COLLISION: Code = (ERR_EXECUTION_COLLISION, 0);
@@ -127,6 +128,15 @@ impl Axis {
             return Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_DECELERATION));
         }
         Ok(())
+    }
+
+    /// A jog's or move's jerk: 0 (a trapezoid) ..= `MAX_JERK` (13 / 8).
+    pub(super) fn check_jerk(&self, jerk: f64) -> Result<(), Code> {
+        if (0.0..=MAX_JERK).contains(&jerk) {
+            Ok(())
+        } else {
+            Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_JERK))
+        }
     }
 
     /// A jog's lease: 50 ms ..= 5 s.

@@ -142,16 +142,20 @@ impl Axis {
             self.op_done(id, true);
             return;
         };
-        let (t, p, v) = self.motion_state(now);
+        let (t, k) = self.motion_state(now);
         let decel = self.stream_decel();
         let limits = self.stop_limits();
-        self.profile.set(Self::stop_within(t, p, v, decel, limits));
+        // A stream's stops have no jerk: its command has no planned
+        // acceleration to ramp from.
+        self.profile
+            .set(Self::stop_within(t, k, decel, 0.0, limits));
         self.status.last_stop = StopCause::Released;
         self.state = State::Motion(Motion {
             op: id,
             run: Run::Halt(Halt {
                 normal: true,
                 decel,
+                jerk: 0.0,
                 limits,
             }),
         });

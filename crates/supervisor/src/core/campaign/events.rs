@@ -226,6 +226,7 @@ fn soft_limit(r: &mut Rig, o: &mut Oracle, rng: &mut Rng) -> u64 {
             lease: Some(5.0),
             accel: Some(2000.0),
             decel: Some(MAX_DECEL),
+            jerk: None,
         }),
     );
     o.asked_power();

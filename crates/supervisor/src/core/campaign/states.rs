@@ -274,6 +274,7 @@ fn jog(r: &mut Rig, rng: &mut Rng) {
             lease: Some((500 * MS) as f64 * 1e-9),
             accel: Some(rng.real(500.0, 2000.0)),
             decel: Some(rng.real(500.0, MAX_DECEL)),
+            jerk: None,
         }),
         token,
     );
@@ -292,6 +293,7 @@ fn moving(target: f64, speed: f64, rng: &mut Rng) -> Operation {
         accel: Some(rng.real(500.0, 2000.0)),
         decel: Some(rng.real(500.0, MAX_DECEL)),
         supersede: false,
+        jerk: None,
     })
 }
 
