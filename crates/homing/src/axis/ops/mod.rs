@@ -13,6 +13,7 @@
 //!   `follower`: the stream's bounded follower (one cycle of arithmetic);
 //! * `limits`: software travel limits (homed, linear) and the hardware
 //!   limit switches;
+//! * `redefine`: redefine position (MRP), the offset alone;
 //! * `motion`: the data a motion carries from step to step;
 //! * this file: the dispatch, stops, faults, and what the status shows.
 //!
@@ -58,6 +59,7 @@ mod limits;
 pub(super) mod motion;
 mod moves;
 mod power;
+mod redefine;
 mod rules;
 mod stream;
 
@@ -110,6 +112,7 @@ impl Axis {
                 self.stop_op(now);
                 Ok(())
             }
+            Operation::Redefine(r) => self.redefine_op(&r),
         };
         if let Err(code) = result {
             self.status.op.refused = Some(code);
