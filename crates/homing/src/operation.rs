@@ -466,20 +466,20 @@ crate::op_spec! {
 }
 
 crate::op_spec! {
-    /// MRP / MC_SetPosition: the axis's position becomes `position`
-    /// (`relative` off) or moves by `position` (`relative`), without
+    /// MRP / MC_SetPosition: the axis's position becomes `value`
+    /// (`relative` off) or moves by `value` (`relative`), without
     /// motion; homed, at rest and not coupled only. The position that
     /// becomes P is the **command** position (exact at rest; the actual
     /// keeps its following error). On a cyclic axis P reads wrapped into
     /// `[0, unwind)`.
     pub struct RedefineSpec {
         /// The new axis position (units); with `relative` the shift.
-        position: f64 = Param::new("Position", Unit::Position).form(Form::Either {
+        value: f64 = Param::new("Position", Unit::Position).form(Form::Either {
             off: ("position", "P"),
             on: ("by", "D"),
             switch: "relative",
         }),
-        /// `position` is a shift of the axis's positions.
+        /// `value` is a shift of the axis's positions.
         relative: bool = Param::new("Relative", Unit::None),
     }
 }
@@ -488,7 +488,7 @@ impl RedefineSpec {
     /// The command position becomes `p`.
     pub fn to(p: f64) -> Self {
         RedefineSpec {
-            position: p,
+            value: p,
             relative: false,
         }
     }
@@ -496,7 +496,7 @@ impl RedefineSpec {
     /// Every position moves by `d`.
     pub fn by(d: f64) -> Self {
         RedefineSpec {
-            position: d,
+            value: d,
             relative: true,
         }
     }

@@ -1,5 +1,6 @@
+use super::moves::op_error;
 use super::{client_error, fail, EXIT_FAILED, EXIT_OK};
-use crate::cli::AxesArgs;
+use crate::cli::{AxesArgs, RedefineArgs};
 use motion_control::*;
 use motion_report::print_json;
 use std::time::Duration;
@@ -42,6 +43,25 @@ pub fn axes(client: &mut Client, what: Simple, a: &AxesArgs) -> i32 {
         print_json(&motion_report::AcceptedReport { accepted: names });
     } else {
         println!("{what}: {}", names.join(" "));
+    }
+    EXIT_OK
+}
+
+/// `redefine AXIS (--position P | --by D)` (MRP): accepted and complete in
+/// the cycle that takes it (nothing moves), so the answer is the outcome:
+/// the axes it was applied to (`status` shows the new positions and soft
+/// limits).
+pub fn redefine(client: &mut Client, a: &RedefineArgs) -> i32 {
+    let op = Operation::Redefine(a.spec.spec);
+    let resp = match client.operate(std::slice::from_ref(&a.axis), op) {
+        Ok(r) => r,
+        Err(e) => return op_error(a.json, "redefine", &e),
+    };
+    let names: Vec<String> = resp.answers().iter().map(|x| get_str(&x.name)).collect();
+    if a.json {
+        print_json(&motion_report::AcceptedReport { accepted: names });
+    } else {
+        println!("redefine: {}", names.join(" "));
     }
     EXIT_OK
 }

@@ -153,7 +153,7 @@ impl Core {
         }
         let lead = &self.slots[sides.trailing_zeros() as usize].engine;
         let p = lead.to_axis(lead.last_command().position);
-        Operation::Redefine(RedefineSpec::by(r.position - p))
+        Operation::Redefine(RedefineSpec::by(r.value - p))
     }
 
     /// Renews (or ends) jog `token` on the axes of `mask` (0: every axis)

@@ -38,9 +38,9 @@ impl Axis {
         self.redefine_gate()?;
         let cyclic = self.cfg.travel == TravelMode::Cyclic && self.cfg.unwind > 0.0;
         let delta = if r.relative {
-            r.position
+            r.value
         } else {
-            r.position - self.to_axis(self.last_command.position)
+            r.value - self.to_axis(self.last_command.position)
         };
         let delta = if cyclic && delta.is_finite() {
             wrap(delta, self.cfg.unwind)
