@@ -38,8 +38,13 @@ pub fn axes(client: &mut Client, what: Simple, a: &AxesArgs) -> i32 {
     if resp.result != RESULT_ACCEPTED {
         return fail(a.json, resp.refusal(what, |x| x.accepted == 0), EXIT_FAILED);
     }
+    accepted(a.json, what, &resp)
+}
+
+/// Prints the axes an accepted request names (JSON or a line): exit 0.
+fn accepted(json: bool, what: &str, resp: &ControlResponse) -> i32 {
     let names: Vec<String> = resp.answers().iter().map(|x| get_str(&x.name)).collect();
-    if a.json {
+    if json {
         print_json(&motion_report::AcceptedReport { accepted: names });
     } else {
         println!("{what}: {}", names.join(" "));
@@ -57,11 +62,5 @@ pub fn redefine(client: &mut Client, a: &RedefineArgs) -> i32 {
         Ok(r) => r,
         Err(e) => return op_error(a.json, "redefine", &e),
     };
-    let names: Vec<String> = resp.answers().iter().map(|x| get_str(&x.name)).collect();
-    if a.json {
-        print_json(&motion_report::AcceptedReport { accepted: names });
-    } else {
-        println!("redefine: {}", names.join(" "));
-    }
-    EXIT_OK
+    accepted(a.json, "redefine", &resp)
 }
