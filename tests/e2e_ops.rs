@@ -830,7 +830,7 @@ fn a_restarted_motion_io_switches_no_drive_on_by_itself() {
 /// soft limits [-20, 20]. `redefine X --by 5`: position 5, limits read
 /// [-15, 25], raw unchanged; a move to 25 ends on raw 20 (the same machine
 /// place as the limit before), 25.5 is refused (13 / 4); Z (not homed)
-/// refuses (1021 / 1).
+/// refuses (1022 / 1).
 #[test]
 fn redefine_by_shifts_the_position_and_the_limits_numbers_not_the_machine() {
     let _serial = serial();
@@ -871,7 +871,7 @@ fn redefine_by_shifts_the_position_and_the_limits_numbers_not_the_machine() {
     refused_with(&d, &["jog", "X", "--speed", "1"], 13, 4);
 
     // Not homed: refused with its code, nothing changes.
-    refused_with(&d, &["redefine", "Z", "--position", "3"], 1021, 1);
+    refused_with(&d, &["redefine", "Z", "--position", "3"], 1022, 1);
     let z = d.axis("Z");
     assert_close!(z, position, 0.0, COUNT);
     d.stop().expect_code(0);

@@ -61,6 +61,15 @@ impl Axis {
         self.status.homed.then_some(self.offset)
     }
 
+    /// The raw → axis offset the configured `travel_limits` are in while
+    /// homed: the reference homing (or a stored reference) established,
+    /// without the shift redefine position added since — so the soft limits
+    /// stay on the machine. What an independent check of the soft limits
+    /// (the cycle monitor) reads them in.
+    pub fn limits_offset(&self) -> Option<f64> {
+        self.status.homed.then_some(self.offset - self.shift)
+    }
+
     /// The part of the offset redefine position added since homing (the
     /// soft limits' shift): stored with the offset, so the limits stay on
     /// the machine across a restart.

@@ -54,6 +54,7 @@ impl ControlThread {
                     shared.send(Control::undated(id, ask)).then_some(id)
                 });
             self.ios.watch(&self.s.machine, snap);
+            self.trips.watch(&self.s.machine, snap);
         }
     }
 }

@@ -18,10 +18,10 @@
 //!   reads wrapped into `[0, unwind)`: `--position 370` on a 360 unwind
 //!   reads 10, `--by -20` from 10 reads 350.
 //! * **Refused** (nothing changes), in this order: homing 16 / 25, faulted
-//!   20 / 25, not homed 1021 / 1, not at rest (a jog, move, stream, a stop
+//!   20 / 25, not homed 1022 / 1, not at rest (a jog, move, stream, a stop
 //!   or an enable under way) 3 / 25, no valid feedback 12 / 40, coupled to
 //!   another axis (`coupling_allows_redefine`), not finite or beyond
-//!   ±`max_position` 1021 / 2.
+//!   ±`max_position` 1022 / 2.
 
 use super::{within, Code};
 use crate::axis::state::State;

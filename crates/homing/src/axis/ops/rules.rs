@@ -12,7 +12,7 @@
 //! | stream start | 3 on an axis in motion (stopping too) · then 13/7 as above · 1019/7 not homed (unless `stream_unhomed`) · 13/1 a speed cap of 0 (unhomed, no `unhomed_speed`) · 13/3 no `max_deceleration` |
 //! | setpoint (an axis fault, 1019) | 1 not finite · 2 outside the travel limits · 3 faster than the speed cap (unhomed: `unhomed_speed`) on the program's timeline, or the command held back by it further than it can follow · 4 a change of velocity above `stream_acceleration` on the program's timeline, or the command held back by it further than it can follow · 5 nothing for `stream_timeout_ms` since the last one arrived · 6 out of order · 7 not homed |
 //! | reset | 16 homing in process |
-//! | redefine | 16/25 homing in process · 20/25 faulted · 1021/1 not homed · 3/25 not at rest (jog, move, stream, stop or enable under way) · 12/40 no valid feedback · coupled to another axis (`coupling_allows_redefine`) · 1021/2 not finite |
+//! | redefine | 16/25 homing in process · 20/25 faulted · 1022/1 not homed · 3/25 not at rest (jog, move, stream, stop or enable under way) · 12/40 no valid feedback · coupled to another axis (`coupling_allows_redefine`) · 1022/2 not finite |
 //! | disable, stop, stream end | never |
 //!
 //! Home (the rung's rising edge) is refused with 20 when faulted and 3 while
