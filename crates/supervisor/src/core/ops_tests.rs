@@ -248,3 +248,33 @@ fn a_gantry_is_redefined_whole_or_not_at_all() {
     );
     assert_eq!(s.axes[0].status.redefines, 1);
 }
+
+#[test]
+fn after_a_redefine_the_monitor_keeps_the_soft_limits_on_the_machine() {
+    use motion_homing::{MoveSpec, RedefineSpec};
+    // X homed at raw 0 (position 0), limits [-20, 20]; by 5: the limits
+    // read [-15, 25], the same raw places. A move to 25 ends on raw 20
+    // and the cycle monitor, which checks every command against the soft
+    // limits on its own, sees nothing wrong.
+    let mut b = Bench::new(ONE_AXIS);
+    b.run(5);
+    b.home(1, false);
+    b.run(5);
+    b.op(1, Operation::Enable, 0);
+    b.run(20);
+    b.op(1, Operation::Redefine(RedefineSpec::by(5.0)), 0);
+    b.run(2);
+    assert_eq!(b.snap().axes[0].status.soft_limits, Some((-15.0, 25.0)));
+    b.op(1, Operation::Move(MoveSpec::to(25.0)), 0);
+    b.run(2);
+    for _ in 0..5000 {
+        b.cycle();
+        if b.snap().axes[0].status.op.pc {
+            break;
+        }
+    }
+    let s = b.snap().axes[0];
+    assert!(s.status.op.pc && !s.status.er, "{:?}", s.status);
+    assert!(s.monitor.is_none(), "{:?}", s.monitor);
+    assert!((cmd(&b) - 20.0).abs() < 1e-9, "{}", cmd(&b));
+}
