@@ -143,10 +143,22 @@ fn op(max_decel: f64) -> impl Strategy<Value = Operation> {
     let dynamics = (1.0..40.0f64, 100.0..5000.0f64, 0.05..1.0f64);
     prop_oneof![
         2 => (dynamics.clone(), any::<bool>(), 50u64..600).prop_map(move |((s, a, d), neg, lease)| {
-            Operation::Jog(JogSpec { speed: if neg { -s } else { s }, lease: Some((lease * MS) as f64 * 1e-9), accel: Some(a), decel: Some(d * max_decel) })
+            Operation::Jog(JogSpec {
+                speed: if neg { -s } else { s },
+                lease: Some((lease * MS) as f64 * 1e-9),
+                accel: Some(a),
+                decel: Some(d * max_decel),
+            })
         }),
         3 => (dynamics, -45.0..45.0f64, any::<bool>(), any::<bool>()).prop_map(
-            move |((speed, accel, d), target, relative, supersede)| Operation::Move(MoveSpec { target: if relative { target / 4.0 } else { target }, relative: relative, speed: Some(speed), accel: Some(accel), decel: Some(d * max_decel), supersede: supersede })
+            move |((speed, accel, d), target, relative, supersede)| Operation::Move(MoveSpec {
+                target: if relative { target / 4.0 } else { target },
+                relative,
+                speed: Some(speed),
+                accel: Some(accel),
+                decel: Some(d * max_decel),
+                supersede,
+            })
         ),
         1 => Just(Operation::Stop),
         1 => Just(Operation::Reset),
@@ -213,7 +225,7 @@ fn home(r: &mut Rig) {
 
 fn held_jog(r: &mut Rig, speed: f64, cycles: u16, every: u16, max_decel: f64) {
     let jog = Operation::Jog(JogSpec {
-        speed: speed,
+        speed,
         lease: Some((300 * MS) as f64 * 1e-9),
         accel: Some(500.0),
         decel: Some(0.5 * max_decel),

@@ -59,7 +59,7 @@ fn ready(cfg: AxisConfig) -> Rig {
 
 fn jog(speed: f64, accel: f64) -> Operation {
     Operation::Jog(JogSpec {
-        speed: speed,
+        speed,
         lease: Some((2_000 * MS) as f64 * 1e-9),
         accel: Some(accel),
         decel: Some(500.0),

@@ -7,9 +7,9 @@
 //! the cycles that carry an event to the engine and its answer to the
 //! drive (two), plus one of rounding.
 
-use super::oracle::Oracle;
+use super::oracle::{stop_cycles, Oracle};
 use super::rig::{setpoint_frame, Client, Rig};
-use super::states::{HOME_DECEL, LIMITS, MAX_ACCEL, MAX_DECEL, MAX_SPEED, STREAM_TIMEOUT_CYCLES};
+use super::states::{HOME_DECEL, LIMITS, MAX_DECEL, MAX_SPEED, STREAM_TIMEOUT_CYCLES};
 use super::Rng;
 use crate::shared::{Ask, Control};
 use motion_homing::JogSpec;
@@ -84,20 +84,6 @@ impl Event {
             Event::IoGone => "io_gone",
         }
     }
-}
-
-/// The speed a motion seen at `v` may have reached by the time the engine
-/// acts on an event `delay` cycles later (plus the two that carry it),
-/// accelerating at the most the axis allows, never beyond `max_speed`.
-pub fn reached(v: f64, delay: u64) -> f64 {
-    (v.abs() + MAX_ACCEL * (delay + 2) as f64 * 1e-3).min(MAX_SPEED)
-}
-
-/// Cycles a stop from a motion seen at `v` at deceleration `d` may take
-/// once the engine acts on the event `delay` cycles later: the delay, the
-/// two cycles that carry the event, the stop (rounded up), one of rounding.
-pub fn stop_cycles(v: f64, d: f64, delay: u64) -> u64 {
-    delay + (reached(v, delay) / d * 1000.0).ceil() as u64 + 3
 }
 
 /// Cycles of missing feedback after which the loss rule has tripped for
@@ -175,25 +161,7 @@ pub fn inject(r: &mut Rig, o: &mut Oracle, event: Event, rng: &mut Rng) -> u64 {
             r.io.overtravel = Some(dir);
             o.switch_tripped(r, dir, k);
         }
-        Event::SoftLimit => {
-            let up = rng.coin();
-            op(
-                r,
-                Operation::Jog(JogSpec {
-                    speed: if up { MAX_SPEED } else { -MAX_SPEED },
-                    lease: Some(5.0),
-                    accel: Some(2000.0),
-                    decel: Some(MAX_DECEL),
-                }),
-            );
-            o.asked_power();
-            // (refused where another motion runs: that one goes on; the
-            // soft limits hold either way)
-            let to = if up { LIMITS.1 } else { LIMITS.0 };
-            let dist = (to - r.plant().position()).abs();
-            horizon =
-                (dist / MAX_SPEED * 1000.0) as u64 + stop_cycles(MAX_SPEED, STOP_DECEL, 0) + 300;
-        }
+        Event::SoftLimit => horizon = soft_limit(r, o, rng),
         Event::Reset => op(r, Operation::Reset),
         Event::Enable => {
             op(r, Operation::Enable);
@@ -245,6 +213,27 @@ pub fn inject(r: &mut Rig, o: &mut Oracle, event: Event, rng: &mut Rng) -> u64 {
         }
     }
     horizon
+}
+
+/// A jog at full speed towards a soft limit; the cycles it may take to
+/// reach it and stop.
+fn soft_limit(r: &mut Rig, o: &mut Oracle, rng: &mut Rng) -> u64 {
+    let up = rng.coin();
+    op(
+        r,
+        Operation::Jog(JogSpec {
+            speed: if up { MAX_SPEED } else { -MAX_SPEED },
+            lease: Some(5.0),
+            accel: Some(2000.0),
+            decel: Some(MAX_DECEL),
+        }),
+    );
+    o.asked_power();
+    // (refused where another motion runs: that one goes on; the soft
+    // limits hold either way)
+    let to = if up { LIMITS.1 } else { LIMITS.0 };
+    let dist = (to - r.plant().position()).abs();
+    (dist / MAX_SPEED * 1000.0) as u64 + stop_cycles(MAX_SPEED, STOP_DECEL, 0) + 300
 }
 
 /// A jog's HMI lets go (its end), a program releases its stream.

@@ -90,7 +90,7 @@ impl Oracle {
     }
 
     pub fn switch_tripped(&mut self, r: &Rig, positive: bool, _k: u64) {
-        let v = super::events::reached(Self::speed(r), 0);
+        let v = reached(Self::speed(r), 0);
         self.switch = Some((positive, r.plant().position(), v));
     }
 
@@ -174,4 +174,18 @@ impl Oracle {
             _ => Ok(()),
         }
     }
+}
+
+/// The speed a motion seen at `v` may have reached by the time the engine
+/// acts on an event `delay` cycles later (plus the two that carry it),
+/// accelerating at the most the axis allows, never beyond `max_speed`.
+pub fn reached(v: f64, delay: u64) -> f64 {
+    (v.abs() + MAX_ACCEL * (delay + 2) as f64 * 1e-3).min(MAX_SPEED)
+}
+
+/// Cycles a stop from a motion seen at `v` at deceleration `d` may take
+/// once the engine acts on the event `delay` cycles later: the delay, the
+/// two cycles that carry the event, the stop (rounded up), one of rounding.
+pub fn stop_cycles(v: f64, d: f64, delay: u64) -> u64 {
+    delay + (reached(v, delay) / d * 1000.0).ceil() as u64 + 3
 }

@@ -286,7 +286,7 @@ fn jog(r: &mut Rig, rng: &mut Rng) {
 
 fn moving(target: f64, speed: f64, rng: &mut Rng) -> Operation {
     Operation::Move(MoveSpec {
-        target: target,
+        target,
         relative: false,
         speed: Some(speed),
         accel: Some(rng.real(500.0, 2000.0)),
