@@ -146,3 +146,65 @@ fn an_absolute_axis_is_homed_at_start_until_its_configuration_changes() {
     assert_clean(&cfg.prefix);
     assert_clean(&changed.prefix);
 }
+
+/// Waits (at most 10 s) until W is homed; its status then.
+#[track_caller]
+fn wait_homed_w(d: &Daemon) -> motion_report::AxisStatus {
+    assert!(
+        wait_for(Duration::from_secs(10), || d.axis("W").homed),
+        "W not homed: {}",
+        d.stderr()
+    );
+    d.axis("W")
+}
+
+/// W of the gantry example: absolute, Home Position 250 at raw 37.5.
+/// Homed, then `redefine W --position 260`: reads 260 (raw 37.5); the
+/// record has a `redefined` line; a new daemon restores W reading 260 with
+/// its limits [0, 400] read [10, 410] — the same machine places.
+#[test]
+fn an_absolute_axis_keeps_its_redefined_position_over_a_restart() {
+    let _serial = serial();
+    let cfg = Machine::gantry().write("redefine_abs");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["home", "W", "--json"]).expect_code(0);
+    let w = wait_homed_w(&d);
+    assert_close!(w, position, 250.0, COUNT);
+    d.ctl(&["redefine", "W", "--position", "260"])
+        .expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || d.axis("W").op_kind == "redefine"));
+    let w = d.axis("W");
+    assert!(w.op_pc, "{w:#?}");
+    assert_close!(w, position, 260.0, COUNT);
+    assert_close!(w, raw, 37.5, COUNT);
+    // The keeper writes the record line and the reference on its next look.
+    assert!(
+        wait_for(Duration::from_secs(5), || record(&cfg)
+            .iter()
+            .any(|e| e.kind == Some(RecordKind::Redefined))),
+        "{:#?}",
+        record(&cfg)
+    );
+    let e = record(&cfg)
+        .into_iter()
+        .rfind(|e| e.kind == Some(RecordKind::Redefined))
+        .unwrap();
+    assert_eq!((e.axis.as_str(), e.result.as_str()), ("W", "redefined"));
+    assert!(e.shift.is_some_and(|x| (x - 10.0).abs() < 1e-6), "{e:#?}");
+    assert!(
+        e.position.is_some_and(|x| (x - 260.0).abs() < 1e-6),
+        "{e:#?}"
+    );
+    d.stop().expect_code(0);
+
+    let d = Daemon::start(&cfg, &["io"]);
+    let w = wait_homed_w(&d);
+    assert!(w.restored && !w.pc, "{w:#?}");
+    assert_close!(w, position, 260.0, COUNT);
+    assert_eq!(
+        (w.soft_limit_negative, w.soft_limit_positive),
+        (Some(10.0), Some(410.0))
+    );
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}

@@ -825,3 +825,55 @@ fn a_restarted_motion_io_switches_no_drive_on_by_itself() {
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
 }
+
+/// X of `tests/machines/ops.toml`: immediate homing at raw 0 (position 0),
+/// soft limits [-20, 20]. `redefine X --by 5`: position 5, limits read
+/// [-15, 25], raw unchanged; a move to 25 ends on raw 20 (the same machine
+/// place as the limit before), 25.5 is refused (13 / 4); Z (not homed)
+/// refuses (1023 / 1).
+#[test]
+fn redefine_by_shifts_the_position_and_the_limits_numbers_not_the_machine() {
+    let _serial = serial();
+    let cfg = Machine::fixture("ops").write("redefine_by");
+    let d = Daemon::start(&cfg, &["io"]);
+    d.ctl(&["home", "X"]).expect_code(0);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    let x = wait_axis(&d, "X", 10, |a| a.homed && a.servo_action && !a.op_ip);
+    assert_close!(x, position, 0.0, COUNT);
+    assert_eq!(
+        (x.soft_limit_negative, x.soft_limit_positive),
+        (Some(-20.0), Some(20.0))
+    );
+    let raw_before = value(x.raw, "X");
+
+    d.ctl(&["redefine", "X", "--by", "5"]).expect_code(0);
+    let x = wait_axis(&d, "X", 10, |a| a.op_kind == "redefine" && a.op_pc);
+    assert_close!(x, position, 5.0, COUNT);
+    assert_close!(x, cmd_position, 5.0, 1e-9);
+    assert_close!(x, raw, raw_before, COUNT);
+    assert!(x.homed && !x.er, "{x:#?}");
+    // `status --json` shows the shifted limits.
+    let v = d.status();
+    let row = named(&v.axes, "X");
+    assert_eq!(
+        (row.soft_limit_negative, row.soft_limit_positive),
+        (Some(-15.0), Some(25.0))
+    );
+
+    // Past the shifted limit: refused; to it: ends on the same machine place.
+    refused_with(&d, &["move", "X", "--to", "25.5"], 13, 4);
+    let row = move_json(&d, &["X", "--to", "25"], 0);
+    assert!(row.pc, "{row:#?}");
+    let x = wait_axis(&d, "X", 10, |a| !a.moving && !a.stopping);
+    assert_close!(x, position, 25.0, COUNT);
+    assert_close!(x, raw, 20.0, COUNT);
+    // A jog further out is refused at the limit (13 / 4), as before.
+    refused_with(&d, &["jog", "X", "--speed", "1"], 13, 4);
+
+    // Not homed: refused with its code, nothing changes.
+    refused_with(&d, &["redefine", "Z", "--position", "3"], 1023, 1);
+    let z = d.axis("Z");
+    assert_close!(z, position, 0.0, COUNT);
+    d.stop().expect_code(0);
+    assert_clean(&cfg.prefix);
+}

@@ -169,6 +169,29 @@ fn the_installed_client_reads_status_homes_and_operates() {
     let x = d.axis("X");
     assert!(value(x.position, "X") < 2.0 && !x.jogging, "{x:#?}");
     client(&["--prefix", p, "--reset", "X"]).expect_code(0);
+    // redefine position through the package: +10, nothing moves, and back
+    let x = d.axis("X");
+    let out = client(&["--prefix", p, "--redefine", "X", "--by", "10"]);
+    assert!(
+        out.expect_code(0).stdout.contains("redefine: X"),
+        "{}",
+        out.stdout
+    );
+    assert!(wait_for(Duration::from_secs(5), || d.axis("X").op_kind == "redefine"));
+    let y = d.axis("X");
+    assert_close!(y, position, value(x.position, "X") + 10.0, COUNT);
+    assert_close!(y, raw, value(x.raw, "X"), COUNT);
+    let back = format!("{}", value(x.cmd_position, "X"));
+    client(&["--prefix", p, "--redefine", "X", "--to", &back]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || (value(
+        d.axis("X").cmd_position,
+        "X"
+    ) - value(
+        x.cmd_position,
+        "X"
+    ))
+    .abs()
+        < 1e-9));
     // the stream through the package: a sine of amplitude 1 from where X stands
     let x0 = value(d.axis("X").position, "X");
     let sine = Path::new(EXAMPLES_DIR).join("stream_sine.py");

@@ -8,6 +8,7 @@
     motion-client --prefix motion --reset X
     motion-client --prefix motion --stop X     # (--stop all: every axis)
     motion-client --prefix motion --unhome X
+    motion-client --prefix motion --redefine X --to 0   # (or --by D): no motion
 
 Exit codes: 0 done (--home: the axis homed with PC set; --move: at its
 target; --jog: ended without an axis fault), 1 refused or failed, 3 no
@@ -77,7 +78,7 @@ def home(sup, axis: str, timeout: float) -> int:
 
 
 def operation(what: str, r) -> int:
-    """enable / disable / reset / stop / unhome: every axis's answer."""
+    """enable / disable / reset / stop / unhome / redefine: every axis's answer."""
     from .client import accepted
 
     if not accepted(r):
@@ -130,6 +131,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--unhome", metavar="AXIS", help="clear HomedStatus of AXIS ('all': every axis)")
     p.add_argument("--jog", metavar="AXIS", help="MAJ: jog AXIS at --speed for --for seconds")
     p.add_argument("--move", metavar="AXIS", help="MAM: move AXIS --to P (or --by D)")
+    p.add_argument("--redefine", metavar="AXIS",
+                   help="MRP: the position of AXIS becomes --to P (or moves --by D), without motion")
     p.add_argument("--speed", type=float, default=float("nan"))
     p.add_argument("--to", type=float)
     p.add_argument("--by", type=float)
@@ -168,12 +171,15 @@ def main(argv=None) -> int:
             return operation(what, op([] if axis == "all" else [axis]))
     if a.jog:
         return jog(sup, a.jog, a.speed, a.duration)
-    if a.move:
+    if a.move or a.redefine:
         relative = a.to is None
         if relative and a.by is None:
-            print("--move needs --to P or --by D", file=sys.stderr)
+            print(f"--{'move' if a.move else 'redefine'} needs --to P or --by D", file=sys.stderr)
             return 1
-        return move(sup, a.move, a.by if relative else a.to, relative, a.speed, a.timeout)
+        value = a.by if relative else a.to
+        if a.redefine:
+            return operation("redefine", sup.redefine(a.redefine, value, relative=relative))
+        return move(sup, a.move, value, relative, a.speed, a.timeout)
     return 0
 
 

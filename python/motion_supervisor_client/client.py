@@ -255,6 +255,13 @@ class Supervisor:
         engine's `OPERATIONS["change"]`: speed, accel, decel, jerk; each
         left out keeps the running motion's) — `change("X", speed=5)`."""
         return self.operate("change", [axis], **params)
+    def redefine(self, axis: str, *args, **params) -> ControlResponse:
+        """MRP: homed and at rest, the position of `axis` (or a gantry)
+        becomes `value` — or moves by it with `relative=True` — without
+        motion; its soft limits stay where they are on the machine. The
+        parameters are the engine's (`OPERATIONS["redefine"]`) —
+        `redefine("X", 0.0)`, `redefine("X", 5.0, relative=True)`."""
+        return self.operate("redefine", [axis], *args, **params)
 
     def jog(self, axis: str, *args, **params) -> "Jog":
         """MAJ, hold to run: a Jog of `axis` whose lease the caller renews

@@ -3,7 +3,7 @@
 use crate::spec_args::SpecArgs;
 use clap::{Args, Parser, Subcommand};
 use motion_config::args::{axis, runtime_dir, seconds, service_prefix};
-use motion_control::{ChangeSpec, JogSpec, MoveSpec};
+use motion_control::{ChangeSpec, JogSpec, MoveSpec, RedefineSpec};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -86,6 +86,12 @@ pub enum Command {
     /// move AXIS (or a gantry) runs now, re-planned from where it is; each
     /// left out keeps the running motion's.
     Change(ChangeArgs),
+    /// MRP, homed and at rest: the position of AXIS (or a gantry, every
+    /// side by the same shift) becomes P (or moves by D) without motion.
+    /// Only the offset between positions and the machine changes: the
+    /// soft limits stay where they are on the machine (their numbers shift
+    /// with it).
+    Redefine(RedefineArgs),
 }
 
 #[derive(Debug, Args)]
@@ -170,6 +176,18 @@ pub struct ChangeArgs {
 }
 
 #[derive(Debug, Args)]
+pub struct RedefineArgs {
+    /// The axis or gantry.
+    #[arg(value_name = "AXIS", value_parser = axis)]
+    pub axis: String,
+    /// The engine's `RedefineSpec`: --position P | --by D.
+    #[command(flatten)]
+    pub spec: SpecArgs<RedefineSpec>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
 pub struct StreamArgs {
     /// The axes (or gantries) of the file's columns, in order.
     #[arg(value_name = "AXIS", required = true, value_parser = axis)]
@@ -231,6 +249,7 @@ impl Command {
             Command::Move(a) => a.json,
             Command::Stream(a) => a.json,
             Command::Change(a) => a.json,
+            Command::Redefine(a) => a.json,
             Command::Stats(a) => a.json,
             Command::Trace(a) => a.json,
         }

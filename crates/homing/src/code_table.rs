@@ -873,6 +873,64 @@ pub const TABLE: &[Code] = &[
          stream with 3 / 0.)",
     )
     .remedy("Change a motion while it runs; start a new jog or move with the dynamics instead."),
+
+    code(
+        ERR_EXECUTION_COLLISION,
+        EX_REDEFINE,
+        &[R],
+        "redefine refused: the axis is not at rest (a jog, move, stream or stop runs)",
+    )
+    .cause(
+        "Redefine position on an axis whose command is not at rest: a jog, move or \
+         stream runs, or a stop or an enable is under way. Redefining under motion would \
+         move the reference of a profile in flight.",
+    )
+    .remedy("Stop the axis (`motionctl stop AXIS`), wait for it to be at rest, redefine."),
+    code(
+        ERR_HOME_IN_PROCESS,
+        EX_REDEFINE,
+        &[R],
+        "redefine refused: homing in process",
+    )
+    .cause("Redefine position while the axis homes: homing establishes the reference itself.")
+    .remedy("Wait for the homing to end (or `stop` it), then redefine."),
+    code(
+        ERR_AXIS_FAULTED,
+        EX_REDEFINE,
+        &[R],
+        "redefine refused: axis in faulted state",
+    )
+    .cause("Redefine position while the axis has an axis fault (ER set).")
+    .remedy("See the fault's code, remove its cause, `motionctl reset AXIS`, redefine."),
+    code(
+        ERR_REDEFINE_REFUSED,
+        EX_REDEFINE_NOT_HOMED,
+        &[R],
+        "redefine refused: the axis is not homed",
+    )
+    .ours()
+    .cause(
+        "Redefine position on an axis without HomedStatus: there is no machine reference \
+         to shift (before homing, the axis position is the raw position).",
+    )
+    .remedy("Home the axis (or let an absolute axis restore its reference), then redefine."),
+    code(
+        ERR_REDEFINE_REFUSED,
+        EX_REDEFINE_NOT_FINITE,
+        &[R],
+        "redefine refused: the position or shift is not a usable number",
+    )
+    .ours()
+    .cause(
+        "The new position or the shift is not finite, or so large that the axis's \
+         position, its offset or its soft limits would lie beyond ±`max_position`.",
+    )
+    .remedy("Give a finite position (`--position P`) or shift (`--by D`) of a sane size."),
+    code(ERR_REDEFINE_REFUSED, 0, &[R], "redefine position refused")
+        .any()
+        .ours()
+        .cause("Redefine position was refused; the EXERR says why.")
+        .remedy("See the EXERR's row."),
 ];
 
 /// The row of `(err, exerr)`: its own, else the one for any EXERR of `err`.

@@ -151,3 +151,15 @@ pub const EX_MONITOR_SOFT_LIMIT: u16 = 4;
 pub const EX_MONITOR_ENABLE: u16 = 5;
 pub const EX_MONITOR_GANTRY: u16 = 6;
 pub const EX_MONITOR_NOT_FINITE: u16 = 7;
+
+// --- redefine position (MRP) ----------------------------------------------
+/// The EXERR that marks a refusal of redefine position under the Logix
+/// codes it shares (3 in motion, 16 homing, 20 faulted).
+pub const EX_REDEFINE: u16 = 25;
+/// Redefine position refused (ours); EXERR: `EX_REDEFINE_*`.
+pub const ERR_REDEFINE_REFUSED: u16 = 1023;
+/// The axis is not homed: there is no reference to redefine.
+pub const EX_REDEFINE_NOT_HOMED: u16 = 1;
+/// The redefined position, shift or soft limits would not be finite, or
+/// would lie beyond ±`max_position`.
+pub const EX_REDEFINE_NOT_FINITE: u16 = 2;

@@ -139,8 +139,8 @@ pub struct OpTraits {
     /// end go with its acquire and release; a client stops with the
     /// control service's stop).
     pub client: bool,
-    /// It moves the axis (or takes it over to be moved): the cycle refuses
-    /// it on an axis a program owns, that a home sequence will start or
+    /// It moves the axis (or takes it over to be moved, or redefines where
+    /// it is): the cycle refuses it on an axis a program owns, that a home sequence will start or
     /// whose I/O process is not attached, and a gantry takes it on every
     /// side or on none.
     pub moves: bool,
@@ -403,6 +403,19 @@ operations! {
         all: false,
         summary: "MCD: new speed, acceleration, deceleration or jerk for the running jog or move",
     }
+    /// MRP / MC_SetPosition ([`RedefineSpec`]): homed and at rest, the
+    /// axis's position becomes P (or moves by D) without motion. Only the
+    /// raw → axis offset changes: the frames, the drive and the soft limits
+    /// on the machine see no step (the limits' numbers shift with it).
+    Redefine(RedefineSpec) = 10 {
+        name: "redefine",
+        title: "Redefine",
+        client: true,
+        moves: true,
+        held: false,
+        all: false,
+        summary: "MRP: the axis's position becomes Position (or moves by it) without motion",
+    }
 }
 
 impl OpKind {
@@ -499,6 +512,43 @@ crate::op_spec! {
         /// Jerk, units/s³ (> 0: an S-curve; 0: a trapezoid); left out: the
         /// running motion's.
         jerk: Option<f64> = Param::new("Jerk", Unit::Jerk).flag("jerk", "J"),
+    }
+}
+
+crate::op_spec! {
+    /// MRP / MC_SetPosition: the axis's position becomes `value`
+    /// (`relative` off) or moves by `value` (`relative`), without
+    /// motion; homed, at rest and not coupled only. The position that
+    /// becomes P is the **command** position (exact at rest; the actual
+    /// keeps its following error). On a cyclic axis P reads wrapped into
+    /// `[0, unwind)`.
+    pub struct RedefineSpec {
+        /// The new axis position (units); with `relative` the shift.
+        value: f64 = Param::new("Position", Unit::Position).form(Form::Either {
+            off: ("position", "P"),
+            on: ("by", "D"),
+            switch: "relative",
+        }),
+        /// `value` is a shift of the axis's positions.
+        relative: bool = Param::new("Relative", Unit::None),
+    }
+}
+
+impl RedefineSpec {
+    /// The command position becomes `p`.
+    pub fn to(p: f64) -> Self {
+        RedefineSpec {
+            value: p,
+            relative: false,
+        }
+    }
+
+    /// Every position moves by `d`.
+    pub fn by(d: f64) -> Self {
+        RedefineSpec {
+            value: d,
+            relative: true,
+        }
     }
 }
 

@@ -182,4 +182,14 @@ pub struct Status {
     /// The I/O process reports the axis's drive lost (`Request::drive_lost`):
     /// not a reading, not enabled, whatever the last feedback said.
     pub drive_lost: bool,
+    /// Redefine position accepted over the axis's life (the keeper records
+    /// each and stores an absolute axis's reference after it).
+    pub redefines: u32,
+    /// The shift redefine position applied since the reference was
+    /// established (homing, or a stored reference): the soft limits read
+    /// `travel_limits` + `shift`, so they stay where they are on the machine.
+    pub shift: f64,
+    /// The software travel limits in axis coordinates while they are in
+    /// force (homed, linear, configured): `travel_limits` + `shift`.
+    pub soft_limits: Option<(f64, f64)>,
 }

@@ -100,7 +100,7 @@ fn home_absolute_then_restart_and_restore_without_motion() {
     assert_eq!(axis.reference_offset(), None);
     step(&mut axis, 0, RAW, &Request::default());
     assert!(!axis.status().homed);
-    axis.restore_reference(0, stored).unwrap();
+    axis.restore_reference(0, stored, 0.0).unwrap();
     let s = *axis.status();
     assert!(
         s.homed && !s.pc && !s.dn && !s.ip,
@@ -114,7 +114,7 @@ fn home_absolute_then_restart_and_restore_without_motion() {
     assert!(axis.status().homed);
 
     // Restoring again applies the same offset, not twice: still 10.
-    axis.restore_reference(100 * MS, stored).unwrap();
+    axis.restore_reference(100 * MS, stored, 0.0).unwrap();
     assert!((axis.axis_position().unwrap() - 10.0).abs() < 1e-9);
 }
 
@@ -125,7 +125,7 @@ fn homing_again_never_applies_the_offset_twice() {
     // recomputed from the raw position: 10 after every homing.
     let mut axis = Axis::new(absolute_axis());
     step(&mut axis, 0, RAW, &Request::default());
-    axis.restore_reference(0, -113.4).unwrap();
+    axis.restore_reference(0, -113.4, 0.0).unwrap();
     let mut k = 1;
     for _ in 0..3 {
         step(&mut axis, k, RAW, &Request::default());
@@ -145,24 +145,30 @@ fn restore_refusals() {
     use RestoreRefusal::*;
     // No feedback yet.
     let mut axis = Axis::new(absolute_axis());
-    assert_eq!(axis.restore_reference(0, -113.4), Err(NoFeedback));
+    assert_eq!(axis.restore_reference(0, -113.4, 0.0), Err(NoFeedback));
     // Feedback, then a missing frame: not fresh.
     step(&mut axis, 0, RAW, &Request::default());
     axis.step(MS, None, &Request::default());
-    assert_eq!(axis.restore_reference(MS, -113.4), Err(NoFeedback));
+    assert_eq!(axis.restore_reference(MS, -113.4, 0.0), Err(NoFeedback));
     // Fresh again, but the reference would put the axis at 123.4 + 30 =
     // 153.4, beyond the travel limit 150.
     step(&mut axis, 2, RAW, &Request::default());
     assert_eq!(
-        axis.restore_reference(2 * MS, 30.0),
+        axis.restore_reference(2 * MS, 30.0, 0.0),
         Err(OutsideTravelLimits {
             position: RAW + 30.0
         })
     );
     assert!(!axis.status().homed, "refused: nothing applied");
-    assert_eq!(axis.restore_reference(2 * MS, f64::NAN), Err(InvalidOffset));
+    assert_eq!(
+        axis.restore_reference(2 * MS, f64::NAN, 0.0),
+        Err(InvalidOffset)
+    );
     // A sample seen long ago is not fresh, even without a later step.
-    assert_eq!(axis.restore_reference(100 * MS, -113.4), Err(NoFeedback));
+    assert_eq!(
+        axis.restore_reference(100 * MS, -113.4, 0.0),
+        Err(NoFeedback)
+    );
     // Drive fault.
     let faulted = Feedback {
         drive: DriveState {
@@ -172,7 +178,7 @@ fn restore_refusals() {
         ..at(RAW)
     };
     axis.step(3 * MS, Some(&faulted), &Request::default());
-    assert_eq!(axis.restore_reference(3 * MS, -113.4), Err(DriveFault));
+    assert_eq!(axis.restore_reference(3 * MS, -113.4, 0.0), Err(DriveFault));
     // Not an absolute device.
     let mut inc = Axis::new(AxisConfig {
         absolute: false,
@@ -180,7 +186,7 @@ fn restore_refusals() {
         ..absolute_axis()
     });
     inc.step(0, Some(&at(RAW)), &Request::default());
-    assert_eq!(inc.restore_reference(0, -113.4), Err(NotAbsolute));
+    assert_eq!(inc.restore_reference(0, -113.4, 0.0), Err(NotAbsolute));
     // Homing in process (an absolute axis homed by a switch sequence).
     let mut active = Axis::new(AxisConfig {
         home_mode: HomeMode::Active,
@@ -194,7 +200,10 @@ fn restore_refusals() {
     });
     active.step(0, Some(&at(RAW)), &home());
     assert!(active.status().ip);
-    assert_eq!(active.restore_reference(0, -113.4), Err(HomingInProcess));
+    assert_eq!(
+        active.restore_reference(0, -113.4, 0.0),
+        Err(HomingInProcess)
+    );
     // Refusals read as sentences.
     assert_eq!(
         OutsideTravelLimits { position: 153.4 }.to_string(),

@@ -276,9 +276,9 @@ fn coordination_feedback_trouble_and_references_make_no_allocation() {
         let offset = a.reference_offset().unwrap();
         b.step(0, Some(&fb), &Request::default());
         results = [
-            b.restore_reference(0, offset),
-            b.restore_reference(0, offset),
-            b.restore_reference(0, 500.0),
+            b.restore_reference(0, offset, 0.0),
+            b.restore_reference(0, offset, 0.0),
+            b.restore_reference(0, 500.0, 0.0),
         ];
     });
     assert!(results[0].is_ok() && results[1].is_ok() && results[2].is_err());
@@ -359,6 +359,8 @@ fn operations_make_no_allocation() {
                 ..Request::default()
             },
             20 => op(jog(20.0)),
+            // Refused while jogging (3 / 25).
+            30 => op(Operation::Redefine(RedefineSpec::by(1.0))),
             21..=700 if k % 50 == 0 => Request {
                 jog_renew: true,
                 ..Request::default()
@@ -367,6 +369,9 @@ fn operations_make_no_allocation() {
             810 | 1450 => op(change),
             850 => op(jog(5.0)),
             860 => op(mv(2.0, true)),
+            // At rest on 2.0: redefined by 1 (reads 3), then back to 2.
+            1400 => op(Operation::Redefine(RedefineSpec::by(1.0))),
+            1420 => op(Operation::Redefine(RedefineSpec::to(2.0))),
             1500 => op(Operation::StreamStart),
             // From where the move left it (2.0) at 1 u/s: every cycle,
             // then every tenth (100 Hz).
@@ -397,9 +402,10 @@ fn operations_make_no_allocation() {
         }
     };
     let mut during = 0;
-    // Jogging, moving, streaming, a refused setpoint, a drive fault: seen.
-    let mut seen = [false; 5];
     let mut changed = false;
+    // Jogging, moving, streaming, a refused setpoint, a drive fault, two
+    // redefines: seen.
+    let mut seen = [false; 6];
     for k in 0..3200u64 {
         let req = script(k);
         let mut cmd = Command::default();
@@ -418,6 +424,7 @@ fn operations_make_no_allocation() {
             s.streaming,
             s.err == codes::ERR_SETPOINT_REFUSED,
             s.exerr == codes::EX_DRIVE_FAULT,
+            s.redefines == 2,
         ]
         .into_iter()
         .enumerate()
@@ -425,8 +432,8 @@ fn operations_make_no_allocation() {
             seen[i] |= b;
         }
     }
-    assert_eq!(seen, [true; 5]);
     assert!(changed, "the change was accepted");
+    assert_eq!(seen, [true; 6]);
     // The unhomed part: a jog into the limit switch and a reset.
     let mut axis = Axis::new(AxisConfig {
         max_deceleration: 2000.0,

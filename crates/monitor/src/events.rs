@@ -17,8 +17,9 @@ pub struct Cycle<'a> {
     pub request: &'a Request,
     /// The engine's status after the step (its answer to the request).
     pub status: &'a Status,
-    /// The raw → axis offset while the axis is homed
-    /// (`Axis::reference_offset`): the reference the soft limits are in.
+    /// The raw → axis offset the soft limits are in while the axis is
+    /// homed (`Axis::limits_offset`: a redefine position does not move
+    /// them on the machine).
     pub reference: Option<f64>,
     /// The command the engine produced.
     pub command: &'a Command,

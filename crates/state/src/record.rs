@@ -34,6 +34,11 @@ pub enum RecordKind {
     Restored,
     /// A stored reference was invalidated (or found unreadable).
     Invalidated,
+    /// Redefine position shifted the axis's positions without motion
+    /// (`shift`: the shift in force since the reference was established;
+    /// `offset`: the raw → axis offset after it; `position`: the command
+    /// position after it).
+    Redefined,
 }
 
 /// One line of the record. Positions are in the axis's units; `event_raw`
@@ -81,6 +86,13 @@ pub struct RecordEntry {
     pub skew: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// Redefined: the shift in force since the reference was established
+    /// (the sum of the redefines since homing), units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift: Option<f64>,
+    /// Redefined: the axis's command position after it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<f64>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
 }

@@ -70,6 +70,11 @@ pub struct StoredReference {
     pub axis: String,
     /// Raw → axis offset: axis position = raw + offset.
     pub offset: f64,
+    /// The part of `offset` redefine position added after homing: the soft
+    /// limits read `travel_limits` + `shift`, so they stay on the machine
+    /// across a restart. Absent (0) in a file no redefine touched.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub shift: f64,
     /// Raw and axis position when the reference was found.
     pub raw: f64,
     pub position: f64,
@@ -78,6 +83,10 @@ pub struct StoredReference {
     pub identity: AxisIdentity,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub invalidated: Option<Invalidation>,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// What [`References::load`] found.
@@ -136,7 +145,8 @@ impl References {
                 r.axis
             ));
         }
-        if !(r.offset.is_finite() && r.raw.is_finite() && r.position.is_finite()) {
+        let numbers = [r.offset, r.shift, r.raw, r.position];
+        if !numbers.iter().all(|x| x.is_finite()) {
             return Loaded::Unreadable(format!("{}: a position is not finite", path.display()));
         }
         if r.invalidated.is_some() {
@@ -178,6 +188,7 @@ mod tests {
             format: FORMAT,
             axis: axis.into(),
             offset,
+            shift: 0.0,
             raw: 113.4,
             position: 0.0,
             homed_at: "2026-11-30T12:00:00.000Z".into(),

@@ -212,6 +212,15 @@ crate::status_table! {
     /// The position commanded this cycle, axis coordinates (with
     /// `position`: the following error).
     cmd_position: Maybe @ 14, Units, "command", -, "CommandPosition", |s| s.a.cmd_axis;
+    /// The negative software travel limit in axis coordinates while it
+    /// applies (homed, linear, `travel_limits`): after a redefine position
+    /// its number moves with the positions, its place on the machine does
+    /// not.
+    soft_limit_negative: Maybe @ 16, Units, "soft_limit_negative", -, "SoftLimitNegative",
+        |s| s.status.soft_limits.map(|l| l.0);
+    /// The positive software travel limit, as `soft_limit_negative`.
+    soft_limit_positive: Maybe @ 17, Units, "soft_limit_positive", -, "SoftLimitPositive",
+        |s| s.status.soft_limits.map(|l| l.1);
 }
 
 /// The rows that say the axis is in motion by an operation (a jog, a

@@ -81,9 +81,14 @@ pub enum Ask {
     Unhome { mask: u64 },
     /// Record every cycle of the next homing of axis `axis`.
     Trace { axis: usize },
-    /// Apply the stored raw → axis `offset` of absolute axis `axis` without
-    /// motion ([`motion_homing::Axis::restore_reference`]).
-    Restore { axis: usize, offset: f64 },
+    /// Apply the stored raw → axis `offset` of absolute axis `axis`, with
+    /// the `shift` redefine position had added to it, without motion
+    /// ([`motion_homing::Axis::restore_reference`]).
+    Restore {
+        axis: usize,
+        offset: f64,
+        shift: f64,
+    },
     /// Stop every axis, disable the drives once at rest, then leave the loop.
     Exit,
     /// An operation for every axis of `mask` (a gantry: all its sides),

@@ -49,6 +49,7 @@ pub fn run(cli: Cli) -> i32 {
         Command::Move(a) => moves::move_axis(&mut client, &a),
         Command::Stream(a) => stream::stream(&mut client, &a),
         Command::Change(a) => simple::change(&mut client, &a),
+        Command::Redefine(a) => simple::redefine(&mut client, &a),
         Command::Stats(a) => stats::stats(&mut client, &a),
         Command::Trace(a) => trace::trace(&mut client, &a),
     }

@@ -1,5 +1,6 @@
+use super::moves::op_error;
 use super::{client_error, fail, EXIT_FAILED, EXIT_OK};
-use crate::cli::{AxesArgs, ChangeArgs};
+use crate::cli::{AxesArgs, ChangeArgs, RedefineArgs};
 use motion_control::*;
 use motion_report::print_json;
 use std::time::Duration;
@@ -37,8 +38,13 @@ pub fn axes(client: &mut Client, what: Simple, a: &AxesArgs) -> i32 {
     if resp.result != RESULT_ACCEPTED {
         return fail(a.json, resp.refusal(what, |x| x.accepted == 0), EXIT_FAILED);
     }
+    accepted(a.json, what, &resp)
+}
+
+/// Prints the axes an accepted request names (JSON or a line): exit 0.
+fn accepted(json: bool, what: &str, resp: &ControlResponse) -> i32 {
     let names: Vec<String> = resp.answers().iter().map(|x| get_str(&x.name)).collect();
-    if a.json {
+    if json {
         print_json(&motion_report::AcceptedReport { accepted: names });
     } else {
         println!("{what}: {}", names.join(" "));
@@ -55,4 +61,17 @@ pub fn change(client: &mut Client, a: &ChangeArgs) -> i32 {
         json: a.json,
     };
     axes(client, Simple::Op(Operation::Change(a.spec.spec)), &named)
+}
+
+/// `redefine AXIS (--position P | --by D)` (MRP): accepted and complete in
+/// the cycle that takes it (nothing moves), so the answer is the outcome:
+/// the axes it was applied to (`status` shows the new positions and soft
+/// limits).
+pub fn redefine(client: &mut Client, a: &RedefineArgs) -> i32 {
+    let op = Operation::Redefine(a.spec.spec);
+    let resp = match client.operate(std::slice::from_ref(&a.axis), op) {
+        Ok(r) => r,
+        Err(e) => return op_error(a.json, "redefine", &e),
+    };
+    accepted(a.json, "redefine", &resp)
 }

@@ -227,6 +227,7 @@ impl Axis {
         self.status.event_raw = Some(e);
         self.status.event_command = Some(self.profile.sample(now).0);
         self.offset = self.cfg.home_position - self.cfg.home_offset - e;
+        self.shift = 0.0;
         self.latches.disarm();
     }
 

@@ -124,6 +124,13 @@ pub struct Axis {
     plausible: Plausibility,
     /// axis position = raw + offset (wrapped on a cyclic axis).
     offset: f64,
+    /// The part of `offset` redefine position added since the reference
+    /// was established: the soft limits are `travel_limits` + `shift` in
+    /// axis coordinates, so on the machine they do not move.
+    shift: f64,
+    /// The last redefine applied (its operation id and shift), so a
+    /// gantry's redefine can be taken back when another side refused it.
+    last_redefine: Option<(u32, f64)>,
     last_command: Command,
 }
 
@@ -164,6 +171,8 @@ impl Axis {
             loss: FeedbackLoss::default(),
             plausible: Plausibility::new(&cfg),
             offset: 0.0,
+            shift: 0.0,
+            last_redefine: None,
             last_command: cmd,
         }
     }
@@ -282,6 +291,8 @@ impl Axis {
         self.status.waiting = false;
         self.status.min_move_ns = 0;
         self.report_ops();
+        self.status.shift = self.shift;
+        self.status.soft_limits = self.soft_limits_axis();
         let State::Homing(h) = &self.state else {
             return;
         };
@@ -351,7 +362,7 @@ impl Axis {
         self.status = Status {
             en: true,
             homed: self.status.homed,
-            prior_offset: self.status.homed.then_some(self.offset),
+            prior_offset: self.status.homed.then_some(self.offset - self.shift),
             feedback_ok: self.status.feedback_ok,
             feedback_gap_ns: self.status.feedback_gap_ns,
             feedback_loss_ns: self.status.feedback_loss_ns,
@@ -360,6 +371,7 @@ impl Axis {
             faulted: self.status.faulted,
             last_stop: self.status.last_stop,
             op: self.status.op,
+            redefines: self.status.redefines,
             ..Status::default()
         };
         // Logix: MAH on a faulted axis errors (20); a jog, move or stream
@@ -392,6 +404,7 @@ impl Axis {
             // never from the axis position, so homing again never adds an
             // offset twice. Home Offset does not apply.
             self.offset = self.cfg.home_position - s.fb.position;
+            self.shift = 0.0;
             return self.complete(now, true);
         }
         match self.cfg.home_mode {

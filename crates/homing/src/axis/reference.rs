@@ -61,19 +61,42 @@ impl Axis {
         self.status.homed.then_some(self.offset)
     }
 
-    /// Applies a stored raw → axis offset without motion: HomedStatus is set
-    /// (not PC, not DN: no instruction ran). Only with fresh valid feedback
-    /// from an absolute device, no fault, not while homing, and only when the
-    /// resulting axis position lies within the travel limits (linear axes).
+    /// The raw → axis offset the configured `travel_limits` are in while
+    /// homed: the reference homing (or a stored reference) established,
+    /// without the shift redefine position added since — so the soft limits
+    /// stay on the machine. What an independent check of the soft limits
+    /// (the cycle monitor) reads them in.
+    pub fn limits_offset(&self) -> Option<f64> {
+        self.status.homed.then_some(self.offset - self.shift)
+    }
+
+    /// The part of the offset redefine position added since homing (the
+    /// soft limits' shift): stored with the offset, so the limits stay on
+    /// the machine across a restart.
+    pub fn reference_shift(&self) -> Option<f64> {
+        self.status.homed.then_some(self.shift)
+    }
+
+    /// Applies a stored raw → axis offset without motion, with the shift
+    /// redefine position had added to it (`shift`, 0 when none): HomedStatus
+    /// is set (not PC, not DN: no instruction ran). Only with fresh valid
+    /// feedback from an absolute device, no fault, not while homing, and
+    /// only when the resulting axis position lies within the travel limits
+    /// (linear axes; shifted by `shift`, the same place on the machine).
     /// The command does not change: nothing moves.
-    pub fn restore_reference(&mut self, now_ns: u64, offset: f64) -> Result<(), RestoreRefusal> {
+    pub fn restore_reference(
+        &mut self,
+        now_ns: u64,
+        offset: f64,
+        shift: f64,
+    ) -> Result<(), RestoreRefusal> {
         if self.status.ip {
             return Err(RestoreRefusal::HomingInProcess);
         }
         if !self.cfg.absolute {
             return Err(RestoreRefusal::NotAbsolute);
         }
-        if !offset.is_finite() {
+        if !(offset.is_finite() && shift.is_finite()) {
             return Err(RestoreRefusal::InvalidOffset);
         }
         let fresh_since = now_ns.saturating_sub(self.last_sample_ns.unwrap_or(0));
@@ -91,11 +114,12 @@ impl Axis {
         }
         let position = sample.fb.position + offset;
         if let (TravelMode::Linear, Some((lo, hi))) = (self.cfg.travel, self.cfg.travel_limits) {
-            if !(lo..=hi).contains(&position) {
+            if !(lo + shift..=hi + shift).contains(&position) {
                 return Err(RestoreRefusal::OutsideTravelLimits { position });
             }
         }
         self.offset = offset;
+        self.shift = shift;
         self.status.homed = true;
         Ok(())
     }

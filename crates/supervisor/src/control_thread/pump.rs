@@ -42,13 +42,17 @@ impl ControlThread {
         }
         if let Some(snap) = hub.snapshot.as_deref() {
             let (shared, next_id) = (&self.shared, &mut self.next_id);
-            self.keeper.observe(&self.s.machine, snap, |axis, offset| {
-                let id = *next_id;
-                *next_id = next_id.wrapping_add(1).max(1);
-                shared
-                    .send(Control::undated(id, Ask::Restore { axis, offset }))
-                    .then_some(id)
-            });
+            self.keeper
+                .observe(&self.s.machine, snap, |axis, offset, shift| {
+                    let id = *next_id;
+                    *next_id = next_id.wrapping_add(1).max(1);
+                    let ask = Ask::Restore {
+                        axis,
+                        offset,
+                        shift,
+                    };
+                    shared.send(Control::undated(id, ask)).then_some(id)
+                });
             self.ios.watch(&self.s.machine, snap);
             self.trips.watch(&self.s.machine, snap);
         }

@@ -34,7 +34,11 @@ impl Core {
             Ask::Stop { mask } => self.stop(ack, mask),
             Ask::Unhome { mask } => self.unhome(ack, mask),
             Ask::Trace { axis } => self.trace(ack, axis),
-            Ask::Restore { axis, offset } => self.restore(ack, axis, offset, now_ns),
+            Ask::Restore {
+                axis,
+                offset,
+                shift,
+            } => self.restore(ack, axis, (offset, shift), now_ns),
             Ask::Exit => {
                 self.exit();
                 return None;
@@ -161,7 +165,7 @@ impl Core {
 
     /// Apply a stored reference to `axis` without motion (the engine checks
     /// the feedback and the travel limits).
-    fn restore(&mut self, mut ack: Ack, axis: usize, offset: f64, now: u64) -> Ack {
+    fn restore(&mut self, mut ack: Ack, axis: usize, reference: (f64, f64), now: u64) -> Ack {
         if axis >= self.slots.len() {
             return ack;
         }
@@ -172,7 +176,7 @@ impl Core {
         } else if busy {
             AxisAck::Refused(Refusal::Busy)
         } else {
-            match slot.engine.restore_reference(now, offset) {
+            match slot.engine.restore_reference(now, reference.0, reference.1) {
                 Ok(()) => {
                     slot.homed.restored();
                     AxisAck::Accepted

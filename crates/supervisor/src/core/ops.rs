@@ -15,7 +15,7 @@
 //! another side refused are stopped again in the next cycle (nothing has
 //! moved by more than one cycle's acceleration) and answered "not started".
 
-use motion_homing::{Operation, Setpoint};
+use motion_homing::{OpKind, Operation, RedefineSpec, Setpoint};
 
 use super::{named, Core};
 use crate::shared::{Ack, AxisAck, Refusal};
@@ -41,11 +41,13 @@ pub(super) struct Pending {
     ack: Ack,
     mask: u64,
     then: Then,
-    /// A motion (jog, move, stream): a gantry accepts it whole or not at all.
+    /// A motion (jog, move, stream) or a redefine: a gantry accepts it
+    /// whole or not at all.
     motion: bool,
     /// Answered in place (a change): accepted when the engine left no
     /// refusal, the running motion's id unchanged.
     in_place: bool,
+    kind: OpKind,
 }
 
 /// Operations that move the axis (or take it over to be moved).
@@ -127,13 +129,35 @@ impl Core {
             then,
             motion: is_motion(&op),
             in_place: op.kind().in_place(),
+            kind: op.kind(),
         });
         for i in named(mask, n) {
+            let side_op = self.whole_gantry(i, op);
             let slot = &mut self.slots[i];
             slot.op_before = slot.status().op.id;
-            slot.rung.request.op = Some(op);
+            slot.rung.request.op = Some(side_op);
         }
         None
+    }
+
+    /// A gantry is redefined as a whole: `--position P` on a side becomes
+    /// the shift that makes its gantry's first side read P, the same shift
+    /// for every side (their skew is kept). The first side's command is at
+    /// rest when the redefine is accepted, so the shift is the one its
+    /// engine would work out in the step.
+    fn whole_gantry(&self, i: usize, op: Operation) -> Operation {
+        let Operation::Redefine(r) = op else {
+            return op;
+        };
+        let Some(sides) = self.gantry_mask.iter().copied().find(|g| g & (1 << i) != 0) else {
+            return op;
+        };
+        if r.relative {
+            return op;
+        }
+        let lead = &self.slots[sides.trailing_zeros() as usize].engine;
+        let p = lead.to_axis(lead.last_command().position);
+        Operation::Redefine(RedefineSpec::by(r.value - p))
     }
 
     /// Renews (or ends) jog `token` on the axes of `mask` (0: every axis)
@@ -208,11 +232,21 @@ impl Core {
 
     /// A motion accepted only in part (on some axes, or on some sides of a
     /// gantry) is taken back where it was accepted: those axes stop (a
-    /// stream: ends) in the next step and are answered "not started".
-    /// Returns what stays accepted.
+    /// stream: ends) in the next step and are answered "not started"; a
+    /// redefine is taken back at once (nothing moved; the frame already
+    /// published carried no change). Returns what stays accepted.
     fn whole_or_nothing(&mut self, p: &mut Pending, accepted: u64) -> u64 {
         if accepted == p.mask {
             return accepted;
+        }
+        if p.kind == OpKind::Redefine {
+            for i in named(accepted, self.slots.len()) {
+                let slot = &mut self.slots[i];
+                let id = slot.status().op.id;
+                slot.engine.take_back_redefine(id);
+                p.ack.axes[i] = AxisAck::Refused(Refusal::NotStarted);
+            }
+            return 0;
         }
         let undo = match p.then {
             Then::Own(_) => Operation::StreamEnd,

@@ -189,3 +189,93 @@ fn a_restarted_io_process_gets_no_enable_it_did_not_ask_for() {
         "enabled again on request"
     );
 }
+
+#[test]
+fn a_gantry_is_redefined_whole_or_not_at_all() {
+    use crate::shared::{AxisAck, Refusal};
+    use motion_homing::codes::{ERR_AXIS_FAULTED, EX_REDEFINE};
+    use motion_homing::RedefineSpec;
+    let mut b = Bench::new(&gantry());
+    b.run(5);
+    b.home(0b11, true);
+    for _ in 0..20_000 {
+        b.cycle();
+        let s = b.snap();
+        if s.axes[..2].iter().all(|a| a.status.pc && a.settled()) {
+            break;
+        }
+    }
+    b.run(5);
+    let before = b.snap();
+    assert!(
+        before.axes[..2].iter().all(|a| a.status.homed),
+        "{before:?}"
+    );
+    let raw = [before.axes[0].cmd_position, before.axes[1].cmd_position];
+    let skew = before.axes[1].cmd_axis.unwrap() - before.axes[0].cmd_axis.unwrap();
+    // --position 7 on the gantry: both sides by the shift that makes G1 read 7.
+    b.op(0b11, Operation::Redefine(RedefineSpec::to(7.0)), 0);
+    b.run(3);
+    let ack = b.acks.pop().unwrap();
+    assert!(
+        ack.axes[..2].iter().all(|a| *a == AxisAck::Accepted),
+        "{ack:?}"
+    );
+    let s = b.snap();
+    assert!((s.axes[0].cmd_axis.unwrap() - 7.0).abs() < 1e-9);
+    let now_skew = s.axes[1].cmd_axis.unwrap() - s.axes[0].cmd_axis.unwrap();
+    assert!((now_skew - skew).abs() < 1e-9, "{skew} → {now_skew}");
+    assert_eq!([s.axes[0].cmd_position, s.axes[1].cmd_position], raw);
+    // G2 faulted: G1 would accept, G2 refuses: neither is redefined.
+    b.plants[1].inject_fault();
+    b.run(3);
+    assert!(b.snap().axes[1].status.faulted);
+    b.op(0b11, Operation::Redefine(RedefineSpec::by(5.0)), 0);
+    b.run(3);
+    let ack = b.acks.pop().unwrap();
+    assert_eq!(ack.axes[0], AxisAck::Refused(Refusal::NotStarted));
+    assert_eq!(
+        ack.axes[1],
+        AxisAck::Refused(Refusal::Operation {
+            err: ERR_AXIS_FAULTED,
+            exerr: EX_REDEFINE
+        })
+    );
+    let s = b.snap();
+    assert!((s.axes[0].cmd_axis.unwrap() - 7.0).abs() < 1e-9);
+    assert_eq!(
+        s.axes[0].status.shift,
+        7.0 - before.axes[0].cmd_axis.unwrap()
+    );
+    assert_eq!(s.axes[0].status.redefines, 1);
+}
+
+#[test]
+fn after_a_redefine_the_monitor_keeps_the_soft_limits_on_the_machine() {
+    use motion_homing::{MoveSpec, RedefineSpec};
+    // X homed at raw 0 (position 0), limits [-20, 20]; by 5: the limits
+    // read [-15, 25], the same raw places. A move to 25 ends on raw 20
+    // and the cycle monitor, which checks every command against the soft
+    // limits on its own, sees nothing wrong.
+    let mut b = Bench::new(ONE_AXIS);
+    b.run(5);
+    b.home(1, false);
+    b.run(5);
+    b.op(1, Operation::Enable, 0);
+    b.run(20);
+    b.op(1, Operation::Redefine(RedefineSpec::by(5.0)), 0);
+    b.run(2);
+    assert_eq!(b.snap().axes[0].status.soft_limits, Some((-15.0, 25.0)));
+    b.op(1, Operation::Move(MoveSpec::to(25.0)), 0);
+    b.run(2);
+    for _ in 0..5000 {
+        b.cycle();
+        if b.snap().axes[0].status.op.pc {
+            break;
+        }
+    }
+    let s = b.snap().axes[0];
+    assert!(s.status.op.pc && !s.status.er, "{:?}", s.status);
+    assert!(s.monitor.is_none(), "{:?}", s.monitor);
+    assert!((cmd(&b) - 20.0).abs() < 1e-9, "{}", cmd(&b));
+}

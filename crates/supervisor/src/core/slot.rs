@@ -261,7 +261,7 @@ impl AxisSlot {
             feedback: self.feedback.as_ref(),
             request,
             status: self.engine.status(),
-            reference: self.engine.reference_offset(),
+            reference: self.engine.limits_offset(),
             command: &self.engine_command,
             io_restarted: self.link.restarted,
         });

@@ -234,6 +234,7 @@ impl Absolute {
             format: FORMAT,
             axis: name.clone(),
             offset,
+            shift: a.status.shift,
             raw,
             position,
             homed_at: entry.time.clone(),
@@ -257,6 +258,45 @@ impl Absolute {
         self.said = None;
     }
 
+    /// Redefine position shifted the axis: the stored reference follows
+    /// (offset and shift), so after a restart the axis reads the redefined
+    /// position and its soft limits are where they were on the machine.
+    /// Only a reference this run trusts is rewritten (a suspended or
+    /// invalidated one stays as it was).
+    pub(super) fn redefined(
+        &mut self,
+        m: &MachineConfig,
+        i: usize,
+        a: &AxisSnap,
+        dir: Option<&StateDir>,
+    ) {
+        let name = &m.axes[i].name;
+        let (Some(r), Some(offset), Some(raw), Some(position)) =
+            (self.stored.as_mut(), a.offset, a.raw, a.axis)
+        else {
+            return;
+        };
+        if self.suspended {
+            return;
+        }
+        r.offset = offset;
+        r.shift = a.status.shift;
+        r.raw = raw;
+        r.position = position;
+        match dir.map(|d| References::new(d.clone()).save(r)) {
+            Some(Ok(())) => log::info!(
+                "{name}: position redefined (offset {offset}, shift {}): the stored reference \
+                 follows",
+                r.shift
+            ),
+            Some(Err(e)) => log::error!(
+                "{name}: could not store the redefined reference ({e}): after a restart the \
+                 axis reads its position before the redefine"
+            ),
+            None => {}
+        }
+    }
+
     /// Asks the cycle to apply the stored reference when the axis is not
     /// homed, not homing, and has fresh feedback from an attached process.
     pub(super) fn maybe_restore(
@@ -264,7 +304,7 @@ impl Absolute {
         m: &MachineConfig,
         i: usize,
         snap: &Snapshot,
-        restore: &mut impl FnMut(usize, f64) -> Option<u32>,
+        restore: &mut impl FnMut(usize, f64, f64) -> Option<u32>,
     ) {
         let Some(r) = &self.stored else {
             return;
@@ -282,7 +322,7 @@ impl Absolute {
         {
             return;
         }
-        self.pending = restore(i, r.offset);
+        self.pending = restore(i, r.offset, r.shift);
         self.retry_at = Some(Instant::now() + RETRY);
     }
 
@@ -319,6 +359,7 @@ impl Absolute {
                 position,
             })) => {
                 let (lo, hi) = m.axes[i].engine.travel_limits.unwrap_or((0.0, 0.0));
+                let (lo, hi) = (lo + r.shift, hi + r.shift);
                 let why = format!(
                     "the stored reference puts the axis at {position}, outside its travel \
                      limits [{lo}, {hi}]: encoder replaced or mechanics moved"

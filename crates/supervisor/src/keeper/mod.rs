@@ -35,6 +35,8 @@ pub use motion_status::AxisNote;
 struct AxisKeep {
     /// `homes_started` of the last homing recorded.
     recorded_homes: u32,
+    /// `redefines` of the last redefine position recorded.
+    recorded_redefines: u32,
     /// Recent events in the prior reference, and switch-to-marker
     /// distances, of successful homings.
     events: DriftHistory,
@@ -120,13 +122,15 @@ impl Keeper {
     }
 
     /// Looks at a new snapshot: records homings that ended, saves,
-    /// invalidates or restores references. `restore(axis, offset)` sends a
-    /// restore request to the cycle and returns its id.
+    /// invalidates or restores references; records every redefine
+    /// position (and stores an absolute axis's reference after it).
+    /// `restore(axis, offset, shift)` sends a restore request to the cycle
+    /// and returns its id.
     pub fn observe(
         &mut self,
         m: &MachineConfig,
         snap: &Snapshot,
-        mut restore: impl FnMut(usize, f64) -> Option<u32>,
+        mut restore: impl FnMut(usize, f64, f64) -> Option<u32>,
     ) {
         if self.last_cycle == Some(snap.cycle) {
             return;
@@ -153,6 +157,15 @@ impl Keeper {
                     abs.homing_ended(m, i, a, &entry, self.dir.as_ref(), self.record.as_mut());
                 }
                 append(self.record.as_mut(), &entry);
+            }
+            if a.status.redefines != keep.recorded_redefines {
+                keep.recorded_redefines = a.status.redefines;
+                if let Some(e) = outcome::redefined(m, i, a) {
+                    if let Some(abs) = keep.absolute.as_mut() {
+                        abs.redefined(m, i, a, self.dir.as_ref());
+                    }
+                    append(self.record.as_mut(), &e);
+                }
             }
             if let Some(abs) = keep.absolute.as_mut() {
                 abs.maybe_restore(m, i, snap, &mut restore);

@@ -1,10 +1,11 @@
 //! A homing that ended, as a line of the homing record, with the two checks
 //! no single homing can make: drift against the axis's recent events, and
 //! the switch-to-marker distance (its drift, and the engine's verdict that
-//! the marker was ambiguous).
+//! the marker was ambiguous); and a redefine position, as a line of its own
+//! kind.
 
 use super::{AxisKeep, AxisNote};
-use crate::shared::Snapshot;
+use crate::shared::{AxisSnap, Snapshot};
 use motion_config::MachineConfig;
 use motion_homing::{HomeMode, HomeSequence};
 use motion_state::{RecordEntry, RecordKind};
@@ -133,6 +134,30 @@ pub(super) fn entry(
         skew: a.skew.map(r6),
         reason: None,
         warnings,
+        ..RecordEntry::default()
     };
     (entry, note)
+}
+
+/// The record line of axis `i`'s redefine position (its own kind: no
+/// homing ran, nothing moved). `None` when the snapshot shows the axis no
+/// longer homed (the reference it shifted is already gone).
+pub(super) fn redefined(m: &MachineConfig, i: usize, a: &AxisSnap) -> Option<RecordEntry> {
+    let offset = a.offset?;
+    let (time, unix_ms) = motion_state::now_stamp();
+    Some(RecordEntry {
+        time,
+        unix_ms,
+        kind: Some(RecordKind::Redefined),
+        axis: m.axes[i].name.clone(),
+        gantry: m.gantry_of(i).map(|g| m.gantries[g].name.clone()),
+        result: "redefined".into(),
+        pc: a.status.pc,
+        homed: true,
+        offset: Some(r6(offset)),
+        shift: Some(r6(a.status.shift)),
+        position: a.cmd_axis.map(r6),
+        reason: Some("redefine position: no motion".into()),
+        ..RecordEntry::default()
+    })
 }

@@ -35,11 +35,17 @@ impl Kb {
         let snap = self.b.snap();
         let mut sends = Vec::new();
         let next = &mut self.next_id;
-        self.keeper.observe(&self.b.m, &snap, |axis, offset| {
-            *next += 1;
-            sends.push(Control::undated(*next, Ask::Restore { axis, offset }));
-            Some(*next)
-        });
+        self.keeper
+            .observe(&self.b.m, &snap, |axis, offset, shift| {
+                *next += 1;
+                let ask = Ask::Restore {
+                    axis,
+                    offset,
+                    shift,
+                };
+                sends.push(Control::undated(*next, ask));
+                Some(*next)
+            });
         for c in sends {
             self.b.control(c);
         }
@@ -504,4 +510,43 @@ fn the_gantry_example_homes_in_order_and_keeps_its_absolute_axis() {
         (0..4).all(|i| !s.axes[i].status.homed),
         "incremental axes need homing"
     );
+}
+
+#[test]
+fn a_redefine_is_recorded_and_an_absolute_axis_keeps_it_over_a_restart() {
+    use motion_homing::{Operation, RedefineSpec};
+    let t = state_dir();
+    let toml = absolute_axis(t.path(), 10.0, 113.4);
+    {
+        let mut k = Kb::new(&toml);
+        k.run(20);
+        k.home(1);
+        // Axis 10 → 35: by 25, nothing moves.
+        k.b.op(1, Operation::Redefine(RedefineSpec::by(25.0)), 0);
+        k.run(5);
+        let a = k.b.snap().axes[0];
+        assert!(a.status.homed && a.status.pc, "{a:?}");
+        assert!((a.axis.unwrap() - 35.0).abs() < 1e-9);
+        assert_eq!(a.status.soft_limits, Some((-25.0, 425.0)));
+        let last = k.record().pop().unwrap();
+        assert_eq!(last.kind, Some(RecordKind::Redefined));
+        assert_eq!(last.result, "redefined");
+        assert_eq!((last.shift, last.position), (Some(25.0), Some(35.0)));
+        assert!((last.offset.unwrap() + 78.4).abs() < 1e-9);
+    }
+    let refs = References::new(StateDir::open(&t.path().join("state")).unwrap());
+    let Loaded::Valid(r) = refs.load("A") else {
+        panic!("not stored")
+    };
+    assert!((r.offset + 78.4).abs() < 1e-9 && r.shift == 25.0, "{r:?}");
+
+    // Restart: the encoder still reads 113.4; the axis reads 35 again and
+    // its soft limits are on the same machine places.
+    let mut k = Kb::new(&toml);
+    k.run(100);
+    let a = k.b.snap().axes[0];
+    assert!(a.status.homed && a.restored, "{a:?}");
+    assert!((a.axis.unwrap() - 35.0).abs() < 1e-9);
+    assert_eq!(a.status.soft_limits, Some((-25.0, 425.0)));
+    assert_eq!(k.record().last().unwrap().result, "restored");
 }

@@ -28,15 +28,22 @@ use crate::operation::StopCause;
 use crate::profile::{stop_displacement, Kinematics, Profile};
 
 impl Axis {
-    /// The travel limits as raw positions, while they are enforced: homed,
-    /// linear, configured.
-    pub(in crate::axis) fn soft_limits_raw(&self) -> Option<(f64, f64)> {
+    /// The travel limits in axis coordinates, while they are enforced:
+    /// homed, linear, configured. `travel_limits` + the shift redefine
+    /// position applied since homing: the numbers move with the axis's
+    /// positions, the place on the machine does not.
+    pub(in crate::axis) fn soft_limits_axis(&self) -> Option<(f64, f64)> {
         match (self.status.homed, self.cfg.travel, self.cfg.travel_limits) {
-            (true, TravelMode::Linear, Some((lo, hi))) => {
-                Some((lo - self.offset, hi - self.offset))
-            }
+            (true, TravelMode::Linear, Some((lo, hi))) => Some((lo + self.shift, hi + self.shift)),
             _ => None,
         }
+    }
+
+    /// The travel limits as raw positions, while they are enforced (the
+    /// same machine places whatever redefine position did).
+    pub(in crate::axis) fn soft_limits_raw(&self) -> Option<(f64, f64)> {
+        self.soft_limits_axis()
+            .map(|(lo, hi)| (lo - self.offset, hi - self.offset))
     }
 
     /// Half a count, units: positions closer than this are the same to the

@@ -14,6 +14,7 @@
 //!   `follower`: the stream's bounded follower (one cycle of arithmetic);
 //! * `limits`: software travel limits (homed, linear) and the hardware
 //!   limit switches;
+//! * `redefine`: redefine position (MRP), the offset alone;
 //! * `motion`: the data a motion carries from step to step;
 //! * this file: the dispatch, stops, faults, and what the status shows.
 //!
@@ -69,6 +70,7 @@ mod limits;
 pub(super) mod motion;
 mod moves;
 mod power;
+mod redefine;
 mod rules;
 mod stream;
 
@@ -123,6 +125,7 @@ impl Axis {
                 Ok(())
             }
             Operation::Change(c) => self.change_op(now, &c),
+            Operation::Redefine(r) => self.redefine_op(&r),
         };
         match result {
             Err(code) => self.status.op.refused = Some(code),

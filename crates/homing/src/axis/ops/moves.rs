@@ -83,7 +83,7 @@ impl Axis {
         if !within(raw, self.cfg.max_position.min(f64::MAX)) {
             return outside;
         }
-        if let (Some((lo, hi)), true) = (self.cfg.travel_limits, self.soft_limits_raw().is_some()) {
+        if let Some((lo, hi)) = self.soft_limits_axis() {
             let axis = if a.relative {
                 p + self.offset + a.target
             } else {

@@ -13,6 +13,7 @@
 //! | setpoint (an axis fault, 1019) | 1 not finite · 2 outside the travel limits · 3 faster than the speed cap (unhomed: `unhomed_speed`) on the program's timeline, or the command held back by it further than it can follow · 4 a change of velocity above `stream_acceleration` on the program's timeline, or the command held back by it further than it can follow · 5 nothing for `stream_timeout_ms` since the last one arrived · 6 out of order · 7 not homed |
 //! | change (`change.rs`) | as jog's first two rows, then 3 streaming · 3/1 no jog or move runs · 13/1..3, 13/8 operands · 13/4 a stop that would end outside |
 //! | reset | 16 homing in process |
+//! | redefine | 16/25 homing in process · 20/25 faulted · 1023/1 not homed · 3/25 not at rest (jog, move, stream, stop or enable under way) · 12/40 no valid feedback · coupled to another axis (`coupling_allows_redefine`) · 1023/2 not finite |
 //! | disable, stop, stream end | never |
 //!
 //! Home (the rung's rising edge) is refused with 20 when faulted and 3 while
@@ -137,6 +138,14 @@ impl Axis {
         } else {
             Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_JERK))
         }
+    }
+
+    /// Redefine position on an axis coupled to another (geared, as master
+    /// or slave) would move the reference the coupling follows: the one
+    /// place that refuses it. Nothing couples axes yet, so nothing is
+    /// refused here; gearing adds its refusal to this predicate.
+    pub(super) fn coupling_allows_redefine(&self) -> Result<(), Code> {
+        Ok(())
     }
 
     /// A jog's lease: 50 ms ..= 5 s.

@@ -218,9 +218,9 @@ impl Axis {
             }
             _ => sp.position - self.offset,
         };
-        let outside = match (self.soft_limits_raw(), self.cfg.travel_limits) {
-            (Some(_), Some((lo, hi))) => !(lo..=hi).contains(&sp.position),
-            _ => false,
+        let outside = match self.soft_limits_axis() {
+            Some((lo, hi)) => !(lo..=hi).contains(&sp.position),
+            None => false,
         };
         if outside || !within(raw, self.cfg.max_position.min(f64::MAX)) {
             return Err(EX_SETPOINT_OUTSIDE_LIMITS);
