@@ -182,4 +182,11 @@ pub struct Status {
     /// The I/O process reports the axis's drive lost (`Request::drive_lost`):
     /// not a reading, not enabled, whatever the last feedback said.
     pub drive_lost: bool,
+    /// A registration (MAR, `Operation::Arm`) is armed: the next edge of
+    /// its input (inside its window) will be latched. Cleared when it
+    /// latched, by `Operation::Disarm`, and when a homing starts.
+    pub registration_armed: bool,
+    /// Axis position of the edge the last registration latched (`None`
+    /// from an arming until it latched).
+    pub registration_position: Option<f64>,
 }

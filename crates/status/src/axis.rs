@@ -207,6 +207,14 @@ crate::status_table! {
     /// The position commanded this cycle, axis coordinates (with
     /// `position`: the following error).
     cmd_position: Maybe @ 14, Units, "command", -, "CommandPosition", |s| s.a.cmd_axis;
+    /// A registration (MAR, `arm`) is armed: the next edge of its input
+    /// will be latched.
+    registration_armed: Flag @ 36, None, "registration_armed", "r", "RegistrationArmed",
+        |s| s.status.registration_armed;
+    /// Axis position of the edge the last registration latched (none from
+    /// an arming until it latched).
+    registration_position: Maybe @ 15, Units, "registration_position", -,
+        "RegistrationPosition", |s| s.status.registration_position;
 }
 
 /// The rows that say the axis is in motion by an operation (a jog, a

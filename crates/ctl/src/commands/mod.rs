@@ -1,5 +1,6 @@
 //! The subcommands; each returns the exit code (see `motionctl --help`).
 
+mod arm;
 mod csv;
 mod home;
 mod jog;
@@ -50,6 +51,8 @@ pub fn run(cli: Cli) -> i32 {
         Command::Stream(a) => stream::stream(&mut client, &a),
         Command::Stats(a) => stats::stats(&mut client, &a),
         Command::Trace(a) => trace::trace(&mut client, &a),
+        Command::Arm(a) => arm::arm(&mut client, &a),
+        Command::Disarm(a) => simple::axes(&mut client, Simple::Op(Operation::Disarm), &a),
     }
 }
 

@@ -50,6 +50,7 @@ pub mod loss;
 mod ops;
 mod plausible;
 mod reference;
+mod registration;
 mod state;
 
 use crate::codes::*;
@@ -70,6 +71,7 @@ use latches::Latches;
 use loss::FeedbackLoss;
 use ops::Ops;
 use plausible::Plausibility;
+use registration::Registration;
 pub use reference::RestoreRefusal;
 use state::{Run, State};
 
@@ -113,6 +115,8 @@ pub struct Axis {
     /// Torque limits and error tolerances overridden (torque sequences).
     overrides: bool,
     latches: Latches,
+    /// The armed registration (MAR), if any.
+    reg: Registration,
     /// The newest valid sample, and what the detection needs of the one
     /// before it.
     prev: Option<Seen>,
@@ -157,6 +161,7 @@ impl Axis {
             enable: false,
             overrides: false,
             latches: Latches::default(),
+            reg: Registration::default(),
             prev: None,
             last: None,
             last_sample_ns: None,
@@ -359,6 +364,8 @@ impl Axis {
             faulted: self.status.faulted,
             last_stop: self.status.last_stop,
             op: self.status.op,
+            registration_armed: self.status.registration_armed,
+            registration_position: self.status.registration_position,
             ..Status::default()
         };
         // Logix: MAH on a faulted axis errors (20); a jog, move or stream
@@ -379,6 +386,9 @@ impl Axis {
             return self.fail(now, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, Abort::Controlled);
         };
         self.homing_takes_over();
+        // Home and registration exclude each other: the homing needs the
+        // latches, and its new reference would move the window.
+        self.disarm_registration();
         self.status.ip = true;
         self.status.homing = true;
         self.status.homed = false;
@@ -411,6 +421,7 @@ impl Axis {
     // ------------------------------------------------------------------
 
     fn advance(&mut self, now: u64, s: &Sample) {
+        self.registration_step(now, s);
         self.power_tick(now);
         self.watch_drive(now, s);
         let moving = self.state.commands_motion();

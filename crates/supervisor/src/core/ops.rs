@@ -43,6 +43,9 @@ pub(super) struct Pending {
     then: Then,
     /// A motion (jog, move, stream): a gantry accepts it whole or not at all.
     motion: bool,
+    /// Answered in place (`OpKind::in_place`): accepted when the engine
+    /// set no refusal, the id staying the running operation's.
+    in_place: bool,
 }
 
 /// Operations that move the axis (or take it over to be moved).
@@ -123,6 +126,7 @@ impl Core {
             mask,
             then,
             motion: is_motion(&op),
+            in_place: op.kind().in_place(),
         });
         for i in named(mask, n) {
             let slot = &mut self.slots[i];
@@ -183,7 +187,7 @@ impl Core {
             let mut accepted = 0u64;
             for i in named(p.mask, n) {
                 let s = self.slots[i].status().op;
-                if s.id != self.slots[i].op_before {
+                if s.id != self.slots[i].op_before || (p.in_place && s.refused.is_none()) {
                     accepted |= 1 << i;
                     p.ack.axes[i] = AxisAck::Accepted;
                     p.ack.op_ids[i] = s.id;

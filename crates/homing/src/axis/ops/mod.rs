@@ -110,9 +110,17 @@ impl Axis {
                 self.stop_op(now);
                 Ok(())
             }
+            Operation::Arm(a) => self.arm_op(now, &a),
+            Operation::Disarm => {
+                self.disarm_registration();
+                Ok(())
+            }
         };
-        if let Err(code) = result {
-            self.status.op.refused = Some(code);
+        match result {
+            Err(code) => self.status.op.refused = Some(code),
+            // Answered in place: the running operation keeps its id.
+            Ok(()) if op.kind().in_place() => self.status.op.refused = None,
+            Ok(()) => {}
         }
     }
 
