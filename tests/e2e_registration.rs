@@ -62,7 +62,10 @@ fn arm_latches_the_switch_and_the_marker_exactly_where_the_drive_latches() {
     // --no-wait: armed, nothing latched yet; a jog across the switch
     d.ctl(&["arm", "X", "--no-wait"]).expect_code(0);
     let x = d.axis("X");
-    assert!(x.registration_armed && x.registration_position.is_none(), "{x:#?}");
+    assert!(
+        x.registration_armed && x.registration_position.is_none(),
+        "{x:#?}"
+    );
     let mut jog = spawn_motionctl(&["--service-prefix", &cfg.prefix, "jog", "X", "--speed", "5"]);
     let x = wait_axis(&d, "X", |a| !a.registration_armed);
     assert!(x.jogging, "the jog runs on: {x:#?}");
@@ -73,7 +76,11 @@ fn arm_latches_the_switch_and_the_marker_exactly_where_the_drive_latches() {
         "the jog ended normally"
     );
     let x = d.axis("X");
-    assert_eq!(x.registration_position, Some(2.0), "the edge, exactly: {x:#?}");
+    assert_eq!(
+        x.registration_position,
+        Some(2.0),
+        "the edge, exactly: {x:#?}"
+    );
 
     // waiting, the falling edge, during a move
     wait_axis(&d, "X", |a| !a.stopping && !a.jogging);
@@ -122,9 +129,13 @@ fn without_a_drive_latch_arm_samples_the_edge_within_a_cycle_of_travel() {
     wait_axis(&d, "Z", |a| a.servo_action);
     // speed 5 u/s, cycle 1 ms: the edge within 5 × 0.001 / 2 (and a count)
     let arm = arm_waiting(&d, &cfg.prefix, "Z", &[]);
-    d.ctl(&["move", "Z", "--to", "6", "--speed", "5"]).expect_code(0);
+    d.ctl(&["move", "Z", "--to", "6", "--speed", "5"])
+        .expect_code(0);
     let p = latched(arm);
-    eprintln!("sampled: latched {p} for the edge at 2 (error {:.4})", p - 2.0);
+    eprintln!(
+        "sampled: latched {p} for the edge at 2 (error {:.4})",
+        p - 2.0
+    );
     assert!((p - 2.0).abs() <= 5.0 * 0.001 / 2.0 + COUNT, "{p}");
 
     // disarm: nothing latched on the way back; the last position stays
@@ -136,4 +147,89 @@ fn without_a_drive_latch_arm_samples_the_edge_within_a_cycle_of_travel() {
     assert!(!d.axis("Z").registration_armed);
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
+}
+
+/// One linear axis S on an emulated CiA 402 drive: immediate homing (axis
+/// = raw until homed), the home switch over [0, 5], markers at 2.5 + 10 k;
+/// `registration` (touch probe 2 on the switch) as given, the marker
+/// latched by touch probe 1 where the drive has it. `tweak` changes the
+/// drive. None (printed why) without root.
+fn ecat(
+    tag: &str,
+    registration: bool,
+    tweak: impl FnOnce(&mut [ecat_emu::DriveConfig]),
+) -> Option<motion_harness::ecat::Bus> {
+    let m = Machine::fixture("slow_switch")
+        .set("supervisor.feedback_timeout_ms", 100)
+        .set("axis.S.home_sequence", "immediate")
+        .set("axis.S.max_speed", 10.0)
+        .set("axis.S.marker", true)
+        .set("axis.S.registration", registration)
+        .set("axis.S.sim.start", -2.0)
+        .set("axis.S.sim.marker_every", 10.0)
+        .set("axis.S.sim.marker_at", 2.5);
+    motion_harness::ecat::Bus::start(tag, &m, tweak)
+}
+
+/// Armed on the bus's S, moved at 2 u/s to `to`: the latched position.
+fn ecat_latched(d: &Daemon, prefix: &str, args: &[&str], to: &str) -> f64 {
+    let arm = arm_waiting(d, prefix, "S", args);
+    d.ctl(&["move", "S", "--to", to, "--speed", "2"])
+        .expect_code(0);
+    latched(arm)
+}
+
+/// Through the touch probes: exact to the count, both edges of the switch
+/// (0x60BC, 0x60BD) and the marker (0x60BA).
+#[test]
+fn over_ethercat_the_touch_probe_latches_exactly_to_the_count() {
+    let _serial = serial();
+    let Some(b) = ecat("ecat_reg_tp", true, |_| {}) else {
+        return;
+    };
+    let d = Daemon::start(&b.cfg, &["bus0"]);
+    d.ctl(&["enable", "S"]).expect_code(0);
+    wait_axis(&d, "S", |a| a.servo_action);
+    let p = &b.cfg.prefix;
+    let rising = ecat_latched(&d, p, &[], "1");
+    let falling = ecat_latched(&d, p, &["--edge", "falling"], "6");
+    let back = ecat_latched(&d, p, &["--edge", "rising"], "4");
+    let marker = ecat_latched(&d, p, &["--input", "marker"], "1");
+    eprintln!(
+        "touch probe: rising {rising} (edge 0), falling {falling} (edge 5), \
+         rising backwards {back} (edge 5), marker {marker} (2.5)"
+    );
+    for (got, want) in [(rising, 0.0), (falling, 5.0), (back, 5.0), (marker, 2.5)] {
+        assert!(
+            (got - want).abs() < 1e-9,
+            "{got} vs {want}: not to the count"
+        );
+    }
+    d.stop().expect_code(0);
+    assert_clean(&b.cfg.prefix);
+}
+
+/// A drive without touch probes ("no touch probe" profile): `arm` is not
+/// refused; the edge is sampled from 0x60FD, within speed × cycle (a
+/// sample may be a bus cycle old, see `e2e_ethercat.rs`).
+#[test]
+fn over_ethercat_without_a_touch_probe_the_edge_is_sampled_within_a_cycle_of_travel() {
+    let _serial = serial();
+    let Some(b) = ecat("ecat_reg_sampled", false, |d| d[0].touch_probe = false) else {
+        return;
+    };
+    let d = Daemon::start(&b.cfg, &["bus0"]);
+    d.ctl(&["enable", "S"]).expect_code(0);
+    wait_axis(&d, "S", |a| a.servo_action);
+    let p = &b.cfg.prefix;
+    let rising = ecat_latched(&d, p, &[], "1");
+    let falling = ecat_latched(&d, p, &["--edge", "falling"], "6");
+    eprintln!(
+        "sampled over EtherCAT at 2 u/s, 1 ms: rising {rising} (edge 0), falling {falling} (edge 5)"
+    );
+    let bound = 2.0 * 0.001 + COUNT;
+    assert!(rising.abs() <= bound, "{rising}");
+    assert!((falling - 5.0).abs() <= bound, "{falling}");
+    d.stop().expect_code(0);
+    assert_clean(&b.cfg.prefix);
 }

@@ -822,7 +822,9 @@ pub const TABLE: &[Code] = &[
         "registration refused: a virtual axis has no inputs",
     )
     .ours()
-    .cause("`arm` on a `virtual` axis: it has no feedback device, no switch and no marker to latch.")
+    .cause(
+        "`arm` on a `virtual` axis: it has no feedback device, no switch and no marker to latch.",
+    )
     .remedy("Arm the registration on an axis with a drive or a feedback device."),
     code(
         ERR_REGISTRATION_REFUSED,
@@ -831,7 +833,9 @@ pub const TABLE: &[Code] = &[
         "registration refused: the axis has no marker",
     )
     .ours()
-    .cause("`arm --input marker` on an axis whose feedback device has no marker (`marker = false`).")
+    .cause(
+        "`arm --input marker` on an axis whose feedback device has no marker (`marker = false`).",
+    )
     .remedy("Latch the home switch input instead, or set `marker = true` if the encoder has one."),
     code(
         ERR_REGISTRATION_REFUSED,

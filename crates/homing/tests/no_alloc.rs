@@ -354,7 +354,10 @@ fn operations_make_no_allocation() {
                 home: true,
                 ..Request::default()
             },
-            15 => op(Operation::Arm(ArmSpec::on(LatchInput::Switch, LatchEdge::Rising))),
+            15 => op(Operation::Arm(ArmSpec::on(
+                LatchInput::Switch,
+                LatchEdge::Rising,
+            ))),
             20 => op(jog(20.0)),
             21..=700 if k % 50 == 0 => Request {
                 jog_renew: true,
@@ -368,7 +371,10 @@ fn operations_make_no_allocation() {
             850 => op(jog(5.0)),
             860 => op(mv(2.0, true)),
             1500 => op(Operation::StreamStart),
-            1510 => op(Operation::Arm(ArmSpec::on(LatchInput::Switch, LatchEdge::Falling))),
+            1510 => op(Operation::Arm(ArmSpec::on(
+                LatchInput::Switch,
+                LatchEdge::Falling,
+            ))),
             1520 => op(Operation::Disarm),
             // From where the move left it (2.0) at 1 u/s: every cycle,
             // then every tenth (100 Hz).

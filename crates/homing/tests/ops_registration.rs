@@ -264,7 +264,11 @@ fn refusals_and_homing() {
     }
     // A point window is a window; a faulted axis may still be armed
     // (registration only watches).
-    ask(&mut r, arm(LatchInput::Switch, LatchEdge::Rising, Some((1.0, 1.0)))).unwrap();
+    ask(
+        &mut r,
+        arm(LatchInput::Switch, LatchEdge::Rising, Some((1.0, 1.0))),
+    )
+    .unwrap();
 
     // Homing in process: refused (16); a homing that starts disarms.
     let cfg = AxisConfig {

@@ -71,8 +71,8 @@ use latches::Latches;
 use loss::FeedbackLoss;
 use ops::Ops;
 use plausible::Plausibility;
-use registration::Registration;
 pub use reference::RestoreRefusal;
+use registration::Registration;
 use state::{Run, State};
 
 /// How an abort treats the axis.
