@@ -585,7 +585,14 @@ fn a_drive_short_on_process_data_leaves_the_others_served() {
     );
     std::thread::sleep(Duration::from_millis(300));
     let v = b.drive(1).drive;
-    assert_eq!(v.state, State::SwitchOnDisabled, "{v:?}");
+    // power stage off: Switch on disabled (the backend's bounded stop), or
+    // Ready to switch on where the engine had withdrawn the enable request
+    // first (the loss is a fault of the axis) and the backend holds it as
+    // every disabled drive
+    assert!(
+        matches!(v.state, State::SwitchOnDisabled | State::ReadyToSwitchOn),
+        "{v:?}"
+    );
     assert_eq!(v.position, at, "moved: {v:?}");
     assert!(!d.axis("S").enabled);
     // after a reset it homes again

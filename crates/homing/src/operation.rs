@@ -689,6 +689,9 @@ pub enum StopCause {
     Released = 9,
     /// `Request::shutdown`: the power stage was switched off at once.
     Shutdown = 10,
+    /// The cycle monitor stopped the axis (ER 1021 / x): a command broke
+    /// one of its invariants.
+    Monitor = 11,
 }
 
 crate::spellings!(StopCause {
@@ -703,6 +706,7 @@ crate::spellings!(StopCause {
     Disable => "disable",
     Released => "released",
     Shutdown => "shutdown",
+    Monitor => "monitor",
 });
 
 impl StopCause {

@@ -52,6 +52,7 @@ mod plausible;
 mod reference;
 mod registration;
 mod state;
+mod tripped;
 
 use crate::codes::*;
 use crate::config::*;
