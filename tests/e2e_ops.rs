@@ -47,17 +47,7 @@ fn cmd(a: &AxisStatus) -> f64 {
 /// `motionctl ARGS --json` refused (exit 1) with ERR `err` / EXERR `exerr`.
 #[track_caller]
 fn refused_with(d: &Daemon, args: &[&str], err: u16, exerr: u16) {
-    let mut all = args.to_vec();
-    all.push("--json");
-    let r = d.ctl(&all);
-    let e: ErrorReport = r.expect_code(1).report();
-    assert!(
-        e.errors
-            .iter()
-            .any(|x| x.err == Some(err) && x.exerr == Some(exerr)),
-        "{args:?}: expected ERR {err} EXERR {exerr}: {}",
-        r.stdout
-    );
+    d.refused_with(args, err, exerr);
 }
 
 /// `motionctl move ... --json`, its one row.

@@ -192,6 +192,30 @@ fn the_installed_client_reads_status_homes_and_operates() {
     ))
     .abs()
         < 1e-9));
+    // registration: armed and disarmed in place, a bad window refused
+    let arm = format!(
+        "import sys\n\
+         from motion_supervisor_client import Supervisor, accepted, refusals\n\
+         s = Supervisor({p:?})\n\
+         assert accepted(s.arm('X', edge='falling', window=(-100.0, 100.0)))\n\
+         print('refused', refusals(s.arm('X', window=(2.0, 1.0))))\n\
+         sys.stdout.flush()\n"
+    );
+    let out = run(python_path, &["-c", &arm]);
+    out.expect_code(0);
+    assert!(out.stdout.contains("refused [('X', "), "{}", out.stdout);
+    assert!(out.stdout.contains(", 1022, 4)]"), "{}", out.stdout);
+    assert!(wait_for(Duration::from_secs(5), || d
+        .axis("X")
+        .registration_armed));
+    let disarm = format!(
+        "from motion_supervisor_client import Supervisor, accepted\n\
+         assert accepted(Supervisor({p:?}).disarm(['X']))\n"
+    );
+    run(python_path, &["-c", &disarm]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || !d
+        .axis("X")
+        .registration_armed));
     // the stream through the package: a sine of amplitude 1 from where X stands
     let x0 = value(d.axis("X").position, "X");
     let sine = Path::new(EXAMPLES_DIR).join("stream_sine.py");

@@ -270,6 +270,34 @@ class Supervisor:
         (s), accel, decel, jerk — `jog("X", -2.0)`."""
         return Jog(self, self.operate("jog", [axis], *args, **params))
 
+    def arm(self, axis: str, input: str = "switch", edge: str = "rising",
+            window=None) -> ControlResponse:
+        """MAR: latch `axis`'s position at the next `edge` ("rising":
+        becoming actuated, or "falling") of `input` ("switch": the home
+        switch, or "marker"), only inside `window` (lo, hi) if given; during
+        whatever motion. The position is the status entry's
+        `registration_position` once `registration_armed` drops
+        (`wait_registered`)."""
+        return self.operate("arm", [axis], input=input, edge=edge, window=window)
+
+    def disarm(self, axes=()) -> ControlResponse:
+        """MDR: disarm the registrations (none: every axis)."""
+        return self.operate("disarm", axes)
+
+    def wait_registered(self, axis: str, answer: ControlResponse, timeout: float = 60.0):
+        """After `arm`'s `answer`: the latched axis position once the
+        registration is no longer armed (None: disarmed without one)."""
+        until = time.monotonic() + timeout
+        while time.monotonic() < until:
+            frame = self.status()
+            if frame.cycle > answer.cycle:
+                for a in frame.axes[: frame.axis_count]:
+                    if text(a.name) == axis and not a.registration_armed:
+                        p = a.registration_position
+                        return None if p is None or math.isnan(p) else p
+            time.sleep(0.02)
+        raise TimeoutError(f"{axis}: nothing latched within {timeout} s")
+
     def stream(self, axes, owner: str = "python") -> "SetpointStream":
         """Takes `axes` over for the supervised setpoint stream."""
         return SetpointStream(self, axes, owner)

@@ -3,7 +3,7 @@
 use crate::spec_args::SpecArgs;
 use clap::{Args, Parser, Subcommand};
 use motion_config::args::{axis, runtime_dir, seconds, service_prefix};
-use motion_control::{ChangeSpec, JogSpec, MoveSpec, RedefineSpec};
+use motion_control::{ArmSpec, ChangeSpec, JogSpec, MoveSpec, RedefineSpec};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -11,7 +11,7 @@ use std::path::PathBuf;
     name = "motionctl",
     version,
     about = "The operator's tool for a running motion-supervisor: home, stop, unhome, status, \
-             stats, trace; enable, disable, reset, jog, move, stream.",
+             stats, trace; enable, disable, reset, jog, move, stream, arm, disarm.",
     after_help = "The supervisor is found by its service prefix: --service-prefix, else the \
                   config's [supervisor] service_prefix (--config), else \"motion\".\n\n\
                   Exit codes:\n  0  done (home: every named axis homed with PC set; move: \
@@ -92,6 +92,13 @@ pub enum Command {
     /// soft limits stay where they are on the machine (their numbers shift
     /// with it).
     Redefine(RedefineArgs),
+    /// MAR: latch the position of AXIS at the next edge of an input (the
+    /// home switch by default; rising: becoming actuated), during whatever
+    /// motion; waits and prints it. Exact where the drive latches the
+    /// input, else sampled (within half a cycle's travel).
+    Arm(ArmArgs),
+    /// MDR: disarm the registration of the named axes (all: every axis).
+    Disarm(AxesArgs),
 }
 
 #[derive(Debug, Args)]
@@ -188,6 +195,22 @@ pub struct RedefineArgs {
 }
 
 #[derive(Debug, Args)]
+pub struct ArmArgs {
+    /// The axis whose position is latched.
+    #[arg(value_name = "AXIS", value_parser = axis)]
+    pub axis: String,
+    /// The registration's parameters (the engine's `ArmSpec`): [--input
+    /// switch|marker] [--edge rising|falling] [--window LO HI].
+    #[command(flatten)]
+    pub spec: SpecArgs<ArmSpec>,
+    /// Return once armed, without waiting for the edge.
+    #[arg(long)]
+    pub no_wait: bool,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
 pub struct StreamArgs {
     /// The axes (or gantries) of the file's columns, in order.
     #[arg(value_name = "AXIS", required = true, value_parser = axis)]
@@ -244,7 +267,9 @@ impl Command {
             | Command::Unhome(a)
             | Command::Enable(a)
             | Command::Disable(a)
-            | Command::Reset(a) => a.json,
+            | Command::Reset(a)
+            | Command::Disarm(a) => a.json,
+            Command::Arm(a) => a.json,
             Command::Jog(a) => a.json,
             Command::Move(a) => a.json,
             Command::Stream(a) => a.json,

@@ -40,9 +40,11 @@ fn args_of(p: &Param, params: &[Param]) -> Vec<Arg> {
         let a = Arg::new(name).long(name).help(help(p));
         match p.kind {
             Kind::Switch => a.action(ArgAction::SetTrue),
+            // Left out: the first choice (the engine's default variant).
             Kind::Choice(choices) => a
                 .value_name(metavar)
-                .value_parser(PossibleValuesParser::new(choices.iter().copied())),
+                .value_parser(PossibleValuesParser::new(choices.iter().copied()))
+                .default_value(choices[0]),
             Kind::Axis => a.value_name(metavar).value_parser(axis),
             Kind::Pair => a
                 .num_args(2)

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use motion_report::{AxisStatus, StatusReport};
+use motion_report::{AxisStatus, ErrorReport, StatusReport};
 
 use crate::bins::test_bin;
 use crate::check::named;
@@ -154,6 +154,23 @@ impl Daemon {
     /// `motionctl --service-prefix P <args>` against this daemon.
     pub fn ctl(&self, args: &[&str]) -> Ended {
         ctl(&self.prefix, args)
+    }
+
+    /// `motionctl ARGS --json` against this daemon refused (exit 1) with
+    /// ERR `err` / EXERR `exerr` among its errors.
+    #[track_caller]
+    pub fn refused_with(&self, args: &[&str], err: u16, exerr: u16) {
+        let mut all = args.to_vec();
+        all.push("--json");
+        let r = self.ctl(&all);
+        let e: ErrorReport = r.expect_code(1).report();
+        assert!(
+            e.errors
+                .iter()
+                .any(|x| x.err == Some(err) && x.exerr == Some(exerr)),
+            "{args:?}: expected ERR {err} EXERR {exerr}: {}",
+            r.stdout
+        );
     }
 
     /// Its process id.

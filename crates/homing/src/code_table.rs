@@ -931,6 +931,51 @@ pub const TABLE: &[Code] = &[
         .ours()
         .cause("Redefine position was refused; the EXERR says why.")
         .remedy("See the EXERR's row."),
+    code(
+        ERR_REGISTRATION_REFUSED,
+        EX_REGISTRATION_NO_FEEDBACK_DEVICE,
+        &[R],
+        "registration refused: a virtual axis has no inputs",
+    )
+    .ours()
+    .cause(
+        "`arm` on a `virtual` axis: it has no feedback device, no switch and no marker to latch.",
+    )
+    .remedy("Arm the registration on an axis with a drive or a feedback device."),
+    code(
+        ERR_REGISTRATION_REFUSED,
+        EX_REGISTRATION_NO_MARKER,
+        &[R],
+        "registration refused: the axis has no marker",
+    )
+    .ours()
+    .cause(
+        "`arm --input marker` on an axis whose feedback device has no marker (`marker = false`).",
+    )
+    .remedy("Latch the home switch input instead, or set `marker = true` if the encoder has one."),
+    code(
+        ERR_REGISTRATION_REFUSED,
+        EX_REGISTRATION_WINDOW_NOT_FINITE,
+        &[R],
+        "registration refused: the window is not a pair of numbers",
+    )
+    .ours()
+    .cause("A bound of `--window LO HI` is not finite.")
+    .remedy("Give two finite axis positions, or no window."),
+    code(
+        ERR_REGISTRATION_REFUSED,
+        EX_REGISTRATION_WINDOW_EMPTY,
+        &[R],
+        "registration refused: the window's LO lies above its HI",
+    )
+    .ours()
+    .cause("`--window LO HI` with LO > HI: no position lies inside it.")
+    .remedy("Give the lower bound first."),
+    code(ERR_REGISTRATION_REFUSED, 0, &[R], "registration refused")
+        .any()
+        .ours()
+        .cause("A registration was refused; nothing was armed.")
+        .remedy("See the EXERR's row."),
 ];
 
 /// The row of `(err, exerr)`: its own, else the one for any EXERR of `err`.

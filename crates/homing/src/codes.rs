@@ -163,3 +163,16 @@ pub const EX_REDEFINE_NOT_HOMED: u16 = 1;
 /// The redefined position, shift or soft limits would not be finite, or
 /// would lie beyond ±`max_position`.
 pub const EX_REDEFINE_NOT_FINITE: u16 = 2;
+/// A registration (MAR, `Operation::Arm`) was refused (ours): nothing was
+/// armed. EXERR: `EX_REGISTRATION_*`. (Homing in process refuses it with
+/// ERR 16 as every operation.)
+pub const ERR_REGISTRATION_REFUSED: u16 = 1022;
+// EXERR under ERR 1022.
+/// A virtual axis: no feedback device, no inputs to latch.
+pub const EX_REGISTRATION_NO_FEEDBACK_DEVICE: u16 = 1;
+/// `--input marker` on an axis whose feedback has no marker (`marker = false`).
+pub const EX_REGISTRATION_NO_MARKER: u16 = 2;
+/// The window's bounds are not finite numbers.
+pub const EX_REGISTRATION_WINDOW_NOT_FINITE: u16 = 3;
+/// The window's LO lies above its HI.
+pub const EX_REGISTRATION_WINDOW_EMPTY: u16 = 4;

@@ -416,14 +416,39 @@ operations! {
         all: false,
         summary: "MRP: the axis's position becomes Position (or moves by it) without motion",
     }
+    /// MAR / MC_TouchProbe ([`ArmSpec`]): latch the axis's position at the
+    /// next edge of an input, during whatever motion (or none); the
+    /// position is `Status::registration_position`. Never moves the axis
+    /// and answered in place: a running jog, move or stream keeps its id.
+    Arm(ArmSpec) = 11 {
+        name: "arm",
+        title: "Arm",
+        client: true,
+        moves: false,
+        held: false,
+        all: false,
+        summary: "MAR: latch the axis's position at the next edge of Input (inside Window)",
+    }
+    /// MDR / MC_AbortTrigger: the armed registration is disarmed (its last
+    /// latched position stays). Always accepted; answered in place; asked
+    /// for without an axis, every axis's.
+    Disarm = 12 {
+        name: "disarm",
+        title: "Disarm",
+        client: true,
+        moves: false,
+        held: false,
+        all: true,
+        summary: "MDR: disarm the axis's registration",
+    }
 }
 
 impl OpKind {
     /// Answered in place: an accepted one leaves `Status::op.id` as it was
-    /// (the running motion keeps its id); only `Status::op.refused` tells
-    /// (cleared when accepted, set when refused).
+    /// (a running motion keeps its id, so its client follows it on); only
+    /// `Status::op.refused` tells (cleared when accepted, set when refused).
     pub const fn in_place(self) -> bool {
-        matches!(self, OpKind::Change)
+        matches!(self, OpKind::Change | OpKind::Arm | OpKind::Disarm)
     }
 }
 
@@ -548,6 +573,68 @@ impl RedefineSpec {
         RedefineSpec {
             value: d,
             relative: true,
+        }
+    }
+}
+
+/// The input a registration watches.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LatchInput {
+    /// The home switch input (actuated whatever its wiring).
+    #[default]
+    Switch = 0,
+    /// The feedback device's marker (index pulse).
+    Marker = 1,
+}
+
+crate::spellings!(LatchInput {
+    Switch => "switch",
+    Marker => "marker",
+});
+
+/// The edge of the input a registration takes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LatchEdge {
+    /// The input becomes actuated (a normally closed switch: opens).
+    #[default]
+    Rising = 0,
+    /// The input stops being actuated.
+    Falling = 1,
+}
+
+crate::spellings!(LatchEdge {
+    Rising => "rising",
+    Falling => "falling",
+});
+
+crate::op_spec! {
+    /// MAR / MC_TouchProbe: latch the axis's position at the next `edge`
+    /// of `input`, optionally only inside `window`. Where the drive latches
+    /// the input (`registration` for the home switch, `marker_latch` for
+    /// the marker) the position is the drive's, exact to the count; else
+    /// the engine samples the input each cycle and places the edge midway
+    /// between the samples around it (within half the travel of a cycle,
+    /// speed × cycle / 2).
+    pub struct ArmSpec {
+        /// The input: `switch` (the home switch, the default) or `marker`.
+        input: LatchInput = Param::new("Input", Unit::None).flag("input", "switch|marker"),
+        /// The edge: `rising` (becoming actuated, the default) or
+        /// `falling`. A marker is a pulse: both of its edges lie at the
+        /// marker.
+        edge: LatchEdge = Param::new("Edge", Unit::None).flag("edge", "rising|falling"),
+        /// Only an edge at an axis position in [LO, HI] counts (units);
+        /// left out: any.
+        window: Option<(f64, f64)> = Param::new("Window", Unit::Position).flag("window", "LO HI"),
+    }
+}
+
+impl ArmSpec {
+    /// The next `edge` of `input`, anywhere.
+    pub fn on(input: LatchInput, edge: LatchEdge) -> Self {
+        ArmSpec {
+            input,
+            edge,
+            window: None,
         }
     }
 }

@@ -192,4 +192,11 @@ pub struct Status {
     /// The software travel limits in axis coordinates while they are in
     /// force (homed, linear, configured): `travel_limits` + `shift`.
     pub soft_limits: Option<(f64, f64)>,
+    /// A registration (MAR, `Operation::Arm`) is armed: the next edge of
+    /// its input (inside its window) will be latched. Cleared when it
+    /// latched, by `Operation::Disarm`, and when a homing starts.
+    pub registration_armed: bool,
+    /// Axis position of the edge the last registration latched (`None`
+    /// from an arming until it latched).
+    pub registration_position: Option<f64>,
 }

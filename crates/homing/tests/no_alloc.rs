@@ -303,11 +303,17 @@ fn operations_make_no_allocation() {
         max_speed: 50.0,
         max_deceleration: 2000.0,
         cycle_ns: T,
+        marker: true,
+        marker_latch: true,
+        registration: true,
         ..AxisConfig::default()
     };
     let mut axis = Axis::new(cfg);
     let mut plant = Plant::new(PlantConfig {
         overtravel: Some((-12.0, 12.0)),
+        switch: Some((0.5, 1.0)),
+        marker_every: 2.0,
+        marker_at: 0.25,
         ..PlantConfig::default()
     });
     let mut fb = plant.feedback();
@@ -358,6 +364,10 @@ fn operations_make_no_allocation() {
                 home: true,
                 ..Request::default()
             },
+            15 => op(Operation::Arm(ArmSpec::on(
+                LatchInput::Switch,
+                LatchEdge::Rising,
+            ))),
             20 => op(jog(20.0)),
             // Refused while jogging (3 / 25).
             30 => op(Operation::Redefine(RedefineSpec::by(1.0))),
@@ -365,6 +375,10 @@ fn operations_make_no_allocation() {
                 jog_renew: true,
                 ..Request::default()
             },
+            790 => op(Operation::Arm(ArmSpec {
+                window: Some((-6.0, 0.0)),
+                ..ArmSpec::on(LatchInput::Marker, LatchEdge::Falling)
+            })),
             800 => op(mv(-5.0, false)),
             810 | 1450 => op(change),
             850 => op(jog(5.0)),
@@ -373,6 +387,11 @@ fn operations_make_no_allocation() {
             1400 => op(Operation::Redefine(RedefineSpec::by(1.0))),
             1420 => op(Operation::Redefine(RedefineSpec::to(2.0))),
             1500 => op(Operation::StreamStart),
+            1510 => op(Operation::Arm(ArmSpec::on(
+                LatchInput::Switch,
+                LatchEdge::Falling,
+            ))),
+            1520 => op(Operation::Disarm),
             // From where the move left it (2.0) at 1 u/s: every cycle,
             // then every tenth (100 Hz).
             1501..=2000 => sp(k - 1501, 2.0 + 0.001 * (k - 1501) as f64),
@@ -404,8 +423,8 @@ fn operations_make_no_allocation() {
     let mut during = 0;
     let mut changed = false;
     // Jogging, moving, streaming, a refused setpoint, a drive fault, two
-    // redefines: seen.
-    let mut seen = [false; 6];
+    // redefines, a registration latched: seen.
+    let mut seen = [false; 7];
     for k in 0..3200u64 {
         let req = script(k);
         let mut cmd = Command::default();
@@ -425,6 +444,7 @@ fn operations_make_no_allocation() {
             s.err == codes::ERR_SETPOINT_REFUSED,
             s.exerr == codes::EX_DRIVE_FAULT,
             s.redefines == 2,
+            s.registration_position.is_some(),
         ]
         .into_iter()
         .enumerate()
@@ -433,7 +453,7 @@ fn operations_make_no_allocation() {
         }
     }
     assert!(changed, "the change was accepted");
-    assert_eq!(seen, [true; 6]);
+    assert_eq!(seen, [true; 7]);
     // The unhomed part: a jog into the limit switch and a reset.
     let mut axis = Axis::new(AxisConfig {
         max_deceleration: 2000.0,

@@ -348,7 +348,8 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         assert_eq!(
             a["_methods"],
             serde_json::json!([
-                "Disable", "Enable", "Home", "Jog", "Move", "Reset", "Stop", "Unhome"
+                "Arm", "Disable", "Disarm", "Enable", "Home", "Jog", "Move", "Reset", "Stop",
+                "Unhome"
             ]),
             "{a}"
         );

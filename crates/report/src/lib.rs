@@ -35,7 +35,7 @@ pub use home::{
 };
 pub use io::{GapCounts, IoCounters, IoReport};
 pub use latency::{LateWakeup, Latency, Percentiles};
-pub use motion::{MotionReport, MotionRow};
+pub use motion::{MotionReport, MotionRow, RegistrationReport, RegistrationRow};
 pub use status::{AxisStatus, IoStatus, StatusReport, StreamIntake};
 pub use trace::TraceRow;
 

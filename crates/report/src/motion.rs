@@ -40,3 +40,18 @@ impl MotionReport {
         !self.axes.is_empty() && self.axes.iter().all(|r| r.pc && !r.er)
     }
 }
+
+/// One axis's latched registration (`arm --json`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RegistrationRow {
+    pub name: String,
+    /// Axis position of the latched edge, units (null: none latched — the
+    /// registration was disarmed, or a homing started).
+    pub position: Option<f64>,
+}
+
+/// `arm --json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RegistrationReport {
+    pub axes: Vec<RegistrationRow>,
+}

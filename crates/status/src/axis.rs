@@ -221,6 +221,14 @@ crate::status_table! {
     /// The positive software travel limit, as `soft_limit_negative`.
     soft_limit_positive: Maybe @ 17, Units, "soft_limit_positive", -, "SoftLimitPositive",
         |s| s.status.soft_limits.map(|l| l.1);
+    /// A registration (MAR, `arm`) is armed: the next edge of its input
+    /// will be latched.
+    registration_armed: Flag @ 36, None, "registration_armed", "r", "RegistrationArmed",
+        |s| s.status.registration_armed;
+    /// Axis position of the edge the last registration latched (none from
+    /// an arming until it latched).
+    registration_position: Maybe @ 15, Units, "registration_position", -,
+        "RegistrationPosition", |s| s.status.registration_position;
 }
 
 /// The rows that say the axis is in motion by an operation (a jog, a

@@ -92,6 +92,11 @@ impl AxisNeeds {
             brake_delay_ms: keys.brake_delay_ms,
             ..AxisNeeds::default()
         };
+        // `registration` says the drive latches the home switch: `arm`
+        // takes that latch whatever the axis homes with.
+        if engine.registration && !seq.uses_limit_switch() {
+            n.switch_probe = Some("registration = true".into());
+        }
         if !homes {
             return n;
         }

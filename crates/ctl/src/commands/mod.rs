@@ -1,5 +1,6 @@
 //! The subcommands; each returns the exit code (see `motionctl --help`).
 
+mod arm;
 mod csv;
 mod home;
 mod jog;
@@ -52,6 +53,8 @@ pub fn run(cli: Cli) -> i32 {
         Command::Redefine(a) => simple::redefine(&mut client, &a),
         Command::Stats(a) => stats::stats(&mut client, &a),
         Command::Trace(a) => trace::trace(&mut client, &a),
+        Command::Arm(a) => arm::arm(&mut client, &a),
+        Command::Disarm(a) => simple::axes(&mut client, Simple::Op(Operation::Disarm), &a),
     }
 }
 

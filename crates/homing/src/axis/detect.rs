@@ -164,7 +164,7 @@ impl Axis {
 
     /// A latched position lies on the travel seen since arming, give or take
     /// one step of travel at `max_speed` (no check without a `max_speed`).
-    fn latch_plausible(&self, travel: Option<Travel>, at: f64, s: &Sample) -> bool {
+    pub(super) fn latch_plausible(&self, travel: Option<Travel>, at: f64, s: &Sample) -> bool {
         match (self.plausible.latch_margin(s.dt_ns), travel) {
             (Some(margin), Some(t)) => t.covers(at, margin),
             _ => true,

@@ -50,6 +50,7 @@ pub mod loss;
 mod ops;
 mod plausible;
 mod reference;
+mod registration;
 mod state;
 mod tripped;
 
@@ -72,6 +73,7 @@ use loss::FeedbackLoss;
 use ops::Ops;
 use plausible::Plausibility;
 pub use reference::RestoreRefusal;
+use registration::Registration;
 use state::{Run, State};
 
 /// How an abort treats the axis.
@@ -114,6 +116,8 @@ pub struct Axis {
     /// Torque limits and error tolerances overridden (torque sequences).
     overrides: bool,
     latches: Latches,
+    /// The armed registration (MAR), if any.
+    reg: Registration,
     /// The newest valid sample, and what the detection needs of the one
     /// before it.
     prev: Option<Seen>,
@@ -165,6 +169,7 @@ impl Axis {
             enable: false,
             overrides: false,
             latches: Latches::default(),
+            reg: Registration::default(),
             prev: None,
             last: None,
             last_sample_ns: None,
@@ -372,6 +377,8 @@ impl Axis {
             last_stop: self.status.last_stop,
             op: self.status.op,
             redefines: self.status.redefines,
+            registration_armed: self.status.registration_armed,
+            registration_position: self.status.registration_position,
             ..Status::default()
         };
         // Logix: MAH on a faulted axis errors (20); a jog, move or stream
@@ -392,6 +399,9 @@ impl Axis {
             return self.fail(now, ERR_SERVO_MESSAGE, EX_FEEDBACK_LOST, Abort::Controlled);
         };
         self.homing_takes_over();
+        // Home and registration exclude each other: the homing needs the
+        // latches, and its new reference would move the window.
+        self.disarm_registration();
         self.status.ip = true;
         self.status.homing = true;
         self.status.homed = false;
@@ -425,6 +435,7 @@ impl Axis {
     // ------------------------------------------------------------------
 
     fn advance(&mut self, now: u64, s: &Sample) {
+        self.registration_step(now, s);
         self.power_tick(now);
         self.watch_drive(now, s);
         let moving = self.state.commands_motion();

@@ -126,10 +126,15 @@ impl Axis {
             }
             Operation::Change(c) => self.change_op(now, &c),
             Operation::Redefine(r) => self.redefine_op(&r),
+            Operation::Arm(a) => self.arm_op(now, &a),
+            Operation::Disarm => {
+                self.disarm_registration();
+                Ok(())
+            }
         };
         match result {
             Err(code) => self.status.op.refused = Some(code),
-            // Answered in place: the running motion keeps its id.
+            // Answered in place: the running operation keeps its id.
             Ok(()) if op.kind().in_place() => self.status.op.refused = None,
             Ok(()) => {}
         }
