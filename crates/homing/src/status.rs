@@ -182,4 +182,7 @@ pub struct Status {
     /// The I/O process reports the axis's drive lost (`Request::drive_lost`):
     /// not a reading, not enabled, whatever the last feedback said.
     pub drive_lost: bool,
+    /// GearingStatus: the axis follows its master (MAG), from the accepted
+    /// gear (a clutch ramping in included) until its stop begins.
+    pub gearing: bool,
 }

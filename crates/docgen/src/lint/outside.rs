@@ -14,12 +14,30 @@ fn outside(line: &str) -> Option<&'static str> {
     let l = line.to_lowercase();
     const NAMES: &[(&str, &str)] = &[
         // Spelled in pieces, so that this file does not name them itself.
-        (concat!("interface", ".md"), "a specification outside the repository"),
-        (concat!("../", "shared"), "a directory outside the repository"),
-        (concat!("shared/", "spec"), "a directory outside the repository"),
-        (concat!("shared/", "seeds"), "a directory outside the repository"),
-        (concat!("seed", " document"), "source texts outside the repository"),
-        (concat!("the seed", "'s"), "source texts outside the repository"),
+        (
+            concat!("interface", ".md"),
+            "a specification outside the repository",
+        ),
+        (
+            concat!("../", "shared"),
+            "a directory outside the repository",
+        ),
+        (
+            concat!("shared/", "spec"),
+            "a directory outside the repository",
+        ),
+        (
+            concat!("shared/", "seeds"),
+            "a directory outside the repository",
+        ),
+        (
+            concat!("seed", " document"),
+            "source texts outside the repository",
+        ),
+        (
+            concat!("the seed", "'s"),
+            "source texts outside the repository",
+        ),
     ];
     if let Some((_, what)) = NAMES.iter().find(|(n, _)| l.contains(n)) {
         return Some(what);

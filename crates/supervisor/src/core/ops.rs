@@ -74,7 +74,7 @@ impl Core {
         if (motion || *op == Operation::Enable) && !self.links[slot.io].attached() {
             return Some(Refusal::IoNotAttached);
         }
-        None
+        self.gear_refusal(i, op)
     }
 
     /// Delivers `op` (as the client gave it: each engine fills what was

@@ -67,7 +67,7 @@ impl Axis {
     pub(super) fn jog_collides(&self) -> Result<(), Code> {
         match self.state {
             State::Motion(Motion {
-                run: Run::Move(_) | Run::Stream(_),
+                run: Run::Move(_) | Run::Stream(_) | Run::Gear(_),
                 ..
             })
             | State::Stopping { .. } => Err(COLLISION),
