@@ -3,7 +3,7 @@
 use crate::spec_args::SpecArgs;
 use clap::{Args, Parser, Subcommand};
 use motion_config::args::{axis, runtime_dir, seconds, service_prefix};
-use motion_control::{JogSpec, MoveSpec};
+use motion_control::{GearSpec, JogSpec, MoveSpec};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -11,7 +11,7 @@ use std::path::PathBuf;
     name = "motionctl",
     version,
     about = "The operator's tool for a running motion-supervisor: home, stop, unhome, status, \
-             stats, trace; enable, disable, reset, jog, move, stream.",
+             stats, trace; enable, disable, reset, jog, move, stream, gear.",
     after_help = "The supervisor is found by its service prefix: --service-prefix, else the \
                   config's [supervisor] service_prefix (--config), else \"motion\".\n\n\
                   Exit codes:\n  0  done (home: every named axis homed with PC set; move: \
@@ -82,6 +82,12 @@ pub enum Command {
     /// max_speed and stream_acceleration on the supervisor's own clock; a
     /// file it cannot follow within them stops it (1019 / 3 or 4).
     Stream(StreamArgs),
+    /// MAG: from now on SLAVE (or a gantry) follows MASTER's commanded
+    /// (--actual: actual) position change times R, from where both stand;
+    /// --clutch ramps the slave's velocity in at A (the distance lost while
+    /// ramping is not made up). Returns once accepted; `stop` or `disable`
+    /// of either axis, or a fault of either, ends it (`status`: gearing).
+    Gear(GearArgs),
 }
 
 #[derive(Debug, Args)]
@@ -153,6 +159,19 @@ pub struct MoveArgs {
 }
 
 #[derive(Debug, Args)]
+pub struct GearArgs {
+    /// The slave: the axis or gantry that follows.
+    #[arg(value_name = "SLAVE", value_parser = axis)]
+    pub slave: String,
+    /// The gear's parameters (the engine's `GearSpec`): --master MASTER
+    /// --ratio R [--actual] [--clutch A].
+    #[command(flatten)]
+    pub spec: SpecArgs<GearSpec>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
 pub struct StreamArgs {
     /// The axes (or gantries) of the file's columns, in order.
     #[arg(value_name = "AXIS", required = true, value_parser = axis)]
@@ -213,6 +232,7 @@ impl Command {
             Command::Jog(a) => a.json,
             Command::Move(a) => a.json,
             Command::Stream(a) => a.json,
+            Command::Gear(a) => a.json,
             Command::Stats(a) => a.json,
             Command::Trace(a) => a.json,
         }

@@ -207,11 +207,14 @@ crate::status_table! {
     /// The position commanded this cycle, axis coordinates (with
     /// `position`: the following error).
     cmd_position: Maybe @ 14, Units, "command", -, "CommandPosition", |s| s.a.cmd_axis;
+    /// GearingStatus: the axis follows its master (MAG), from the accepted
+    /// gear until its stop begins.
+    gearing: Flag @ 35, None, "gearing", "G", "GearingStatus", |s| s.status.gearing;
 }
 
 /// The rows that say the axis is in motion by an operation (a jog, a
-/// move, a stream); [`motion_mask`] is their bits.
-pub const IN_MOTION: &[&str] = &["jogging", "moving", "streaming"];
+/// move, a stream, a gear); [`motion_mask`] is their bits.
+pub const IN_MOTION: &[&str] = &["jogging", "moving", "streaming", "gearing"];
 
 /// The `flags` bits of the rows `names`.
 pub fn mask(names: &[&str]) -> u64 {

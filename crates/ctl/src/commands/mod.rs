@@ -1,6 +1,7 @@
 //! The subcommands; each returns the exit code (see `motionctl --help`).
 
 mod csv;
+mod gear;
 mod home;
 mod jog;
 mod moves;
@@ -48,6 +49,7 @@ pub fn run(cli: Cli) -> i32 {
         Command::Jog(a) => jog::jog(&mut client, &a),
         Command::Move(a) => moves::move_axis(&mut client, &a),
         Command::Stream(a) => stream::stream(&mut client, &a),
+        Command::Gear(a) => gear::gear(&mut client, &a),
         Command::Stats(a) => stats::stats(&mut client, &a),
         Command::Trace(a) => trace::trace(&mut client, &a),
     }

@@ -70,7 +70,7 @@ impl Core {
                 exerr: 0,
             });
         }
-        if s.jogging || s.moving || s.streaming {
+        if s.jogging || s.moving || s.streaming || s.gearing {
             return Some(Refusal::Instruction {
                 err: ERR_EXECUTION_COLLISION,
                 exerr: 0,

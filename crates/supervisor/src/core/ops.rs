@@ -281,7 +281,7 @@ impl Core {
             for i in named(sides & !over, self.slots.len()) {
                 let slot = &mut self.slots[i];
                 let s = slot.status();
-                if s.jogging || s.moving || s.streaming {
+                if s.jogging || s.moving || s.streaming || s.gearing {
                     slot.rung.request.op = Some(Operation::Stop);
                 }
                 slot.jog_token = 0;
