@@ -9,8 +9,9 @@
 //!   order: home in process 16, faulted 20, shutdown 12/12, not a servo
 //!   axis 5/1, no feedback 12/40, servo off 5) and the operand checks (13);
 //! * `power`: enable, disable, reset, the drive's faults and power stage;
-//! * `jog`, `moves`, `stream`: each motion, its start and its progress;
-//!   `follower`: the stream's bounded follower (one cycle of arithmetic);
+//! * `jog`, `moves`, `stream`, `gear`: each motion, its start and its
+//!   progress; `follower`: the bounded follower of the stream and the gear
+//!   (one cycle of arithmetic);
 //! * `limits`: software travel limits (homed, linear) and the hardware
 //!   limit switches;
 //! * `motion`: the data a motion carries from step to step;

@@ -11,6 +11,7 @@
 //! | move | 3 on a jogging or moving axis without `supersede`, on a streaming axis · 13/5 target not finite · 13/1..3 operands · 13/4 target outside the travel limits (or ±`max_position`), or a stop that would end outside · 9 towards a tripped limit switch |
 //! | stream start | 3 on an axis in motion (stopping too) · then 13/7 as above · 1019/7 not homed (unless `stream_unhomed`) · 13/1 a speed cap of 0 (unhomed, no `unhomed_speed`) · 13/3 no `max_deceleration` |
 //! | setpoint (an axis fault, 1019) | 1 not finite · 2 outside the travel limits · 3 faster than the speed cap (unhomed: `unhomed_speed`) on the program's timeline, or the command held back by it further than it can follow · 4 a change of velocity above `stream_acceleration` on the program's timeline, or the command held back by it further than it can follow · 5 nothing for `stream_timeout_ms` since the last one arrived · 6 out of order · 7 not homed |
+//! | gear | as stream start, then 3 on an axis in motion (stopping too) · 13/8 ratio not finite or 0 · 13/2 clutch not above 0 · 13/3 no `max_deceleration` · 1025/3 the master faulted · 1025/5 no position of the master (the cycle's own: 1025/4 itself, 1025/6 chained) |
 //! | reset | 16 homing in process |
 //! | disable, stop, stream end | never |
 //!
