@@ -37,7 +37,7 @@
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use motion_harness::engine::{
-    homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
+    geared_state, homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
 use motion_homing::profile::{Kinematics, Profile, Ramp};
 use motion_homing::{Axis, Phase};
@@ -65,6 +65,21 @@ fn check(name: &str, c: &Captured, phase: Phase) {
         c.feedback.position,
         c.feedback.torque,
         cmd.velocity
+    );
+}
+
+/// Checks that stepping a copy of `c` is an operation's real work: a jog
+/// or a gear running on.
+fn check_op(name: &str, c: &Captured) {
+    let mut a = c.axis.clone();
+    let cmd = a.step(c.now, Some(&c.feedback), &c.request);
+    let s = a.status();
+    assert!(s.jogging || s.gearing, "{name}: neither jogging nor geared");
+    eprintln!(
+        "{name}: cycle {}, command v {:.1}, {}",
+        c.cycle,
+        cmd.velocity,
+        if s.gearing { "geared" } else { "jogging" }
     );
 }
 
@@ -99,6 +114,25 @@ fn engine_step(c: &mut Criterion) {
             )
         });
         if name == "seek" {
+            // Beside it: a jog's step (a trapezoid at its cruise) and the
+            // step of a slave geared to that jog (the follower, every cycle).
+            let (master, slave) = geared_state();
+            for (id, s) in [("jog_master", master), ("geared", slave)] {
+                check_op(&format!("engine_step/{id}"), &s);
+                g.bench_function(id, |b| {
+                    b.iter_batched_ref(
+                        || s.axis.clone(),
+                        |axis: &mut Axis| {
+                            axis.step(
+                                black_box(s.now),
+                                Some(black_box(&s.feedback)),
+                                black_box(&s.request),
+                            )
+                        },
+                        BatchSize::NumIterations(CYCLE_AXES),
+                    )
+                });
+            }
             // The same with criterion's `SmallInput` batches, which grow
             // with the iteration count (to tens of MB of copies): each step
             // then streams its copy from memory, and the figure is about
@@ -271,6 +305,8 @@ fn summary(dir: &Path, since: SystemTime) {
         ("engine_step/seek".into(), 1, Some(50.0)),
         ("engine_step/torque_detect".into(), 1, Some(50.0)),
         ("engine_step/seek_cold".into(), 1, None),
+        ("engine_step/jog_master".into(), 1, Some(50.0)),
+        ("engine_step/geared".into(), 1, Some(50.0)),
     ];
     for what in ["plan", "plan_turn", "stop_at", "sample"] {
         for kind in ["trapezoid", "scurve"] {
