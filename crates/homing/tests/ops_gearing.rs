@@ -126,9 +126,8 @@ impl Pair {
     }
 }
 
-/// A master jog at `speed` for `n` cycles, renewed.
-fn jog_master(p: &mut Pair, speed: f64, n: u64) {
-    p.master_op(jog(speed));
+/// `n` cycles of the master's jog renewed.
+fn renew(p: &mut Pair, n: u64) {
     for _ in 0..n {
         p.step(
             Request {
@@ -138,6 +137,22 @@ fn jog_master(p: &mut Pair, speed: f64, n: u64) {
             Request::default(),
         );
     }
+}
+
+/// As [`renew`], until the slave shows ER (at most `n` cycles).
+fn renew_until_er(p: &mut Pair, n: u64) {
+    for _ in 0..n {
+        renew(p, 1);
+        if p.s.axis.status().er {
+            break;
+        }
+    }
+}
+
+/// A master jog at `speed` for `n` cycles, renewed.
+fn jog_master(p: &mut Pair, speed: f64, n: u64) {
+    p.master_op(jog(speed));
+    renew(p, n);
 }
 
 fn gear_spec(ratio: f64) -> GearSpec {
@@ -150,9 +165,10 @@ fn gear_spec(ratio: f64) -> GearSpec {
 fn follows_exactly(p: &Pair, from: usize, ratio: f64, master_pos: &[f64]) {
     let s0 = p.s.cmds[from].position;
     let m0 = master_pos[from];
-    for k in from..p.s.cmds.len() {
-        let want = s0 + ratio * (master_pos[k] - m0);
-        let got = p.s.cmds[k].position;
+    assert_eq!(p.s.cmds.len(), master_pos.len());
+    for (k, (c, m)) in p.s.cmds.iter().zip(master_pos).enumerate().skip(from) {
+        let want = s0 + ratio * (m - m0);
+        let got = c.position;
         assert!((got - want).abs() < 1e-9, "step {k}: {got} vs {want}");
     }
 }
@@ -224,15 +240,7 @@ fn a_clutch_ramps_in_at_its_acceleration_and_does_not_make_up_the_lost_distance(
     let mut spec = gear_spec(1.0);
     spec.clutch = Some(100.0);
     p.gear(spec).unwrap();
-    for _ in 0..100 {
-        p.step(
-            Request {
-                jog_renew: true,
-                ..Request::default()
-            },
-            Request::default(),
-        );
-    }
+    renew(&mut p, 100);
     let cmds = p.s.since(from as u64);
     // At most 100 u/s² (the clutch), never faster than the master.
     assert!(max_accel(cmds, CYCLE_S) <= 100.0 * (1.0 + 1e-6) + 1e-6);
@@ -259,15 +267,7 @@ fn without_a_clutch_a_running_master_is_caught_up_within_the_bounds() {
     jog_master(&mut p, 5.0, 50);
     let from = p.k();
     p.gear(gear_spec(1.0)).unwrap();
-    for _ in 0..200 {
-        p.step(
-            Request {
-                jog_renew: true,
-                ..Request::default()
-            },
-            Request::default(),
-        );
-    }
+    renew(&mut p, 200);
     let cmds = p.s.since(from as u64 - 1);
     assert!(max_accel(cmds, CYCLE_S) <= 800.0 * (1.0 + 1e-6) + 1e-6);
     // Locked where both stood: caught up with the geared position.
@@ -284,18 +284,7 @@ fn a_master_faster_than_the_slaves_cap_stops_the_slave_with_1025_2() {
     let from = p.k();
     p.gear(gear_spec(10.0)).unwrap();
     p.master_op(jog(8.0));
-    for _ in 0..400 {
-        p.step(
-            Request {
-                jog_renew: true,
-                ..Request::default()
-            },
-            Request::default(),
-        );
-        if p.s.axis.status().er {
-            break;
-        }
-    }
+    renew_until_er(&mut p, 400);
     geared_fault(&p, EX_GEAR_CANNOT_FOLLOW);
     assert!(max_speed(p.s.since(from as u64), CYCLE_S) <= 50.0 * (1.0 + 1e-9));
 }
@@ -307,18 +296,7 @@ fn the_slave_at_its_travel_limit_stops_inside_it_with_1025_1() {
     let from = p.k();
     p.gear(gear_spec(4.0)).unwrap();
     p.master_op(jog(6.0));
-    for _ in 0..1000 {
-        p.step(
-            Request {
-                jog_renew: true,
-                ..Request::default()
-            },
-            Request::default(),
-        );
-        if p.s.axis.status().er {
-            break;
-        }
-    }
+    renew_until_er(&mut p, 1000);
     geared_fault(&p, EX_GEAR_SOFT_LIMIT);
     for _ in 0..200 {
         p.s.step(Request::default());
@@ -342,15 +320,7 @@ fn a_stop_or_disable_of_the_slave_ends_the_gearing_normally() {
         let id = p.slave_op(op).unwrap();
         let s = *p.s.axis.status();
         assert!(!s.gearing && !s.er, "{op:?}: {s:?}");
-        for _ in 0..100 {
-            p.step(
-                Request {
-                    jog_renew: true,
-                    ..Request::default()
-                },
-                Request::default(),
-            );
-        }
+        renew(&mut p, 100);
         let s = p.s.axis.status();
         assert!(
             !s.gearing && !s.er && s.op.id == id && s.op.pc,
@@ -502,15 +472,7 @@ fn an_unhomed_slave_gears_at_its_unhomed_speed() {
     jog_master(&mut p, 3.0, 100);
     assert!(p.s.axis.status().gearing, "15 u/s is under the cap");
     p.master_op(jog(5.0));
-    for _ in 0..300 {
-        p.step(
-            Request {
-                jog_renew: true,
-                ..Request::default()
-            },
-            Request::default(),
-        );
-    }
+    renew(&mut p, 300);
     geared_fault(&p, EX_GEAR_CANNOT_FOLLOW);
     assert!(max_speed(p.s.since(from as u64), CYCLE_S) <= 20.0 * (1.0 + 1e-9));
 }
