@@ -5,7 +5,7 @@ functions, and import circles between the files of a crate.
 Why a script: no maintained tool reports "functions over N lines" and
 "module-file cycles" for Rust (clippy's too_many_lines counts differently and
 per function only; cargo-modules draws graphs but does not list cycles of
-files), and these are the figures the team's standards keep down.
+files), and these are the figures the project keeps down.
 
     python3 .ci/layout.py            # report
     python3 .ci/layout.py --check    # exit 1 on a function over 120 lines or a circle
@@ -176,7 +176,6 @@ def circles(files):
             s = strip(open(os.path.join(ROOT, p), encoding="utf-8", errors="replace").read())
             for a, b in test_ranges(s):
                 s = s[:a] + " " * (b - a) + s[b:]
-            here = key if os.path.basename(p) == "mod.rs" or key == () else key[:-1]
             targets = []
             for m in REF.finditer(s):
                 targets.append((m.group(1), [x for x in m.group(2).split("::") if x]))
@@ -190,12 +189,12 @@ def circles(files):
                 if kind == "crate":
                     path = segs
                 else:
-                    up = list(here)
+                    # `super` of module `key` (a file or a mod.rs alike) is
+                    # its parent; each further `super` one more up.
+                    up = list(key)[:-1]
                     while segs and segs[0] == "super":
                         segs = segs[1:]
                         up = up[:-1]
-                    if up:
-                        up = up[:-1] if kind == "super" else up
                     path = up + segs
                 # longest prefix that is a module file
                 best = None

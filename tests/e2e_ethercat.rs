@@ -28,10 +28,10 @@
 
 use std::time::{Duration, Instant};
 
-use ecat_emu::State;
+use ecat_emu::{al, Dropped, State};
 use motion_harness::ecat::Bus;
 use motion_harness::{assert_close, *};
-use motion_report::{AxisResult, AxisStatus, CtlHomeReport, HomeReport};
+use motion_report::{AxisResult, AxisStatus, CtlHomeReport, HomeReport, StatsReport};
 use nix::sys::signal::Signal;
 
 /// `home --json` on the bus: exit 0, latency measured, nothing left behind.
@@ -214,6 +214,52 @@ fn slow(tag: &str, tweak: impl FnOnce(&mut [ecat_emu::DriveConfig])) -> Option<B
     Bus::start(tag, &machine, tweak)
 }
 
+/// `slow(tag, tweak)` homed by `motion-supervisor home`, once its drive
+/// seeks at 5 u/s: the bus and the running supervisor.
+fn seeking(tag: &str, tweak: impl FnOnce(&mut [ecat_emu::DriveConfig])) -> Option<(Bus, Running)> {
+    let b = slow(tag, tweak)?;
+    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
+    assert!(
+        wait_for(Duration::from_secs(30), || b.drive(0).drive.velocity > 4.0),
+        "homing never started: {:?}\n{}",
+        b.drive(0),
+        w.stderr()
+    );
+    Some((b, w))
+}
+
+/// How long from now until `done` holds (polled every millisecond), at
+/// most 5 s.
+fn time_until(mut done: impl FnMut() -> bool) -> Option<Duration> {
+    let t0 = Instant::now();
+    while t0.elapsed() < Duration::from_secs(5) {
+        if done() {
+            return Some(t0.elapsed());
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    None
+}
+
+/// `sig` to the bus's `motion-io`.
+fn signal_io(b: &Bus, sig: Signal) {
+    let io = find_process("motion-io", &b.cfg.prefix).expect("motion-io");
+    signal_pid(io, sig);
+}
+
+/// `motion-io` of `prefix` is gone within 10 s.
+#[track_caller]
+fn io_gone(prefix: &str) {
+    assert!(
+        wait_for(Duration::from_secs(10), || find_process(
+            "motion-io",
+            prefix
+        )
+        .is_none()),
+        "motion-io still runs"
+    );
+}
+
 /// Waits until axis `name` is in `phase` (status), or panics.
 #[track_caller]
 fn wait_phase(d: &Daemon, name: &str, phase: &str) {
@@ -334,14 +380,6 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
             .is_some_and(|e| e.starts_with("drive lost")),
         "{s:#?}"
     );
-    assert!(
-        d.wait_line(
-            "EtherCAT: SubDevice 1 \"EMU-S\" (axis S) lost: it does not answer",
-            Duration::from_secs(5)
-        ),
-        "{}",
-        d.stderr()
-    );
     let t = d.axis("T");
     assert!(!t.homed, "HomedStatus cleared by the feedback loss: {t:#?}");
     let r = wait_ended(&d, "R");
@@ -368,11 +406,6 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
         let s = d.axis("S");
         s.raw.is_some() && !s.drive_lost
     }));
-    assert!(
-        d.wait_line("(axis S) back in OP", Duration::from_secs(5)),
-        "{}",
-        d.stderr()
-    );
     // the axis faults (feedback lost in motion, the drives' own faults after
     // their watchdog) need a reset before the next homing (issue 15)
     d.ctl(&["reset", "S", "T"]).expect_code(0);
@@ -391,41 +424,30 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
     for a in ["R", "S", "T"] {
         assert!(named(&st.axes, a).homed, "{a}: {:#?}", named(&st.axes, a));
     }
-    d.stop().expect_code(0);
+    // what motion-io said about it (both states lasted: logged)
+    let end = d.stop().expect_code(0).stderr.clone();
+    for line in [
+        "EtherCAT: SubDevice 1 \"EMU-S\" (axis S) lost: it does not answer",
+        "(axis S) back in OP",
+    ] {
+        assert!(end.contains(line), "no {line:?} in\n{end}");
+    }
     assert_clean(&b.cfg.prefix);
 }
 
 #[test]
 fn killed_motion_io_the_drives_watchdog_stops_the_axis() {
     let _serial = serial();
-    let Some(b) = slow("ecat_killio", |_| {}) else {
+    let Some((b, w)) = seeking("ecat_killio", |_| {}) else {
         return;
     };
-    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
-    assert!(
-        w.wait_line("home S: accepted", Duration::from_secs(20))
-            .is_some(),
-        "homing never started"
-    );
-    // into the seek, moving at 5 u/s
-    assert!(wait_for(Duration::from_secs(10), || b
-        .drive(0)
-        .drive
-        .velocity
-        > 4.0));
-    let io = find_process("motion-io", &b.cfg.prefix).expect("motion-io");
-    signal_pid(io, Signal::SIGKILL);
-    let killed = Instant::now();
-    let mut stopped = None;
-    while killed.elapsed() < Duration::from_secs(5) {
-        let v = b.drive(0);
-        if v.drive.state == State::Fault && v.drive.velocity == 0.0 {
-            stopped = Some((killed.elapsed(), v));
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    let (after, v) = stopped.unwrap_or_else(|| panic!("drive not stopped: {:?}", b.drive(0)));
+    signal_io(&b, Signal::SIGKILL);
+    let after = time_until(|| {
+        let v = b.drive(0).drive;
+        v.state == State::Fault && v.velocity == 0.0
+    })
+    .unwrap_or_else(|| panic!("drive not stopped: {:?}", b.drive(0)));
+    let v = b.drive(0);
     eprintln!("drive stopped {after:?} after motion-io was killed: {v:?}");
     assert_eq!(v.al_status, 0x14, "SAFE-OP + error");
     assert_eq!(v.al_code, 0x001B, "SM watchdog");
@@ -452,38 +474,17 @@ fn killed_supervisor_stop_time(
     tag: &str,
     tweak: impl FnOnce(&mut [ecat_emu::DriveConfig]),
 ) -> Option<Duration> {
-    let b = slow(tag, tweak)?;
-    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
-    assert!(
-        w.wait_line("home S: accepted", Duration::from_secs(20))
-            .is_some(),
-        "homing never started"
-    );
-    assert!(wait_for(Duration::from_secs(10), || b
-        .drive(0)
-        .drive
-        .velocity
-        > 4.0));
+    let (b, w) = seeking(tag, tweak)?;
     signal_pid(w.pid() as i32, Signal::SIGKILL);
-    let killed = Instant::now();
-    let mut off = None;
-    while killed.elapsed() < Duration::from_secs(5) {
+    let off = time_until(|| {
         let v = b.drive(0).drive;
-        if v.state == State::SwitchOnDisabled && !v.enabled {
-            off = Some(killed.elapsed());
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    let off = off.unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
+        v.state == State::SwitchOnDisabled && !v.enabled
+    })
+    .unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
     let io = find_process("motion-io", &b.cfg.prefix);
     // motion-io outlives its supervisor by the stop and a second, then
     // leaves (it was spawned with --exit-with-supervisor)
-    assert!(wait_for(Duration::from_secs(10), || find_process(
-        "motion-io",
-        &b.cfg.prefix
-    )
-    .is_none()));
+    io_gone(&b.cfg.prefix);
     let run = w.finish();
     eprintln!("motion-io ({io:?}):\n{}", run.stderr);
     assert_clean(&b.cfg.prefix);
@@ -511,6 +512,301 @@ fn killed_supervisor_every_drive_ends_switched_off_within_the_bound() {
     assert!(ignores < Duration::from_secs(1), "{ignores:?}");
 }
 
+/// The drive is off: its power stage (its own state says so).
+fn off(b: &Bus, position: usize) -> bool {
+    let v = b.drive(position).drive;
+    !v.enabled
+        && matches!(
+            v.state,
+            State::SwitchOnDisabled | State::ReadyToSwitchOn | State::Fault
+        )
+}
+
+/// R, S and T homing (`tests/machines/unplug.toml`); S's drive falls to
+/// SAFE-OP with an AL error (a sync error) and stays there, answering its
+/// AL status but not its process data. S's homing ends with its drive lost
+/// (12/45); R homes on to the end on valid data; a disable reaches R's
+/// drive; S's drive stopped by its own reaction and, back in OP, is not
+/// enabled by itself and has not moved.
+#[test]
+fn a_drive_short_on_process_data_leaves_the_others_served() {
+    let _serial = serial();
+    let Some(b) = family("unplug") else {
+        return;
+    };
+    let d = Daemon::start(&b.cfg, &["bus0"]);
+    for a in ["R", "S"] {
+        d.ctl(&["home", a, "--no-wait"]).expect_code(0);
+    }
+    wait_phase(&d, "S", "seek");
+    let emu = b.rig.emulator();
+    emu.refuse_op(1, Some(al::SYNC_ERROR));
+    emu.drop_out_of_op(1, Dropped::SafeOp(al::SYNC_ERROR));
+    let s = wait_ended(&d, "S");
+    assert_eq!((s.err, s.exerr), (12, 45), "its drive lost: {s:#?}");
+    assert!(s.drive_lost && !s.enabled, "{s:#?}");
+    // R's data stayed valid: its homing went on to the end
+    let r = wait_ended(&d, "R");
+    assert!(r.pc && r.homed, "{r:#?}\n{}", d.stderr());
+    assert!(!d.axis("T").drive_lost, "T behind S still answers");
+    // S's drive: its own quick stop on the lost outputs, where it was
+    assert!(
+        wait_for(Duration::from_secs(5), || {
+            let v = b.drive(1).drive;
+            v.state == State::SwitchOnDisabled && v.velocity == 0.0
+        }),
+        "{:?}",
+        b.drive(1)
+    );
+    let at = b.drive(1).drive.position;
+    // a disable reaches R's drive while S's is short
+    d.ctl(&["enable", "R"]).expect_code(0);
+    assert!(
+        wait_for(Duration::from_secs(5), || b.drive(0).drive.enabled),
+        "{:?}",
+        b.drive(0)
+    );
+    d.ctl(&["disable", "R"]).expect_code(0);
+    assert!(
+        wait_for(Duration::from_secs(2), || off(&b, 0)),
+        "R's drive still powered: {:?}",
+        b.drive(0)
+    );
+    // S's drive accepts OP again: back, data valid, not enabled, not moved
+    emu.refuse_op(1, None);
+    assert!(
+        wait_for(Duration::from_secs(5), || {
+            let s = d.axis("S");
+            b.drive(1).al_status == 0x08 && s.raw.is_some() && !s.drive_lost
+        }),
+        "{:?} {:#?}",
+        b.drive(1),
+        d.axis("S")
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let v = b.drive(1).drive;
+    // power stage off: Switch on disabled (the backend's bounded stop), or
+    // Ready to switch on where the engine had withdrawn the enable request
+    // first (the loss is a fault of the axis) and the backend holds it as
+    // every disabled drive
+    assert!(
+        matches!(v.state, State::SwitchOnDisabled | State::ReadyToSwitchOn),
+        "{v:?}"
+    );
+    assert_eq!(v.position, at, "moved: {v:?}");
+    assert!(!d.axis("S").enabled);
+    // after a reset it homes again
+    d.ctl(&["reset", "S"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || !d.axis("S").faulted));
+    let v = home_again(&d, &["S"]);
+    assert!(named(&v.axes, "S").pc);
+    d.stop().expect_code(0);
+    assert_clean(&b.cfg.prefix);
+}
+
+/// R seeking (`tests/machines/unplug.toml`); the supervisor is killed and
+/// S's drive falls to SAFE-OP (AL error, OP refused) at the same moment: motion-io's watchdog stop must still reach R's and T's drives,
+/// which end in Switch on disabled within the stop's bound (50 ms of
+/// watchdog + 500 ms of quick stop at most), S's by its own reaction.
+#[test]
+fn a_drive_short_on_process_data_killed_supervisor_the_others_switch_off_within_the_bound() {
+    let _serial = serial();
+    let Some(b) = family("unplug") else {
+        return;
+    };
+    // (home order: R first, S and T after it)
+    let w = spawn_supervisor(&["home", "--json", "--config", b.cfg.arg()]);
+    assert!(
+        wait_for(Duration::from_secs(30), || b.drive(0).drive.velocity > 5.0),
+        "R never seeking: {:?}\n{}",
+        b.drive(0),
+        w.stderr()
+    );
+    let emu = b.rig.emulator();
+    signal_pid(w.pid() as i32, Signal::SIGKILL);
+    emu.refuse_op(1, Some(al::SYNC_ERROR));
+    emu.drop_out_of_op(1, Dropped::SafeOp(al::SYNC_ERROR));
+    let took = time_until(|| off(&b, 0) && off(&b, 2)).unwrap_or_else(|| {
+        panic!(
+            "still powered: {:?} {:?}\n{}",
+            b.drive(0),
+            b.drive(2),
+            w.stderr()
+        )
+    });
+    eprintln!(
+        "drive short on process data, supervisor killed → the other drives in Switch on \
+         disabled after {:.1} ms",
+        took.as_secs_f64() * 1e3
+    );
+    assert!(took < Duration::from_secs(1), "{took:?}");
+    assert!(
+        wait_for(Duration::from_secs(5), || {
+            let v = b.drive(1).drive;
+            v.state == State::SwitchOnDisabled && v.velocity == 0.0
+        }),
+        "{:?}",
+        b.drive(1)
+    );
+    // motion-io's stop completes (a lost drive does not hold it up) and it
+    // leaves a second later
+    io_gone(&b.cfg.prefix);
+    let run = w.finish();
+    eprintln!("{}", run.stderr);
+    assert_clean(&b.cfg.prefix);
+}
+
+/// motion-io's main loop blocks for good in the middle of a seek (its test
+/// hook, SIGUSR1: as a write to a stderr nobody reads once blocked it): no
+/// command reaches the bus thread any more, whose own watchdog stops the
+/// drive — 2 × `io_watchdog_cycles` (100 ms) without a command, then the
+/// bounded stop — into Switch on disabled.
+#[test]
+fn a_stalled_motion_io_the_bus_thread_switches_the_drive_off_by_itself() {
+    let _serial = serial();
+    let Some((b, w)) = seeking("ecat_stall", |_| {}) else {
+        return;
+    };
+    signal_io(&b, Signal::SIGUSR1);
+    let took =
+        time_until(|| off(&b, 0)).unwrap_or_else(|| panic!("still powered: {:?}", b.drive(0)));
+    eprintln!(
+        "motion-io's main loop stalled → the drive in Switch on disabled after {:.1} ms \
+         (bus thread's own watchdog: 100 ms; quick stop bound 500 ms)",
+        took.as_secs_f64() * 1e3
+    );
+    assert!(took < Duration::from_secs(1), "{took:?}");
+    assert_eq!(b.drive(0).drive.velocity, 0.0);
+    // the supervisor's homing fails (no feedback); it ends its motion-io,
+    // which does not answer SIGTERM any more: SIGKILL after the grace
+    let run = w.finish();
+    eprintln!("{}", run.stderr);
+    if let Some(pid) = find_process("motion-io", &b.cfg.prefix) {
+        signal_pid(pid, Signal::SIGKILL);
+    }
+    io_gone(&b.cfg.prefix);
+    assert_clean(&b.cfg.prefix);
+}
+
+/// What one end-to-end jog showed (see [`jog_regularity`]).
+#[derive(Debug)]
+struct Jog {
+    /// Frames at constant speed; those that did not advance by 5 counts,
+    /// and of those the ones away from an event of the bus (a frame that
+    /// passed more than half a cycle off its period within three cycles).
+    frames: usize,
+    irregular: usize,
+    unexcused: usize,
+    /// From motion-io's bus summary: frames moved off the supervisor's
+    /// sequence (its whole run). From the daemon's statistics: its cycle's
+    /// deadline misses since start.
+    corrections: u64,
+    deadline_misses: u64,
+}
+
+/// The number before `what` in the bus summary `line` (`… 3 frame(s) moved
+/// off …`).
+fn counted(line: &str, what: &str) -> u64 {
+    let before = line.split(what).next().unwrap_or_default();
+    let n = before.rsplit([' ', ',']).find(|w| !w.is_empty());
+    n.and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no {what:?} in {line}"))
+}
+
+/// X of `tests/machines/ops.toml` jogged at 5 units/s — 5 counts per 1 ms
+/// cycle — for 3 s through the daemon, motion-io and the bus, on drives
+/// whose distributed clocks run `ppm` off the host's (the bus thread
+/// follows the first one's); X's drive records every frame's target.
+fn jog_regularity(tag: &str, ppm: f64) -> Option<Jog> {
+    let b = Bus::start(tag, &Machine::fixture("ops"), |drives| {
+        for d in drives {
+            d.clock_ppm = ppm;
+        }
+    })?;
+    let d = Daemon::start(&b.cfg, &["bus0"]);
+    d.ctl(&["enable", "X"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || d.axis("X").enabled));
+    let emu = b.rig.emulator();
+    emu.record_targets(0, true);
+    d.ctl(&["jog", "X", "--speed", "5", "--for", "3"])
+        .expect_code(0);
+    let t = emu.take_timed_targets(0);
+    // the daemon's statistics are handed over every second
+    std::thread::sleep(Duration::from_millis(1200));
+    let stats: StatsReport = d.ctl(&["stats", "--json"]).expect_code(0).report();
+    let end = d.stop().expect_code(0).stderr.clone();
+    assert_clean(&b.cfg.prefix);
+    let summary = end
+        .lines()
+        .find(|l| l.contains(" bus cycles, "))
+        .unwrap_or_else(|| panic!("no bus summary in\n{end}"));
+    // at constant speed: between the first and the last step of 5, the
+    // ramps' ends left out
+    let steps: Vec<i32> = t.windows(2).map(|w| w[1].0 - w[0].0).collect();
+    let first = steps.iter().position(|s| *s == 5)? + 20;
+    let last = steps.iter().rposition(|s| *s == 5)?.saturating_sub(20);
+    let cycle = Duration::from_millis(1);
+    let off = |j: usize| {
+        let dt = t[j + 1].1 - t[j].1;
+        dt > cycle * 3 / 2 || dt < cycle / 2
+    };
+    let mut hist = std::collections::BTreeMap::new();
+    let mut jog = Jog {
+        frames: last - first,
+        irregular: 0,
+        unexcused: 0,
+        corrections: counted(summary, " frame(s) moved off"),
+        deadline_misses: stats.latency.deadline_misses,
+    };
+    for j in first..last {
+        *hist.entry(steps[j]).or_insert(0u32) += 1;
+        if steps[j] != 5 {
+            jog.irregular += 1;
+            let near = (j.saturating_sub(3)..=(j + 3).min(steps.len() - 1)).any(off);
+            jog.unexcused += usize::from(!near);
+        }
+    }
+    eprintln!(
+        "clock {ppm:+} ppm, jog at 5 counts per cycle end to end: {} frames at constant speed, \
+         {} not advancing by 5 counts ({:.3} %), {} of them away from the bus's events: \
+         {hist:?}; {jog:?}",
+        jog.frames,
+        jog.irregular,
+        jog.irregular as f64 * 100.0 / jog.frames as f64,
+        jog.unexcused
+    );
+    eprintln!("{summary}");
+    Some(jog)
+}
+
+/// Set-point regularity end to end on drives whose clock runs 100 and
+/// 1,000 ppm off. Each frame carries the command that follows the previous
+/// frame's in the supervisor's sequence (`motion_ethercat::handoff`); a
+/// frame steps by other than v·T only next to an event of the bus (an
+/// overrun, a lost or late frame), where the supervisor's cycle missed its
+/// deadline (its command steps two cycles), or where the hand-off
+/// corrected its sequence (the clocks a cycle apart, or a stall). Taking
+/// the newest command for each frame made 2–4 % of the frames at 1,000 ppm
+/// step by 0 or two cycles, host or not, and no correction was counted.
+#[test]
+fn set_points_advance_regularly_end_to_end_over_a_drifting_clock() {
+    let _serial = serial();
+    for (tag, ppm) in [("ecat_reg100", 100.0), ("ecat_reg1000", 1000.0)] {
+        let Some(j) = jog_regularity(tag, ppm) else {
+            return;
+        };
+        assert!(j.frames > 2500, "{j:?}");
+        // (the corrections are motion-io's whole run's: how many fell in
+        // the jog, and how late motion-io's main loop handed commands on,
+        // is not counted end to end — `ecat-emu/tests/regularity.rs`
+        // bounds them where it is)
+        assert!(
+            j.unexcused as u64 <= j.corrections + j.deadline_misses,
+            "irregular frames the host does not explain: {j:?}"
+        );
+    }
+}
+
 /// R on the first drive, S and T behind it: S's and T's drives are lost
 /// (cable pulled) while motion-io serves the daemon; SIGTERM to motion-io
 /// still ends it within its stated bound (quick stop bound 500 ms + 200 ms
@@ -526,7 +822,10 @@ fn sigterm_ends_motion_io_within_the_bound_with_drives_lost() {
     d.ctl(&["home", "R"]).expect_code(0);
     b.rig.emulator().unplug(1);
     assert!(
-        d.wait_line("(axis S) lost", Duration::from_secs(5)),
+        wait_for(Duration::from_secs(5), || {
+            let st = d.status();
+            named(&st.axes, "S").drive_lost && named(&st.axes, "T").drive_lost
+        }),
         "{}",
         d.stderr()
     );
@@ -584,18 +883,25 @@ fn a_drive_power_cycled_mid_homing_is_reconfigured_without_restarting_motion_io(
     assert!(s.drive_lost && !s.enabled, "{s:#?}");
     std::thread::sleep(Duration::from_millis(500));
     emu.power_on(0);
-    for line in [
-        "(axis S) was power-cycled (found at its bus position without its station address): \
-         re-configuring it",
-        "(axis S) back in OP",
-    ] {
-        assert!(
-            d.wait_line(line, Duration::from_secs(10)),
-            "no {line:?} in\n{}",
-            d.stderr()
-        );
-    }
-    assert!(wait_for(Duration::from_secs(5), || !d.axis("S").drive_lost));
+    // back: the drive in OP again (re-configured: its station address was
+    // gone) and its axis no longer lost. What motion-io logs meanwhile is
+    // sampled every 20 ms (a quick re-configuration can pass unlogged), so
+    // the states are awaited, and the count read from its summary at exit.
+    assert!(
+        wait_for(Duration::from_secs(10), || {
+            let v = b.drive(0);
+            v.al_status == 0x08 && v.station_address != 0
+        }),
+        "not back in OP: {:?}\n{}",
+        b.drive(0),
+        d.stderr()
+    );
+    assert!(
+        wait_for(Duration::from_secs(5), || !d.axis("S").drive_lost),
+        "{:#?}\n{}",
+        d.axis("S"),
+        d.stderr()
+    );
     // not enabled by itself: its power stage off (the engine withdrew the
     // enable request when the drive was lost, so the backend holds it
     // where it holds every disabled drive — Ready to switch on — or, with

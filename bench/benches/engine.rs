@@ -1,7 +1,11 @@
 //! Engine benchmarks (criterion): one `Axis::step` in the middle of a homing
-//! leg, and one whole cycle's compute (`Core::step` + `Core::fill`) for 1, 8,
-//! 32 and 64 axes. Goals: ≤ 50 ns per axis step, ≤ 10 µs for a 64-axis
-//! cycle. A summary table against the goals is printed at the end.
+//! leg, one cycle monitor's verdict on that step's command
+//! (`engine_step/monitor`: `Monitor::check`, what the cycle adds per axis
+//! between the engine and the frame), and one whole cycle's compute
+//! (`Core::step` + `Core::fill`, the monitors included) for 1, 8, 32 and 64
+//! axes. Goals: ≤ 50 ns per axis step, ≤ 50 ns per monitor check, ≤ 10 µs
+//! for a 64-axis cycle. A summary table against the goals is printed at the
+//! end.
 //!
 //! `profile/*`: what a jog or move costs the cycle, trapezoid against
 //! S-curve — planning one (the step that asks for it: a move from a moving
@@ -32,15 +36,16 @@
 //! The total it prints (`Collected`) divided by N (and by the axis count for
 //! a cycle) is the cost of one step; `callgrind_annotate engine.cg` shows
 //! where it goes. IDs: `engine_step/seek`, `engine_step/torque_detect`,
-//! `cycle/1`, `cycle/8`, `cycle/32`, `cycle/64`, and `profile/*` (e.g.
-//! `profile/plan_scurve`).
+//! `engine_step/monitor`, `cycle/1`, `cycle/8`, `cycle/32`, `cycle/64`, and
+//! `profile/*` (e.g. `profile/plan_scurve`).
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
-use motion_harness::engine::{
+use motion_bench::engine::{
     geared_state, homing_core, phases, repeated_demo as machine, seek_state, torque_state, Captured,
 };
 use motion_homing::profile::{Kinematics, Profile, Ramp};
-use motion_homing::{Axis, Phase};
+use motion_homing::{Axis, Command, Phase, Status};
+use motion_monitor::{Cycle, Monitor};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
@@ -226,6 +231,70 @@ fn profile(c: &mut Criterion) {
     g.finish();
 }
 
+/// A monitor that has judged the captured seek for three cycles, and the
+/// fourth cycle's inputs: the engine's command and status of that step.
+struct Judged {
+    monitor: Monitor,
+    state: Captured,
+    command: Command,
+    status: Status,
+}
+
+/// The seek of `seek_state()` stepped on for three cycles with the monitor
+/// judging each (a homing in its seek: the monitor's history, mode and
+/// speed bound in place), then a fourth step whose command is measured.
+fn judged() -> Judged {
+    let state = seek_state();
+    let mut axis = state.axis.clone();
+    let mut monitor = Monitor::new(axis.config());
+    let step = |axis: &mut Axis, now: u64| {
+        let command = axis.step(now, Some(&state.feedback), &state.request);
+        (command, *axis.status())
+    };
+    for k in 0..3 {
+        let now = state.now + k * 1_000_000;
+        let (command, status) = step(&mut axis, now);
+        let out = monitor.check(&cycle_of(&state, now, &command, &status));
+        assert_eq!(out, command, "the monitor passes a normal seek");
+    }
+    let (command, status) = step(&mut axis, state.now + 3_000_000);
+    Judged {
+        monitor,
+        state,
+        command,
+        status,
+    }
+}
+
+fn cycle_of<'a>(s: &'a Captured, now: u64, command: &'a Command, status: &'a Status) -> Cycle<'a> {
+    Cycle {
+        now_ns: now,
+        feedback: Some(&s.feedback),
+        request: &s.request,
+        status,
+        reference: None,
+        command,
+        io_restarted: false,
+    }
+}
+
+fn monitor_check(c: &mut Criterion) {
+    let j = judged();
+    let now = j.state.now + 3_000_000;
+    let cycle = cycle_of(&j.state, now, &j.command, &j.status);
+    assert_eq!(j.monitor.clone().check(&cycle), j.command);
+    let mut g = c.benchmark_group("engine_step");
+    // a fresh copy of the monitor per check, a cycle's worth per batch
+    g.bench_function("monitor", |b| {
+        b.iter_batched_ref(
+            || j.monitor.clone(),
+            |m| m.check(black_box(&cycle)),
+            BatchSize::NumIterations(CYCLE_AXES),
+        )
+    });
+    g.finish();
+}
+
 fn cycle(c: &mut Criterion) {
     let mut g = c.benchmark_group("cycle");
     for n in AXES {
@@ -305,6 +374,7 @@ fn summary(dir: &Path, since: SystemTime) {
         ("engine_step/seek".into(), 1, Some(50.0)),
         ("engine_step/torque_detect".into(), 1, Some(50.0)),
         ("engine_step/seek_cold".into(), 1, None),
+        ("engine_step/monitor".into(), 1, Some(50.0)),
         ("engine_step/jog_master".into(), 1, Some(50.0)),
         ("engine_step/geared".into(), 1, Some(50.0)),
     ];
@@ -323,7 +393,7 @@ fn summary(dir: &Path, since: SystemTime) {
         };
         let (goal_txt, verdict) = match goal {
             Some(g) if n == 1 && id.starts_with("engine") => (
-                "≤ 50 ns per axis".to_string(),
+                format!("≤ {g} ns per axis"),
                 if t <= g { "ok" } else { "MISSED" },
             ),
             Some(g) => (
@@ -343,12 +413,14 @@ fn summary(dir: &Path, since: SystemTime) {
         "engine_step/* = one Axis::step on a copy in the cache (64 copies per batch, as a cycle's axes); \
          seek_cold: copies streamed from memory"
     );
+    println!("engine_step/monitor = one Monitor::check on the command of a seek step");
     println!(
         "profile/* = planning a move (from a moving state; turning back; a stop on a limit) and sampling one, \
          trapezoid against S-curve"
     );
     println!(
-        "cycle/N = Core::step + Core::fill for N homing axes (engine steps + counts↔units for every axis)"
+        "cycle/N = Core::step + Core::fill for N homing axes (engine steps, monitors, counts↔units \
+         for every axis)"
     );
 }
 
@@ -383,6 +455,17 @@ mod instructions {
         };
         let mut profiles = profile_routines();
         match id {
+            "engine_step/monitor" => {
+                let j = judged();
+                let cycle = cycle_of(&j.state, j.state.now + 3_000_000, &j.command, &j.status);
+                let mut ms: Vec<Monitor> = (0..n).map(|_| j.monitor.clone()).collect();
+                let mut next = ms.iter_mut();
+                counted(n, &mut || {
+                    if let Some(m) = next.next() {
+                        black_box(m.check(black_box(&cycle)));
+                    }
+                });
+            }
             "engine_step/seek" => step(seek_state(), Phase::Seek),
             "engine_step/torque_detect" => step(torque_state(), Phase::Seek),
             _ if id.starts_with("profile/") => {
@@ -397,7 +480,10 @@ mod instructions {
                     .strip_prefix("cycle/")
                     .and_then(|k| k.parse().ok())
                     .filter(|k| AXES.contains(k))
-                    .expect("ID: engine_step/seek, engine_step/torque_detect or cycle/{1,8,32,64}");
+                    .expect(
+                        "ID: engine_step/seek, engine_step/torque_detect, engine_step/monitor or \
+                         cycle/{1,8,32,64}",
+                    );
                 let (mut core, fb, mut cmd, now) = homing_core(&machine(k));
                 counted(n, &mut || {
                     core.step(black_box(now), false, &[Some(black_box(&fb))]);
@@ -430,6 +516,7 @@ fn main() {
         .configure_from_args();
     engine_step(&mut c);
     profile(&mut c);
+    monitor_check(&mut c);
     cycle(&mut c);
     c.final_summary();
     if !args.iter().any(|a| a == "--list" || a == "--test") {

@@ -2,7 +2,6 @@
 //! other real-time threads seen while it runs, and the bench's own threads
 //! set up like the cycle's ([`enter_rt`], the harness's placement).
 
-pub use motion_harness::bins::{beside_this_exe, find_in_path, is_executable};
 pub use motion_harness::placement::enter as enter_rt;
 pub use motion_rt::host::{cpus, loadavg, other_rt_tasks, Host};
 use std::collections::BTreeSet;

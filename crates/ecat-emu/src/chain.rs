@@ -20,7 +20,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use crate::drive::{Drive, DriveConfig, DriveView};
-use crate::esc::{Esc, EscStats};
+use crate::esc::{Dropped, Esc, EscStats};
 
 // The raw socket is the master's own (`motion_ethercat::socket`): plumbing,
 // not protocol, so sharing it cannot hide a misreading of the standard.
@@ -387,6 +387,49 @@ impl Emulator {
         if let Some(e) = self.chain().escs.get_mut(position) {
             e.pd_refused = refuse;
         }
+    }
+
+    /// SubDevice `position` falls out of OP by itself while it still
+    /// answers its AL status (see [`Esc::drop_out_of_op`]): its working
+    /// counter comes back short (1 of 3 in SAFE-OP, 0 in PRE-OP).
+    pub fn drop_out_of_op(&self, position: usize, to: Dropped) {
+        if let Some(e) = self.chain().escs.get_mut(position) {
+            e.drop_out_of_op(to);
+        }
+    }
+
+    /// SubDevice `position` refuses SAFE-OP → OP with AL status code
+    /// `code` (`None`: it accepts again).
+    pub fn refuse_op(&self, position: usize, code: Option<u16>) {
+        if let Some(e) = self.chain().escs.get_mut(position) {
+            e.op_refused = code;
+        }
+    }
+
+    /// Drive `position` records the target position (0x607A) of every
+    /// process-data frame it takes in cyclic synchronous position mode
+    /// (`false`: stops and forgets them).
+    pub fn record_targets(&self, position: usize, on: bool) {
+        if let Some(e) = self.chain().escs.get_mut(position) {
+            e.targets = on.then(Vec::new);
+        }
+    }
+
+    /// The targets drive `position` recorded so far (taken: the record
+    /// starts empty again).
+    pub fn take_targets(&self, position: usize) -> Vec<i32> {
+        let timed = self.take_timed_targets(position);
+        timed.into_iter().map(|(t, _)| t).collect()
+    }
+
+    /// The targets drive `position` recorded so far with when their frames
+    /// passed (taken: the record starts empty again).
+    pub fn take_timed_targets(&self, position: usize) -> Vec<(i32, Instant)> {
+        self.chain()
+            .escs
+            .get_mut(position)
+            .and_then(|e| e.targets.as_mut().map(std::mem::take))
+            .unwrap_or_default()
     }
 
     /// The drive at `position` faults with `code` (0x603F) at its next cycle.

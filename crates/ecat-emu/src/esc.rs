@@ -26,13 +26,28 @@ pub mod al {
     pub const OP: u8 = 0x08;
     pub const ERROR: u8 = 0x10;
 
+    pub const UNSPECIFIED: u16 = 0x0001;
     pub const INVALID_STATE_CHANGE: u16 = 0x0011;
     pub const BOOTSTRAP_NOT_SUPPORTED: u16 = 0x0013;
     pub const INVALID_MAILBOX_CONFIG: u16 = 0x0016;
+    pub const SYNC_ERROR: u16 = 0x001A;
     pub const SM_WATCHDOG: u16 = 0x001B;
     pub const INVALID_OUTPUT_CONFIG: u16 = 0x001D;
     pub const INVALID_INPUT_CONFIG: u16 = 0x001E;
     pub const INVALID_DC_SYNC_CONFIG: u16 = 0x0030;
+}
+
+/// Where a SubDevice falls out of OP by itself (a test fault: see
+/// [`Esc::drop_out_of_op`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dropped {
+    /// SAFE-OP with the error flag and this AL status code (an SM watchdog
+    /// 0x001B, a sync error 0x001A, ...): its inputs are still read, its
+    /// outputs no longer taken (the application deactivated the output
+    /// sync manager: 0x0817 bit 0), so it counts 1 of 3 in an LRW.
+    SafeOp(u16),
+    /// PRE-OP (its application restarted): no process data at all, 0 of 3.
+    PreOp,
 }
 
 /// Time the ESC waits in SAFE-OP for the first process data after an OP
@@ -114,6 +129,20 @@ pub struct Esc {
     /// Test fault: logical (FMMU) accesses are refused — the working
     /// counter comes back short while the AL state stays as it is.
     pub pd_refused: bool,
+    /// The output sync manager (SM2) is deactivated by the application
+    /// (its PDI control register 0x0817 bit 0, ESC datasheet: "SyncManager
+    /// deactivated by PDI"):
+    /// EtherCAT writes to it are refused and not counted. Set when an error
+    /// takes the ESC from OP to SAFE-OP; cleared when OP is asked for.
+    out_sm_off: bool,
+    /// Test fault: SAFE-OP → OP is refused with this AL status code.
+    pub op_refused: Option<u16>,
+    /// Clock drift, parts per million (the drive's `clock_ppm`).
+    clock_ppm: f64,
+    /// While recording: the target position (0x607A) of every frame whose
+    /// outputs the drive took in cyclic synchronous position mode, and
+    /// when the frame passed.
+    pub targets: Option<Vec<(i32, Instant)>>,
     pub stats: EscStats,
 }
 
@@ -133,6 +162,7 @@ impl Esc {
     /// Power-on: registers at their reset values, AL INIT, station address 0.
     pub fn new(drive: Drive, position: usize, epoch: Instant) -> Esc {
         let dc = drive.cfg.dc;
+        let clock_ppm = drive.cfg.clock_ppm;
         let info = sii::SiiInfo {
             name: drive.cfg.name.clone(),
             vendor_id: drive.cfg.vendor_id,
@@ -169,6 +199,10 @@ impl Esc {
             frame_local: 0,
             next_tick: None,
             pd_refused: false,
+            out_sm_off: false,
+            op_refused: None,
+            clock_ppm,
+            targets: None,
             stats: EscStats::default(),
         };
         e.reset_registers();
@@ -241,8 +275,11 @@ impl Esc {
         (time != 0 && enabled).then(|| Duration::from_nanos((divider + 2) * 40 * time))
     }
 
+    /// This ESC's local clock at `now`: it runs `clock_ppm` off the host's.
     fn local_time(&self, now: Instant) -> u64 {
-        now.duration_since(self.epoch).as_nanos() as u64 + self.clock_base
+        let ns = now.duration_since(self.epoch).as_nanos() as u64;
+        let drift = (ns as f64 * self.clock_ppm * 1e-6) as i64;
+        ns.wrapping_add_signed(drift) + self.clock_base
     }
 
     fn sm(&self, n: usize) -> Sm {
@@ -279,6 +316,7 @@ impl Esc {
         }
         let status = u16::from(self.al_status());
         let code = self.al_code;
+        let t = self.local_time(now);
         let wd = u16::from(!self.wd_expired);
         let m = &mut self.mem;
         m[0x0110..0x0112].copy_from_slice(&dl.to_le_bytes());
@@ -295,8 +333,8 @@ impl Esc {
             };
             m[a + 5] = if full { 0x08 } else { 0x00 };
         }
+        m[0x0817] = u8::from(self.out_sm_off);
         if self.dc {
-            let t = now.duration_since(self.epoch).as_nanos() as u64 + self.clock_base;
             let sys = t.wrapping_add(u64_at(m, 0x0920));
             m[0x0910..0x0918].copy_from_slice(&sys.to_le_bytes());
         }
@@ -371,7 +409,7 @@ impl Esc {
                     }
                     mbx_last |= end >= sm.end();
                 } else {
-                    if !self.pd_active() {
+                    if !self.pd_active() || self.out_sm_off {
                         return false;
                     }
                     pd_last |= end >= sm.end();
@@ -571,6 +609,9 @@ impl Esc {
                 let sm2 = self.sm(2);
                 let out = self.mem[usize::from(sm2.start)..sm2.end()].to_vec();
                 self.drive.apply_outputs(&out);
+                if let (Some(t), 8) = (&mut self.targets, self.drive.mode()) {
+                    t.push((self.drive.od.get_signed(0x607A, 0) as i32, now));
+                }
             }
             self.drive.cycle(valid);
             self.write_inputs();
@@ -619,6 +660,7 @@ impl Esc {
                 }
                 self.al_state = al::INIT;
                 self.op_requested_at = None;
+                self.out_sm_off = false;
                 self.mbx_out_full = false;
                 self.mbx_in_full = false;
                 self.mbx_queue.clear();
@@ -647,7 +689,12 @@ impl Esc {
                 }
                 Err(code) => self.error(code),
             },
+            (al::SAFEOP, al::OP) if self.op_refused.is_some() => {
+                self.error(self.op_refused.unwrap_or(al::UNSPECIFIED));
+            }
             (al::SAFEOP, al::OP) => {
+                // the application takes outputs again
+                self.out_sm_off = false;
                 let recent = self.last_pd_write.is_some_and(|t| {
                     now.duration_since(t)
                         < self.watchdog_time().unwrap_or(Duration::from_millis(100))
@@ -667,6 +714,7 @@ impl Esc {
                     self.drive.outputs_lost(false);
                 }
                 self.op_requested_at = None;
+                self.out_sm_off = false;
                 self.al_state = al::PREOP;
             }
             (_, al::BOOT) => self.error(al::BOOTSTRAP_NOT_SUPPORTED),
@@ -734,6 +782,7 @@ impl Esc {
                     self.stats.watchdog_expiries += 1;
                     self.al_state = al::SAFEOP;
                     self.error(al::SM_WATCHDOG);
+                    self.out_sm_off = true;
                     self.drive.outputs_lost(true);
                 }
             }
@@ -765,6 +814,38 @@ impl Esc {
             self.next_tick = Some(next);
         }
         self.refresh(now);
+    }
+
+    /// The SubDevice falls out of OP by itself (from OP or SAFE-OP), as a
+    /// drive does after an SM-watchdog trip, an AL error or a restart of its
+    /// application, while it still answers its AL status: a drive in
+    /// Operation enabled takes its reaction to the lost outputs (ETG.6010,
+    /// the abort connection option 0x6007 — here: a quick stop to Switch
+    /// on disabled, or after an SM watchdog its fault reaction to Fault).
+    pub fn drop_out_of_op(&mut self, to: Dropped) {
+        if !matches!(self.al_state, al::OP | al::SAFEOP) {
+            return;
+        }
+        let was_op = self.al_state == al::OP;
+        self.op_requested_at = None;
+        match to {
+            Dropped::SafeOp(code) => {
+                if was_op {
+                    self.drive.outputs_lost(code == al::SM_WATCHDOG);
+                }
+                self.al_state = al::SAFEOP;
+                self.out_sm_off = true;
+                self.error(code);
+            }
+            Dropped::PreOp => {
+                if was_op {
+                    self.drive.outputs_lost(false);
+                }
+                self.al_state = al::PREOP;
+                self.out_sm_off = false;
+            }
+        }
+        self.refresh(Instant::now());
     }
 
     /// The CoE server's counters.

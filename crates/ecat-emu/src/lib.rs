@@ -29,4 +29,5 @@ pub use chain::{Chain, Emulator, EmulatorConfig, SubDeviceView};
 pub use drive::{
     DriveConfig, DriveView, ModeDisplay, PdoProfile, State, TorqueObjects, SUPPORTED_METHODS,
 };
+pub use esc::{al, Dropped};
 pub use netns::{Skip, VethPair};

@@ -44,9 +44,19 @@
 //! * **A lost drive** ([`AxisLogic::lost`]): the backend latches a fault
 //!   for an axis that was enabled, so the drive is not re-enabled by itself
 //!   when it comes back.
-//! * **No data this cycle**: the outputs stay what they were (the state
-//!   machines are not stepped blind) and the feedback is the last good one
-//!   with `SW_NO_DATA`.
+//! * **No data this cycle**: the state machines are not stepped blind and
+//!   the feedback is the last good one with `SW_NO_DATA`; a drive that was
+//!   following goes on getting the command's target (its outputs may well
+//!   arrive: a working counter that cannot be trusted), other outputs stay
+//!   what they were — but a stop (watchdog, emergency, disable, the
+//!   backend's fault) is sent all the same, on the last state seen and on
+//!   time alone (`blind`): whatever the working counter says, the stop
+//!   reaches every drive that takes its outputs.
+//! * **Data back after a loss** longer than the supervisor's feedback
+//!   timeout (its engine aborted the motion meanwhile), the drive still
+//!   enabled but its command run away from the last target it got: never
+//!   jumped there — its target is its actual position and it gets the
+//!   backend's fault, the bounded stop (`after_gap`).
 //! * **Objects the layout lacks**: without 0x606C the velocity is the
 //!   position's change per cycle; without 0x6077 the torque is 0; without
 //!   0x60FD no input is ever reported; without touch probes no latch.
@@ -71,6 +81,10 @@ pub const MAX_TARGET_DISTANCE: i64 = 1 << 30;
 /// its velocity), counts.
 pub const RESYNC_COUNTS: i64 = 16;
 
+/// The fewest missing cycles after which data that returns is checked for
+/// a command that ran away ([`AxisSetup::gap_cycles`]).
+pub const GAP_CYCLES: u32 = 3;
+
 /// What the caller wants from all axes this cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -87,6 +101,11 @@ pub enum Mode {
 pub struct AxisCounters {
     pub rejected_setpoints: u64,
     pub fault_resets: u64,
+    /// Returns of its data after a gap over which the command ran away:
+    /// the drive was stopped where it stood instead of jumping.
+    pub gap_stops: u64,
+    /// Cycles a stop was sent to the drive without its data (blind).
+    pub blind_stop_cycles: u64,
 }
 
 /// How one axis is set up.
@@ -104,6 +123,9 @@ pub struct AxisSetup {
     pub brake_ms: u32,
     /// The drive homes the axis itself when asked.
     pub drive_homing: bool,
+    /// Cycles of missing data after which the supervisor's engine has
+    /// aborted the motion (its feedback timeout; at least [`GAP_CYCLES`]).
+    pub gap_cycles: u32,
 }
 
 impl AxisSetup {
@@ -118,6 +140,7 @@ impl AxisSetup {
             quick_stop_ms: 500,
             brake_ms: 0,
             drive_homing: false,
+            gap_cycles: 10,
         }
     }
 }
@@ -146,6 +169,9 @@ pub struct AxisLogic {
     /// Cycles since the last valid inputs (derived velocity).
     since_inputs: u32,
     state: State,
+    /// The state its data showed last (kept through a loss: a stop sent
+    /// without data goes on from there).
+    seen_state: State,
     outputs: DriveOutputs,
     last_feedback: AxisFeedback,
     kept_error: u16,
@@ -161,6 +187,8 @@ pub struct AxisLogic {
     /// late master repeated its set-point; disabling voltage on it would
     /// drop a moving axis).
     still: u32,
+    /// See [`AxisSetup::gap_cycles`].
+    gap_cycles: u32,
     pub counters: AxisCounters,
 }
 
@@ -191,6 +219,7 @@ impl AxisLogic {
             pos32: 0,
             since_inputs: 1,
             state: State::NotReadyToSwitchOn,
+            seen_state: State::NotReadyToSwitchOn,
             outputs: DriveOutputs {
                 mode: MODE_CSP,
                 ..DriveOutputs::default()
@@ -203,6 +232,7 @@ impl AxisLogic {
             cycle_s,
             rest_velocity: 1.0 / cycle_s,
             still: 0,
+            gap_cycles: setup.gap_cycles.max(GAP_CYCLES),
             counters: AxisCounters::default(),
             layout: setup.layout,
         }
@@ -247,14 +277,15 @@ impl AxisLogic {
     /// a drive that comes back no longer enabled while enable is still
     /// asked for gets the backend's fault — it is never enabled again by
     /// itself (a short loss the drive rode out in Operation enabled just
-    /// goes on).
+    /// goes on). A stop in progress goes on, blind, on the last state seen
+    /// (its outputs may still arrive): it reaches disable voltage at its
+    /// bound.
     pub fn lost(&mut self) {
         self.was_lost = true;
         self.cia = Cia402::new();
         if let Some(h) = &mut self.homing {
             h.forget();
         }
-        self.stopper.reset();
         self.state = State::NotReadyToSwitchOn;
         self.last_feedback.status_word &= !(SW_ENABLED | SW_DRIVE_HOMING | SW_DRIVE_HOMED);
     }
@@ -273,10 +304,12 @@ impl AxisLogic {
         }
         let Some(inp) = inputs else {
             self.since_inputs = self.since_inputs.saturating_add(1);
+            self.blind(cmd, mode, enable);
             let mut fb = self.last_feedback;
             fb.status_word |= SW_NO_DATA;
             return (self.outputs, fb);
         };
+        let gap = self.since_inputs > self.gap_cycles;
         let prev = self.pos64;
         let pos64 = self.extend(inp.position);
         let velocity = if self.layout.present.velocity {
@@ -287,6 +320,7 @@ impl AxisLogic {
         };
         self.since_inputs = 1;
         self.state = State::from_statusword(inp.statusword);
+        self.seen_state = self.state;
         if std::mem::take(&mut self.was_lost) && enable && !self.state.is_enabled() {
             self.fault_latch = true;
         }
@@ -298,7 +332,10 @@ impl AxisLogic {
             0
         };
         let at_rest = self.still >= REST_CYCLES;
-        let target = self.cia_target(mode, enable, at_rest);
+        if gap && mode == Mode::Normal {
+            self.after_gap(cmd);
+        }
+        let target = self.cia_target(mode, enable, at_rest, true);
         let home = self.drive_homing(cmd, mode, target, inp, at_rest);
         let mut controlword = self.cia.step(inp.statusword, target);
         if self.state.is_enabled() && target == Target::Enabled {
@@ -335,11 +372,86 @@ impl AxisLogic {
         let reset = cmd.control_word & CW_FAULT_RESET != 0;
         if (enable && !self.last_enable) || (reset && !self.last_reset) {
             self.fault_latch = false;
+            // asked for again: a stop in progress is over
+            self.stopper.reset();
             self.cia.request_fault_reset();
             self.counters.fault_resets += 1;
         }
         self.last_enable = enable;
         self.last_reset = reset;
+    }
+
+    /// No data this cycle (the state machines are not stepped blind).
+    ///
+    /// * A drive that was following in Operation enabled goes on getting
+    ///   the command's target: its data is missing, not necessarily its
+    ///   outputs (a working counter that cannot be trusted), and the
+    ///   supervisor goes on commanding through a short loss of feedback.
+    /// * A stop (the watchdog's, the emergency stop, a disable, the
+    ///   backend's own fault) is sent whatever the working counter says:
+    ///   stepped on the last state seen and on time alone
+    ///   ([`Stopper::step_blind`]) — quick stop until the bound, then (the
+    ///   brake's delay and) disable voltage; from Operation enabled a
+    ///   disable is "shutdown". Nothing is concluded from it: the axis
+    ///   counts as stopped only once its data shows it.
+    /// * Otherwise the outputs stay what they were.
+    fn blind(&mut self, cmd: &AxisCommand, mode: Mode, enable: bool) {
+        if mode == Mode::Normal && enable && !self.fault_latch {
+            let following =
+                self.state.is_enabled() && !self.resync && self.outputs.mode == MODE_CSP;
+            let plausible = self.pos64.is_some_and(|p| {
+                cmd.target_position != INVALID_COUNTS
+                    && cmd
+                        .target_position
+                        .checked_sub(p)
+                        .is_some_and(|d| d.abs() <= MAX_TARGET_DISTANCE)
+            });
+            if following && plausible {
+                self.outputs.target_position = cmd.target_position as i32;
+            }
+            return;
+        }
+        let target = self.cia_target(mode, enable, false, false);
+        self.outputs.controlword = self.cia.step(self.seen_state.statusword(), target);
+        self.counters.blind_stop_cycles += 1;
+    }
+
+    /// The data came back after a loss longer than the supervisor's
+    /// feedback timeout ([`AxisSetup::gap_cycles`]: its engine has aborted
+    /// the motion and stops it on its own profile) with the drive still in
+    /// Operation enabled, and the last target the drive got lies further
+    /// from the command's than catching up in one cycle allows
+    /// ([`RESYNC_COUNTS`] + four cycles of its velocity): it was lost (its
+    /// outputs frozen) while the command ran on — a 30 ms loss at 20
+    /// units/s would be 0.6 units in one cycle. It is never jumped there:
+    /// its target is its actual position and it gets the backend's fault
+    /// (the bounded stop, then disabled); the supervisor enables it again
+    /// from where it stands after a reset. A shorter loss, which the engine
+    /// rides out, is caught up: at most its feedback timeout's travel. (A
+    /// drive that did not ride the loss out in Operation enabled follows
+    /// its actual position anyway and gets the fault of a lost drive:
+    /// [`AxisLogic::lost`].)
+    fn after_gap(&mut self, cmd: &AxisCommand) {
+        if !self.state.is_enabled() || self.resync || cmd.target_position == INVALID_COUNTS {
+            return;
+        }
+        // the wire's targets are 32-bit: the step modulo 2^32
+        let step = (cmd.target_position as i32).wrapping_sub(self.outputs.target_position);
+        if f64::from(step).abs() > self.resync_window(cmd) {
+            self.fault_latch = true;
+            self.counters.gap_stops += 1;
+        }
+    }
+
+    /// How near the command's target must be to be followed (again):
+    /// [`RESYNC_COUNTS`] plus four cycles of the command's velocity.
+    fn resync_window(&self, cmd: &AxisCommand) -> f64 {
+        let v = if cmd.target_velocity.is_finite() {
+            cmd.target_velocity.abs()
+        } else {
+            0.0
+        };
+        RESYNC_COUNTS as f64 + v * 4.0 * self.cycle_s
     }
 
     /// The set-point this cycle: the command's while following, the last
@@ -362,7 +474,7 @@ impl AxisLogic {
             return inp.position;
         }
         if self.resync {
-            let window = RESYNC_COUNTS as f64 + cmd.target_velocity.abs() * 4.0 * self.cycle_s;
+            let window = self.resync_window(cmd);
             let near = ((cmd.target_position - pos64) as f64).abs() <= window;
             if !(target_ok && near) {
                 return inp.position;
@@ -449,21 +561,38 @@ impl AxisLogic {
     }
 
     /// Where the CiA 402 machine walks the drive this cycle.
-    fn cia_target(&mut self, mode: Mode, enable: bool, at_rest: bool) -> Target {
+    /// (`seen`: from this cycle's data; else blind, see
+    /// [`blind`](Self::blind)).
+    fn cia_target(&mut self, mode: Mode, enable: bool, at_rest: bool, seen: bool) -> Target {
+        let seen_state = self.seen_state;
+        let stop = |s: &mut Stopper, state: State| {
+            if seen {
+                s.step(state, at_rest)
+            } else {
+                s.step_blind(seen_state)
+            }
+        };
         match mode {
+            // commands back in the middle of a watchdog stop of an enabled
+            // drive, enable still asked for: the stop goes on and the axis
+            // is faulted — never enabled again by itself
+            Mode::Normal if enable && !self.fault_latch && self.stopper.stopping() => {
+                self.fault_latch = true;
+                stop(&mut self.stopper, self.state)
+            }
             Mode::Normal if enable && !self.fault_latch => {
                 self.stopper.reset();
                 Target::Enabled
             }
             // a refused set-point (or a drive back after a loss) while
             // enabled: the bounded stop
-            Mode::Normal if self.fault_latch => self.stopper.step(self.state, at_rest),
+            Mode::Normal if self.fault_latch => stop(&mut self.stopper, self.state),
             Mode::Normal => {
                 self.stopper.reset();
                 Target::Disabled
             }
             Mode::WatchdogStop => {
-                let t = self.stopper.step(self.state, at_rest);
+                let t = stop(&mut self.stopper, self.state);
                 if t == Target::Off && self.last_enable {
                     self.fault_latch = true;
                 }

@@ -272,6 +272,45 @@ fn watchdog_stop_quick_stops_then_disables_with_a_fault() {
 }
 
 #[test]
+fn commands_back_in_the_middle_of_a_watchdog_stop_never_enable_again() {
+    let mut a = logic();
+    a.step(
+        &cmd(true, 0),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 0)),
+    );
+    let (o, _) = a.step(
+        &cmd(true, 0),
+        Mode::WatchdogStop,
+        Some(&inputs(State::OperationEnabled, 0)),
+    );
+    assert_eq!(o.controlword, 0x0002);
+    // the drive ended its quick stop by itself; the commands come back
+    // before the stop saw it: enable still asked for, no edge
+    for _ in 0..5 {
+        let (o, fb) = a.step(
+            &cmd(true, 0),
+            Mode::Normal,
+            Some(&inputs(State::SwitchOnDisabled, 0)),
+        );
+        assert_eq!(o.controlword, 0x0000, "never walked to enabled");
+        assert_eq!(fb.status_word, SW_FAULT);
+    }
+    // a reset (the enable edge) and it enables
+    a.step(
+        &cmd(false, 0),
+        Mode::Normal,
+        Some(&inputs(State::SwitchOnDisabled, 0)),
+    );
+    let (o, fb) = a.step(
+        &cmd(true, 0),
+        Mode::Normal,
+        Some(&inputs(State::SwitchOnDisabled, 0)),
+    );
+    assert_eq!((o.controlword, fb.status_word), (0x0006, 0));
+}
+
+#[test]
 fn emergency_is_disable_voltage_and_a_fault() {
     let mut a = logic();
     a.step(
@@ -297,10 +336,173 @@ fn no_data_keeps_outputs_and_reports_last_values() {
     let (o1, fb1) = a.step(&cmd(true, 42), Mode::Normal, Some(&i));
     assert_eq!(fb1.digital_inputs, DI_HOME_SWITCH | DI_MARKER_PULSE);
     assert_eq!(fb1.torque, -12.5);
+    // enabled and following: the target goes on, the rest stays
     let (o2, fb2) = a.step(&cmd(true, 99), Mode::Normal, None);
-    assert_eq!(o2, o1);
+    assert_eq!(
+        o2,
+        DriveOutputs {
+            target_position: 99,
+            ..o1
+        }
+    );
     assert_eq!(fb2.status_word, fb1.status_word | SW_NO_DATA);
     assert_eq!(fb2.position, 42);
+}
+
+#[test]
+fn a_stop_without_data_is_sent_blind_on_time_alone() {
+    // quick stop bound 20 ms at 1 ms: enabled and moving, then no data
+    let mut a = AxisLogic::new(AxisSetup {
+        quick_stop_ms: 20,
+        ..AxisSetup::new(
+            PdoLayout::standard(TorqueLimits::PerDirection, false),
+            0.001,
+        )
+    });
+    let (o, _) = a.step(
+        &cmd(true, 100),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 90)),
+    );
+    assert_eq!(o.controlword, 0x000F);
+    // enabled and following: the target goes on, the state machine is not
+    // stepped blind
+    let (o, _) = a.step(&cmd(true, 120), Mode::Normal, None);
+    assert_eq!((o.controlword, o.target_position), (0x000F, 120));
+    // the watchdog stop: quick stop until the bound (never judged ignored
+    // without data), then disable voltage, the target held
+    let words: Vec<u16> = (0..22)
+        .map(|_| a.step(&cmd(true, 140), Mode::WatchdogStop, None).0)
+        .map(|o| {
+            assert_eq!(o.target_position, 120);
+            o.controlword
+        })
+        .collect();
+    assert!(words[..20].iter().all(|w| *w == 0x0002), "{words:?}");
+    assert_eq!(&words[20..], &[0x0000, 0x0000]);
+    assert_eq!(a.counters.blind_stop_cycles, 22);
+    // not counted as stopped: its state was not seen
+    assert!(!a.at_rest_and_disabled());
+    // data again: Switch on disabled seen, the stop complete, a fault
+    let (o, fb) = a.step(
+        &cmd(true, 120),
+        Mode::WatchdogStop,
+        Some(&inputs(State::SwitchOnDisabled, 95)),
+    );
+    assert_eq!(o.controlword, 0x0000);
+    assert!(a.at_rest_and_disabled());
+    assert_eq!(fb.status_word & (SW_ENABLED | SW_FAULT), SW_FAULT);
+
+    // lost (not answering) in the middle of a watchdog stop: the stop goes
+    // on from the last state seen — quick stop until the bound, not
+    // disable voltage at once
+    let mut a = AxisLogic::new(AxisSetup {
+        quick_stop_ms: 20,
+        ..AxisSetup::new(
+            PdoLayout::standard(TorqueLimits::PerDirection, false),
+            0.001,
+        )
+    });
+    a.step(
+        &cmd(true, 100),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 100)),
+    );
+    let words: Vec<u16> = (0..22)
+        .map(|_| {
+            a.lost();
+            a.step(&cmd(true, 100), Mode::WatchdogStop, None)
+                .0
+                .controlword
+        })
+        .collect();
+    assert!(words[..20].iter().all(|w| *w == 0x0002), "{words:?}");
+    assert_eq!(&words[20..], &[0x0000, 0x0000]);
+
+    // a disable without data: "shutdown" at once; the emergency stop:
+    // disable voltage at once
+    for (mode, enable, word) in [
+        (Mode::Normal, false, 0x0006),
+        (Mode::Emergency, true, 0x0000),
+    ] {
+        let mut a = logic();
+        a.step(
+            &cmd(true, 0),
+            Mode::Normal,
+            Some(&inputs(State::OperationEnabled, 0)),
+        );
+        let (o, _) = a.step(&cmd(enable, 0), mode, None);
+        assert_eq!(o.controlword, word, "{mode:?}");
+    }
+}
+
+#[test]
+fn without_data_a_following_drive_gets_the_command_and_after_a_loss_never_a_jump() {
+    let mut a = logic();
+    let fast = |t: i64| AxisCommand {
+        target_velocity: 20_000.0, // 20 counts per cycle
+        ..cmd(true, t)
+    };
+    for k in 0..5 {
+        let (o, _) = a.step(
+            &fast(1000 + 20 * k),
+            Mode::Normal,
+            Some(&inputs(State::OperationEnabled, (980 + 20 * k) as i32)),
+        );
+        assert_eq!(o.target_position, (1000 + 20 * k) as i32);
+    }
+    // no data (a working counter not to be trusted): the command's target
+    // goes on out, the controlword stays
+    for k in 5..35 {
+        let (o, fb) = a.step(&fast(1000 + 20 * k), Mode::Normal, None);
+        assert_eq!(
+            (o.target_position, o.controlword),
+            ((1000 + 20 * k) as i32, 0x000F)
+        );
+        assert_ne!(fb.status_word & SW_NO_DATA, 0);
+    }
+    let (o, fb) = a.step(
+        &fast(1700),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1660)),
+    );
+    assert_eq!(o.target_position, 1700);
+    assert_eq!(fb.status_word & SW_FAULT, 0);
+    // lost for 30 cycles (its outputs frozen) while the command ran on,
+    // back still in Operation enabled: not 600 counts in one cycle — its
+    // actual position, the backend's fault, the bounded stop
+    for k in 1..=30 {
+        a.lost();
+        let (o, _) = a.step(&fast(1700 + 20 * k), Mode::Normal, None);
+        assert_eq!(o.target_position, 1700, "frozen while lost");
+    }
+    let (o, fb) = a.step(
+        &fast(2320),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1700)),
+    );
+    assert_eq!(o.target_position, 1700, "never 620 counts in one cycle");
+    assert_eq!(o.controlword, 0x0002, "quick stop");
+    assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
+    assert_eq!(a.counters.gap_stops, 1);
+    // a loss the engine rides out (up to its feedback timeout, 10 cycles
+    // here) is caught up: no fault
+    let mut a = logic();
+    a.step(
+        &fast(1000),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1000)),
+    );
+    for k in 1..=9 {
+        a.lost();
+        a.step(&fast(1000 + 20 * k), Mode::Normal, None);
+    }
+    let (o, fb) = a.step(
+        &fast(1200),
+        Mode::Normal,
+        Some(&inputs(State::OperationEnabled, 1000)),
+    );
+    assert_eq!((o.target_position, fb.status_word & SW_FAULT), (1200, 0));
 }
 
 #[test]

@@ -194,6 +194,7 @@ impl Backend for EthercatBackend {
         for (i, c) in cmd.axes[..self.names.len()].iter().enumerate() {
             words::put_command(&mut self.cmd_words, i, c);
         }
+        self.cmd_words[2] = cmd.header.sequence;
         self.mode = MODE_NORMAL;
         self.stop_from_cycle = None;
         self.publish();

@@ -8,15 +8,18 @@
 //!    background job meanwhile ([`crate::jobs`]: recovery of a SubDevice,
 //!    an SDO write);
 //! 2. take the newest commands from `motion-io` (seqlock, never blocks);
+//!    none new for twice motion-io's watchdog is the watchdog stop, run by
+//!    the bus thread itself ([`crate::cycle::watchdog_cycles`]);
 //! 3. write the outputs prepared last cycle into the process image, exchange
 //!    it (LRW + AL status of every SubDevice in one frame, + the DC time with
 //!    DC) with a deadline of `reply_timeout`;
 //! 4. per axis: data valid only if the frame came back, the SubDevice is in
-//!    OP and the working counter matches (a shortfall exactly explained by
-//!    SubDevices that did not answer their AL status read leaves the others
-//!    valid); [`crate::axis::AxisLogic`] turns command + inputs into the next
+//!    OP and the working counter matches (a shortfall explained by the
+//!    SubDevices out of OP — silent, or answering from SAFE-OP, PRE-OP —
+//!    leaves the others valid: `cycle::explained`);
+//!    [`crate::axis::AxisLogic`] turns command + inputs into the next
 //!    outputs and the feedback (`SW_NO_DATA` and the last values otherwise,
-//!    counted per cause);
+//!    counted per cause; a stop is sent without data too);
 //! 5. publish the feedback (seqlock).
 //!
 //! A lost SubDevice ([`crate::health`]) is brought back when it answers

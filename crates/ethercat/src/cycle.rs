@@ -18,6 +18,7 @@ use motion_rt::now_ns;
 use crate::axis::{AxisLogic, AxisSetup, Mode};
 use crate::capacity::MAX_SUBDEVICES;
 use crate::group::{Exchanged, OpGroup};
+use crate::handoff::HandOff;
 use crate::health::Devices;
 use crate::io::BusIo;
 use crate::jobs::{Done, Job};
@@ -25,8 +26,60 @@ use crate::objects::MODE_CSP;
 use crate::pdo::DriveOutputs;
 use crate::startup::AxisPlan;
 use crate::status::Shared;
-use crate::words::{self, FLAG_RUNNING, MODE_EMERGENCY, MODE_WATCHDOG_STOP};
+use crate::words::{self, FLAG_BUS_WATCHDOG, FLAG_RUNNING, MODE_EMERGENCY, MODE_WATCHDOG_STOP};
 use motion_frames::{SW_DRIVE_LOST, SW_ENABLED};
+
+/// The bound of the bus thread's own watchdog, in bus cycles it ran:
+/// twice motion-io's (`io_watchdog_cycles`, [`EthercatBus::watchdog_cycles`]),
+/// so motion-io's own watchdog — which says why in the log — acts first
+/// when the supervisor falls silent, and this one only when motion-io's
+/// main loop cannot (blocked, stalled, or gone without stopping). Counted
+/// in cycles the bus thread ran, not in time: a host that held both
+/// threads off the CPU is no silence of motion-io's (the bus thread, back
+/// first, would otherwise stop the drives before motion-io had its turn).
+/// With the defaults 100 cycles (100 ms, longer if cycles were late); the
+/// drives are then in Switch on disabled within that plus the bounded stop
+/// (`quick_stop_timeout_ms` + a brake's delay).
+pub fn watchdog_cycles(cfg: &EthercatBus) -> u64 {
+    2 * u64::from(cfg.watchdog_cycles.max(1))
+}
+
+/// A working counter `wkc` short of `expected` is explained by the
+/// SubDevices out of OP when the shortfall lies between what the silent
+/// ones (no answer to their AL status read: they counted nothing) and what
+/// all of them out of OP would have counted (`contrib`: 1 for inputs, 2 for
+/// outputs): one in SAFE-OP is read but may no longer take outputs (its
+/// application deactivated the output sync manager after an SM watchdog or
+/// an AL error), one in PRE-OP or INIT counts nothing. The SubDevices that
+/// report OP in the same frame (their AL status is read after the process
+/// data) are then taken to have processed theirs: an ESC in OP always does,
+/// and one whose application stopped taking data leaves OP (its SM
+/// watchdog), which the next frames show. Anything else — a shortfall only
+/// SubDevices in OP can have caused, a counter above the expected one —
+/// leaves no SubDevice's data trusted (a stop is still sent: see
+/// `AxisLogic::blind`).
+pub(crate) fn explained(
+    wkc: u16,
+    expected: u16,
+    contrib: &[u16],
+    state: impl Fn(usize) -> SubDeviceState,
+) -> bool {
+    let Some(short) = expected.checked_sub(wkc) else {
+        return false;
+    };
+    let (mut silent, mut out_of_op) = (0u16, 0u16);
+    for (i, c) in contrib.iter().enumerate() {
+        match state(i) {
+            SubDeviceState::Op => {}
+            SubDeviceState::None => {
+                silent += c;
+                out_of_op += c;
+            }
+            _ => out_of_op += c,
+        }
+    }
+    (silent..=out_of_op).contains(&short)
+}
 
 /// Per-cycle state of the bus.
 pub(crate) struct Engine {
@@ -40,8 +93,19 @@ pub(crate) struct Engine {
     expected_wkc: u16,
     cmd_words: Vec<u64>,
     fb_words: Vec<u64>,
+    /// The newest commands from motion-io, and this frame's (their targets
+    /// re-timed by the hand-off).
+    newest: Vec<AxisCommand>,
     cmds: Vec<AxisCommand>,
+    handoff: HandOff,
     mode: Mode,
+    /// The bus thread's own watchdog: the generation of the newest command
+    /// words, the bus cycles run since a new one came, the bound, whether
+    /// it stops the drives now.
+    generation: u64,
+    silent_cycles: u64,
+    watchdog_cycles: u64,
+    watchdog: bool,
     window_written: Vec<Option<u32>>,
     window_pending: Vec<bool>,
     /// The SubDevices: answering, in OP, lost, their recovery.
@@ -57,8 +121,8 @@ pub(crate) struct Engine {
 struct Validity {
     /// The frame came back in time.
     frame_ok: bool,
-    /// In OP with a working counter that matches (or whose shortfall is
-    /// exactly explained by SubDevices that did not answer).
+    /// In OP with a working counter that matches, or whose shortfall is
+    /// explained by the SubDevices out of OP (see [`explained`]).
     valid: [bool; MAX_SUBDEVICES],
     /// Not in OP (the cause counted when its data is missing).
     not_op: [bool; MAX_SUBDEVICES],
@@ -86,6 +150,9 @@ impl Engine {
                     quick_stop_ms: cfg.keys.quick_stop_timeout_ms,
                     brake_ms: a.ethercat.brake_delay_ms,
                     drive_homing: p.homing.is_some(),
+                    gap_cycles: (cfg.feedback_timeout_ms * 1e-3 / cycle_s)
+                        .ceil()
+                        .clamp(0.0, 1e6) as u32,
                 })
             })
             .collect();
@@ -117,8 +184,14 @@ impl Engine {
             contrib,
             cmd_words: vec![0; words::len(n)],
             fb_words: vec![0; words::len(n)],
+            newest: vec![AxisCommand::ZERO; n],
             cmds: vec![AxisCommand::ZERO; n],
+            handoff: HandOff::new(n, cycle_s),
             mode: Mode::Normal,
+            generation: 0,
+            silent_cycles: 0,
+            watchdog_cycles: watchdog_cycles(cfg),
+            watchdog: false,
             window_written,
             window_pending: vec![false; n],
             devices: Devices::new(count, &sd_of_axis),
@@ -136,25 +209,54 @@ impl Engine {
     }
 
     /// Takes the newest commands from `motion-io` (never blocks; a failed
-    /// read keeps the previous ones).
+    /// read keeps the previous ones), once per bus cycle, and applies the
+    /// bus thread's own watchdog: no new command for [`watchdog_cycles`]
+    /// bus cycles while they ask for normal operation (motion-io's main
+    /// loop blocked, or gone without stopping) is the watchdog stop, run
+    /// here without motion-io, until a new command comes.
     pub fn read_commands(&mut self) {
         if self.shared.commands.published() == 0 {
             return; // nothing from motion-io yet: disabled
         }
-        if !self.shared.commands.read(&mut self.cmd_words) {
+        if self.shared.commands.read(&mut self.cmd_words) {
+            self.mode = match self.cmd_words[1] {
+                MODE_WATCHDOG_STOP => Mode::WatchdogStop,
+                MODE_EMERGENCY => Mode::Emergency,
+                _ => Mode::Normal,
+            };
+            for (i, c) in self.newest.iter_mut().enumerate() {
+                *c = words::command(&self.cmd_words, i);
+            }
+            if self.cmd_words[0] != self.generation {
+                self.generation = self.cmd_words[0];
+                self.silent_cycles = 0;
+            }
+        } else {
+            // keep the previous commands
             self.shared
                 .command_read_failures
                 .fetch_add(1, Ordering::Relaxed);
-            return; // keep the previous commands
         }
-        self.mode = match self.cmd_words[1] {
-            MODE_WATCHDOG_STOP => Mode::WatchdogStop,
-            MODE_EMERGENCY => Mode::Emergency,
-            _ => Mode::Normal,
-        };
-        for (i, c) in self.cmds.iter_mut().enumerate() {
-            *c = words::command(&self.cmd_words, i);
+        self.silent_cycles += 1;
+        let trips = self.silent_cycles > self.watchdog_cycles && self.mode == Mode::Normal;
+        if trips && !self.watchdog {
+            self.shared
+                .bus_watchdog_trips
+                .fetch_add(1, Ordering::Relaxed);
         }
+        self.watchdog = trips;
+        if trips {
+            self.mode = Mode::WatchdogStop;
+        }
+        self.cmds.copy_from_slice(&self.newest);
+        if self.mode == Mode::Normal {
+            self.handoff.frame(self.cmd_words[2], &mut self.cmds);
+        } else {
+            self.handoff.reset();
+        }
+        self.shared
+            .handoff_corrections
+            .store(self.handoff.corrections, Ordering::Relaxed);
     }
 
     /// One exchange; returns the DC wait to the next cycle, if any.
@@ -187,7 +289,7 @@ impl Engine {
         let rest_mask = self.step_axes(&validity, group, md);
         self.fb_words[0] = self.cycle;
         self.fb_words[1] = done;
-        self.fb_words[2] = FLAG_RUNNING;
+        self.fb_words[2] = FLAG_RUNNING | if self.watchdog { FLAG_BUS_WATCHDOG } else { 0 };
         self.fb_words[3] = rest_mask;
         self.shared.feedback.write(&self.fb_words);
         self.shared.cycles.store(self.cycle, Ordering::Relaxed);
@@ -223,19 +325,15 @@ impl Engine {
         sh.record_roundtrip(done.saturating_sub(start));
         let count = self.contrib.len();
         let state = |i: usize| ex.states.get(i).copied().unwrap_or(SubDeviceState::None);
-        let silent: u16 = (0..count)
-            .filter(|&i| state(i) == SubDeviceState::None)
-            .map(|i| self.contrib[i])
-            .sum();
         let all_ok = ex.wkc == self.expected_wkc;
-        let explained = !all_ok && self.expected_wkc.checked_sub(ex.wkc) == Some(silent);
+        let trusted = all_ok || explained(ex.wkc, self.expected_wkc, &self.contrib, state);
         if !all_ok && self.counting {
             sh.wkc_errors.fetch_add(1, Ordering::Relaxed);
         }
         for i in 0..count {
             let op = state(i) == SubDeviceState::Op;
             v.not_op[i] = !op;
-            v.valid[i] = op && (all_ok || explained);
+            v.valid[i] = op && trusted;
             self.devices.observe(i, state(i), done);
         }
         self.devices.update(sh, self.counting);
@@ -282,9 +380,11 @@ impl Engine {
             } else if self.axes[k].at_rest_and_disabled() {
                 rest_mask |= 1 << k;
             }
-            sh.axis[k]
-                .rejected
-                .store(self.axes[k].counters.rejected_setpoints, Ordering::Relaxed);
+            let (a, c) = (&sh.axis[k], &self.axes[k].counters);
+            a.rejected.store(c.rejected_setpoints, Ordering::Relaxed);
+            a.gap_stops.store(c.gap_stops, Ordering::Relaxed);
+            a.blind_stop_cycles
+                .store(c.blind_stop_cycles, Ordering::Relaxed);
             words::put_feedback(&mut self.fb_words, k, &fb);
         }
         rest_mask
@@ -328,5 +428,33 @@ impl Engine {
             }
             (job, r) => self.devices.job_done(sh, job, r.and_then(Result::ok)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use SubDeviceState::{None as Silent, Op, PreOp, SafeOp};
+
+    #[test]
+    fn a_shortfall_is_explained_only_by_the_subdevices_out_of_op() {
+        let contrib = [3, 3, 3];
+        let at = |states: [SubDeviceState; 3]| move |i: usize| states[i];
+        // one in SAFE-OP read but not written (1 of 3), or counted fully
+        assert!(explained(7, 9, &contrib, at([Op, SafeOp, Op])));
+        assert!(explained(9, 9, &contrib, at([Op, SafeOp, Op])));
+        // one in PRE-OP: nothing counted
+        assert!(explained(6, 9, &contrib, at([Op, Op, PreOp])));
+        // a silent one counted nothing: less short than that is not it
+        assert!(explained(6, 9, &contrib, at([Op, Silent, Op])));
+        assert!(!explained(7, 9, &contrib, at([Op, Silent, Op])));
+        // a silent one and one in SAFE-OP: 3 to 6 short
+        assert!(explained(4, 9, &contrib, at([Silent, SafeOp, Op])));
+        assert!(explained(3, 9, &contrib, at([Silent, SafeOp, Op])));
+        assert!(!explained(2, 9, &contrib, at([Silent, SafeOp, Op])));
+        // all in OP: a shortfall is nobody's in particular
+        assert!(!explained(6, 9, &contrib, at([Op, Op, Op])));
+        // more than expected: not trusted
+        assert!(!explained(10, 9, &contrib, at([Op, SafeOp, Op])));
     }
 }

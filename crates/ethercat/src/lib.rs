@@ -16,7 +16,8 @@
 //!   ([`dictionary`] read, [`wants`] checked, [`mapping`] settled, CSP,
 //!   homing parameters, sync); [`objects`] — the objects, named once;
 //!   [`report`] — what start-up found or why it failed.
-//! * [`bus`] — the bus thread; [`cycle`] — one bus cycle; [`health`] — who
+//! * [`bus`] — the bus thread; [`cycle`] — one bus cycle; [`handoff`] —
+//!   which of the supervisor's commands each frame carries; [`health`] — who
 //!   answers, who is lost; [`jobs`] — recovery, [`reconfigure`] (a
 //!   power-cycled drive) and SDO writes between cycles; [`group`] — the
 //!   SubDevice group in OP.
@@ -36,6 +37,7 @@ pub mod dictionary;
 pub mod drive_homing;
 pub mod drive_setup;
 pub mod group;
+pub mod handoff;
 pub mod health;
 pub mod io;
 pub mod jobs;

@@ -80,6 +80,8 @@ pub(crate) struct AxisAtomics {
     pub stale: AtomicU64,
     pub rejected: AtomicU64,
     pub window_writes: AtomicU64,
+    pub gap_stops: AtomicU64,
+    pub blind_stop_cycles: AtomicU64,
 }
 
 pub(crate) struct Shared {
@@ -100,6 +102,11 @@ pub(crate) struct Shared {
     pub frames_received: AtomicU64,
     pub window_write_failures: AtomicU64,
     pub needs_restart: AtomicU64,
+    /// Times the bus thread's own watchdog stopped the drives.
+    pub bus_watchdog_trips: AtomicU64,
+    /// Frames whose command had to be other than the next in the
+    /// supervisor's sequence ([`crate::handoff`]).
+    pub handoff_corrections: AtomicU64,
     /// Per bus position: the health of the SubDevices that drive axes.
     pub sd: Vec<SdAtomics>,
     /// Bumped on every change of a SubDevice's health (the log's cue).
@@ -134,6 +141,8 @@ impl Shared {
                     stale: AtomicU64::new(0),
                     rejected: AtomicU64::new(0),
                     window_writes: AtomicU64::new(0),
+                    gap_stops: AtomicU64::new(0),
+                    blind_stop_cycles: AtomicU64::new(0),
                 })
                 .collect(),
             cycles: AtomicU64::new(0),
@@ -148,6 +157,8 @@ impl Shared {
             frames_received: AtomicU64::new(0),
             window_write_failures: AtomicU64::new(0),
             needs_restart: AtomicU64::new(0),
+            bus_watchdog_trips: AtomicU64::new(0),
+            handoff_corrections: AtomicU64::new(0),
             sd: (0..MAX_SUBDEVICES)
                 .map(|_| SdAtomics {
                     health: AtomicU8::new(0),
@@ -216,6 +227,8 @@ impl Shared {
             recoveries: l(&self.recoveries),
             recovery_failures: l(&self.recovery_failures),
             needs_restart: l(&self.needs_restart),
+            bus_watchdog_trips: l(&self.bus_watchdog_trips),
+            handoff_corrections: l(&self.handoff_corrections),
             losses: self.sd.iter().map(|s| l(&s.losses)).sum(),
             returns: self.sd.iter().map(|s| l(&s.returns)).sum(),
             reconfigured: self.sd.iter().map(|s| l(&s.reconfigured)).sum(),
@@ -236,6 +249,8 @@ impl Shared {
                     no_data_stale: l(&a.stale),
                     rejected_setpoints: l(&a.rejected),
                     following_window_writes: l(&a.window_writes),
+                    gap_stops: l(&a.gap_stops),
+                    blind_stop_cycles: l(&a.blind_stop_cycles),
                 })
                 .collect(),
         }
@@ -307,6 +322,12 @@ pub struct AxisStatus {
     pub rejected_setpoints: u64,
     /// SDO writes of 0x6065 (following error window) done.
     pub following_window_writes: u64,
+    /// Its data came back after a loss over which the command ran away:
+    /// the drive was stopped where it stood (the backend's fault), never
+    /// jumped.
+    pub gap_stops: u64,
+    /// Cycles a stop was sent to its drive without its data.
+    pub blind_stop_cycles: u64,
 }
 
 /// Round-trip statistics of the cyclic exchange (frame out → data back), µs.
@@ -348,6 +369,13 @@ pub struct BusStatus {
     /// SubDevices given up on (re-configuring them failed): only a restart
     /// of the backend brings them back.
     pub needs_restart: u64,
+    /// Times the bus thread's own watchdog stopped the drives (no command
+    /// from motion-io within its bound).
+    pub bus_watchdog_trips: u64,
+    /// Frames that could not carry the command following the previous
+    /// frame's in the supervisor's sequence (the clocks a cycle apart, or
+    /// a stall): their target stepped by 0 or two cycles' travel.
+    pub handoff_corrections: u64,
     /// Losses of SubDevices that drive axes (not answering, out of OP),
     /// returns to OP, and re-configurations after a power cycle.
     pub losses: u64,

@@ -24,6 +24,11 @@
 //!   disable voltage. The drive's own brake control does the closing; the
 //!   backend only makes sure the power stage outlives it.
 //!
+//! * **Without data** ([`Stopper::step_blind`]: a frame lost, a working
+//!   counter that cannot be trusted) the stop goes on, judged on time
+//!   alone: quick stop until the bound, then (the brake, and) disable
+//!   voltage. Nothing is concluded from a cycle not seen.
+//!
 //! The worst case from the first cycle of a stop to "disable voltage" sent
 //! is `quick_stop_timeout_ms` + `brake_delay_ms` (+ one cycle); a drive that
 //! answers takes a few cycles more to report Switch on disabled. With the
@@ -100,6 +105,12 @@ impl Stopper {
         self.ended
     }
 
+    /// A stop of a drive that was enabled (or in Quick stop active) when it
+    /// began is in progress or done, not yet reset.
+    pub fn stopping(&self) -> bool {
+        self.phase != Phase::Idle && self.ended != Some(Ended::NotEnabled)
+    }
+
     /// No stop wanted (any more): the next one starts from the beginning.
     pub fn reset(&mut self) {
         self.phase = Phase::Idle;
@@ -119,6 +130,20 @@ impl Stopper {
     /// One cycle of the stop: the drive's `state`, whether it is at rest;
     /// returns where the CiA 402 machine walks it.
     pub fn step(&mut self, state: State, at_rest: bool) -> Target {
+        self.advance(state, at_rest, true)
+    }
+
+    /// One cycle of the stop without this cycle's data (`state`: the last
+    /// one seen): the outputs still reach a drive whose data is missing
+    /// (a working counter that cannot be trusted, a lost frame), but
+    /// nothing can be concluded from it — not that it acknowledged, left
+    /// or ignored the quick stop, nor that it is at rest. Only the bound
+    /// ends the quick stop then; the brake's delay counts as it does.
+    pub fn step_blind(&mut self, state: State) -> Target {
+        self.advance(state, false, false)
+    }
+
+    fn advance(&mut self, state: State, at_rest: bool, seen: bool) -> Target {
         if self.phase == Phase::Idle {
             self.phase = if state.is_enabled() || state == State::QuickStopActive {
                 Phase::QuickStop {
@@ -132,8 +157,10 @@ impl Stopper {
         }
         match self.phase {
             Phase::QuickStop { cycles, acked } => {
-                let acked = acked || !state.is_enabled();
-                let end = if state == State::QuickStopActive && at_rest {
+                let acked = acked || (seen && !state.is_enabled());
+                let end = if !seen {
+                    (cycles >= self.bound).then_some(Ended::BoundPassed)
+                } else if state == State::QuickStopActive && at_rest {
                     Some(Ended::AtRest)
                 } else if acked && state != State::QuickStopActive {
                     Some(Ended::LeftQuickStop)
@@ -265,6 +292,42 @@ mod tests {
         let k = QS_ACK_CYCLES as usize;
         assert_eq!(&t[k..k + 5], &[Target::DisableOperation; 5]);
         assert_eq!(t[k + 5], Target::Off);
+    }
+
+    #[test]
+    fn without_data_only_the_bound_ends_the_quick_stop() {
+        // 20 ms at 1 ms: a drive whose data is missing is told quick stop
+        // until the bound, never judged as ignoring it, then disable voltage
+        let mut s = Stopper::new(0.001, 20, 0);
+        let t: Vec<Target> = (0..22).map(|_| s.step_blind(OperationEnabled)).collect();
+        assert!(t[..20].iter().all(|t| *t == Target::QuickStop), "{t:?}");
+        assert_eq!(t[20], Target::Off);
+        assert_eq!(s.ended(), Some(Ended::BoundPassed));
+        // data again in the middle: judged from there on (it still shows
+        // Operation enabled after QS_ACK_CYCLES counted in all: ignored)
+        let mut s = Stopper::new(0.001, 500, 0);
+        for _ in 0..5 {
+            assert_eq!(s.step_blind(OperationEnabled), Target::QuickStop);
+        }
+        let t = run(&mut s, &[OperationEnabled], 1000, 10);
+        let first_off = t.iter().position(|t| *t == Target::Off).unwrap();
+        assert_eq!(first_off as u32, QS_ACK_CYCLES - 5);
+        assert_eq!(s.ended(), Some(Ended::Ignored));
+        // a brake still gets its delay
+        let mut s = Stopper::new(0.001, 3, 2);
+        let t: Vec<Target> = (0..7).map(|_| s.step_blind(QuickStopActive)).collect();
+        assert_eq!(
+            t,
+            [
+                Target::QuickStop,
+                Target::QuickStop,
+                Target::QuickStop,
+                Target::DisableOperation,
+                Target::DisableOperation,
+                Target::Off,
+                Target::Off
+            ]
+        );
     }
 
     #[test]

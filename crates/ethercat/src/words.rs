@@ -9,7 +9,7 @@ pub(crate) const HEADER_WORDS: usize = 4;
 /// Words per axis (an `AxisCommand` / `AxisFeedback`, 48 bytes).
 pub(crate) const AXIS_WORDS: usize = 6;
 
-/// Commands header: `[generation, mode, 0, 0]`.
+/// Commands header: `[generation, mode, the command frame's sequence, 0]`.
 pub(crate) const MODE_NORMAL: u64 = 0;
 pub(crate) const MODE_WATCHDOG_STOP: u64 = 1;
 pub(crate) const MODE_EMERGENCY: u64 = 2;
@@ -17,6 +17,9 @@ pub(crate) const MODE_EMERGENCY: u64 = 2;
 /// Feedback header: `[bus cycle, CLOCK_MONOTONIC ns of the exchange,
 /// flags, at-rest mask]`.
 pub(crate) const FLAG_RUNNING: u64 = 1;
+/// The bus thread's own watchdog stops the drives (no command within its
+/// bound).
+pub(crate) const FLAG_BUS_WATCHDOG: u64 = 2;
 
 const _: () = {
     assert!(size_of::<AxisCommand>() == AXIS_WORDS * 8);

@@ -1,16 +1,17 @@
 //! The daemon (`motion-supervisor run`): starting it, knowing when it is
 //! ready — its session is there and `motionctl status --json`, read as the
 //! typed [`StatusReport`], shows its I/O processes attached — reading its
-//! status, and stopping it (SIGTERM, its report collected).
+//! status, and stopping it (SIGTERM, its report collected). [`wait_ready`]
+//! and [`status`] serve any daemon the caller started (the benches start
+//! theirs with their own binaries); [`Daemon`] is a test's.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use motion_report::{AxisStatus, StatusReport};
-use nix::sys::signal::Signal;
 
-use crate::bins::{test_bin, Binaries};
+use crate::bins::test_bin;
 use crate::check::named;
 use crate::commands::{ctl, spawn_supervisor};
 use crate::machines::TempConfig;
@@ -81,82 +82,19 @@ pub fn wait_ready(
     }
 }
 
-/// [`wait_ready`] with every I/O process attached (the benches).
-pub fn wait_until_ready(
-    motionctl: &Path,
-    prefix: &str,
-    sup: &mut Running,
-    timeout: Duration,
-) -> Result<(), String> {
-    wait_ready(motionctl, prefix, sup, Attached::All, timeout).map(|_| ())
-}
-
-/// `motion-supervisor run --config CFG --json --service-prefix P`: a
-/// bench's daemon, to which it adds what it measures (`--duration`,
-/// `--hlog`, ...).
-pub fn run_command(b: &Binaries, cfg: &Path, prefix: &str) -> Command {
-    let mut cmd = Command::new(&b.supervisor);
-    cmd.arg("run").arg("--config").arg(cfg);
-    cmd.args(["--json", "--service-prefix", prefix]);
-    cmd
-}
-
-/// [`run_command`] started and ready within `timeout` (every I/O process
-/// attached); else stopped, and the error says how it ended with the end of
-/// its stderr.
-pub fn start_run(
-    b: &Binaries,
-    cfg: &Path,
-    prefix: &str,
-    timeout: Duration,
-) -> Result<Running, String> {
-    let mut run = Running::spawn(
-        &mut run_command(b, cfg, prefix),
-        "motion-supervisor run",
-        true,
-        false,
-    )?;
-    match wait_until_ready(&b.motionctl, prefix, &mut run, timeout) {
-        Ok(()) => Ok(run),
-        Err(e) => {
-            let ended = stop_run(run, Duration::from_secs(20));
-            let tail = crate::process::tail(&ended.stderr, 5);
-            Err(format!("{e} ({}; {tail})", ended.describe()))
-        }
-    }
-}
-
-/// The machine `toml` written as `dir/PREFIX.toml`; its path.
-pub fn write_config(dir: &Path, prefix: &str, toml: &str) -> Result<PathBuf, String> {
-    let cfg = dir.join(format!("{prefix}.toml"));
-    std::fs::write(&cfg, toml).map_err(|e| format!("{}: {e}", cfg.display()))?;
-    Ok(cfg)
-}
-
-/// The machine `toml` written to `dir` ([`write_config`]) and [`start_run`]
-/// of it under `prefix` (ready within 20 s); an error names the prefix.
-pub fn start_machine(
-    b: &Binaries,
-    dir: &Path,
-    prefix: &str,
-    toml: &str,
-) -> Result<Running, String> {
-    let cfg = write_config(dir, prefix, toml)?;
-    start_run(b, &cfg, prefix, Duration::from_secs(20)).map_err(|e| format!("{prefix}: {e}"))
-}
-
-/// Asks a running supervisor to stop (SIGTERM) and collects its output.
-pub fn stop_run(r: Running, timeout: Duration) -> Ended {
-    r.signal(Signal::SIGTERM);
-    r.wait(timeout, Duration::from_secs(5))
-}
+/// What the daemon logs when its cycle monitor stops an axis.
+pub const MONITOR_TRIPPED: &str = "the cycle monitor tripped";
 
 /// A test's daemon: `motion-supervisor run --config CFG`, stopped with
-/// SIGTERM when dropped (a failed test leaves no daemon behind).
+/// SIGTERM when dropped (a failed test leaves no daemon behind). Its end
+/// (stop or drop) fails the test if the cycle monitor stopped an axis —
+/// it never trips in normal operation — unless the test expects it
+/// ([`Daemon::allow_monitor_trips`]).
 pub struct Daemon {
     running: Option<Running>,
     pub prefix: String,
     motionctl: PathBuf,
+    monitor_trips_allowed: bool,
 }
 
 impl Daemon {
@@ -166,7 +104,14 @@ impl Daemon {
             running: Some(spawn_supervisor(&["run", "--config", cfg.arg()])),
             prefix: cfg.prefix.clone(),
             motionctl: test_bin("motionctl"),
+            monitor_trips_allowed: false,
         }
+    }
+
+    /// The test provokes what the cycle monitor must stop: its trips do
+    /// not fail the test.
+    pub fn allow_monitor_trips(&mut self) {
+        self.monitor_trips_allowed = true;
     }
 
     /// Starts the daemon and waits (20 s at most) until it answers with the
@@ -233,15 +178,33 @@ impl Daemon {
 
     /// SIGTERM and the daemon's exit (external I/O processes may still hold
     /// the domain: check it with `assert_clean` once they are gone too).
+    #[track_caller]
     pub fn stop(mut self) -> Ended {
-        self.running.take().expect("running").stop()
+        let ended = self.running.take().expect("running").stop();
+        no_trip(self.monitor_trips_allowed, &ended.stderr);
+        ended
+    }
+}
+
+/// Panics when the daemon's log shows a trip of its cycle monitor and none
+/// was allowed.
+#[track_caller]
+fn no_trip(allowed: bool, stderr: &str) {
+    if let Some(line) = stderr.lines().find(|l| l.contains(MONITOR_TRIPPED)) {
+        assert!(
+            allowed,
+            "the cycle monitor tripped in this test: {line}\n{stderr}"
+        );
     }
 }
 
 impl Drop for Daemon {
     fn drop(&mut self) {
         if let Some(r) = self.running.take() {
-            let _ = r.stop();
+            let ended = r.stop();
+            if !std::thread::panicking() {
+                no_trip(self.monitor_trips_allowed, &ended.stderr);
+            }
         }
     }
 }

@@ -23,21 +23,6 @@ pub fn leftovers(prefix: &str) -> Vec<String> {
     v
 }
 
-/// What a prefix left behind once all its processes ended, and what of it
-/// remains after `cleanup_stale_domains` (which touches only domains without
-/// a live node). A client (`motionctl`) whose node exists while the
-/// supervisor runs its final clean-up keeps the domain's node-counter
-/// segment alive, and motionctl does not clean up after itself: that
-/// segment is what is usually found here.
-pub fn clean_leftovers(prefix: &str) -> (Vec<String>, Vec<String>) {
-    let found = leftovers(prefix);
-    if found.is_empty() {
-        return (found, Vec::new());
-    }
-    cleanup_stale_domains(prefix, &default_runtime_dir());
-    (found, leftovers(prefix))
-}
-
 /// Asserts that the processes of `prefix` left nothing in `/dev/shm`
 /// (waits up to 3 s: a process may still be cleaning up when its parent has
 /// already returned). Cleans nothing itself.

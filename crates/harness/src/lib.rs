@@ -1,36 +1,25 @@
-//! `motion-harness`: the one test harness of the workspace, for the
-//! end-to-end tests (`tests/`), `motion-io`'s tests (`crates/io/tests`) and
-//! the benches (`bench/`). Dev-only: never a dependency of a product crate.
+//! `motion-harness`: the test harness of the workspace, for the end-to-end
+//! tests (`tests/`), `motion-io`'s tests (`crates/io/tests`) and any other
+//! test that runs the binaries. Dev-only: never a dependency of a product
+//! crate. The benches (`bench/`) build on it — their children, readiness
+//! and leftover checks are these — but what only they need is theirs
+//! (`motion-bench`'s library); nothing here knows about a bench.
 //!
 //! * [`process`] — a child with captured output, stderr lines as they come,
-//!   bounded waits, signals and a guaranteed end (also on drop); the
-//!   benches' SIGINT/SIGTERM flag.
-//! * [`bins`] — where `motion-supervisor`, `motion-io` and `motionctl` are;
-//!   [`commands`] runs them as a test does.
+//!   bounded waits, signals and a guaranteed end (also on drop).
+//! * [`bins`] — where `motion-supervisor`, `motion-io` and `motionctl` are
+//!   for a test; [`commands`] runs them as a test does.
 //! * [`daemon`] — `motion-supervisor run`: ready when `status --json`, read
-//!   as the typed report, shows its I/O attached; started and ready in one
-//!   call (the benches); status; stop.
+//!   as the typed report, shows its I/O attached; status; stop.
 //! * [`machines`] — the fixture machines (`tests/machines/*.toml`) with
-//!   stated overrides, written as a test's temporary config;
-//!   [`generated`] — the machines the benches generate.
+//!   stated overrides, written as a test's temporary config.
 //! * [`leftovers`] — what a prefix left in `/dev/shm`, and the checks;
 //!   [`temp`] — a test's scratch directory.
 //! * [`check`] — rows by name, positions within a tolerance, homed axes.
 //! * [`peer`] — the supervisor's side of a `motion-io`, played by a test.
-//! * [`homing`] — homing runs, their tally, homings repeated while a
-//!   daemon is measured, a traced homing (the benches); [`runs`] — a
-//!   timed daemon run and what it measured, read back (the slice benches),
-//!   [`slices`] those of one variant merged;
-//!   [`clients`] — a deployed machine's motionctl clients as a load.
-//! * [`procs`] — processes found in `/proc`; stress-ng.
-//! * [`spy`] — the frame spy on one I/O process's topics; [`bare`] — plain
-//!   iceoryx2 ports of the frames' sizes and their echo (the IPC bench's floor).
-//! * [`cyclictest`] — the jitter bench's reference: its command and histogram.
-//! * [`stream`] — a streaming program: axes homed and enabled, a thread
-//!   publishing setpoints at the stream's rate.
-//! * [`ecat`] — the EtherCAT veth rig with emulated drives.
-//! * [`engine`] — engine states reached by real homing against the plants
-//!   (the engine bench's inputs).
+//! * [`procs`] — processes found in `/proc`.
+//! * [`ecat`] — the EtherCAT veth rig with emulated drives;
+//!   [`placement`] — where its emulator's thread runs.
 //!
 //! Invariants: every process it starts ends (SIGTERM, then SIGKILL) when
 //! its handle goes, also when a test panics; every test config has a
@@ -39,27 +28,17 @@
 //! read through `motion-report`'s typed structs, the same definitions the
 //! binaries write.
 
-pub mod bare;
 pub mod bins;
 pub mod check;
-pub mod clients;
 pub mod commands;
-pub mod cyclictest;
 pub mod daemon;
 pub mod ecat;
-pub mod engine;
-pub mod generated;
-pub mod homing;
 pub mod leftovers;
 pub mod machines;
 pub mod peer;
 pub mod placement;
 pub mod process;
 pub mod procs;
-pub mod runs;
-pub mod slices;
-pub mod spy;
-pub mod stream;
 pub mod temp;
 
 use std::sync::atomic::{AtomicU32, Ordering};

@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use motion_config::MachineConfig;
 use toml::{Table, Value};
 
 use crate::unique_prefix;
@@ -204,6 +205,19 @@ impl Machine {
                 .unwrap_or_else(|| panic!("{path}: {part} is not a table"));
         }
         (table, key)
+    }
+}
+
+/// `text` with the machine it parses to, or every problem in one line (a
+/// machine generated as text: the EtherCAT rig's, the benches').
+pub fn checked(text: String) -> Result<(String, MachineConfig), String> {
+    match motion_config::parse(&text) {
+        Ok(m) => Ok((text, m)),
+        Err(problems) => Err(problems
+            .iter()
+            .map(|p| p.to_string())
+            .collect::<Vec<_>>()
+            .join("; ")),
     }
 }
 

@@ -1,6 +1,7 @@
-//! Where the harness's and the benches' own threads run (the frame spy,
-//! the emulated EtherCAT drives, the IPC bench's measuring thread): pinned to a CPU, SCHED_FIFO when a priority is given,
-//! memory locked — through `motion-rt`, as the supervisor sets up its cycle.
+//! Where a thread of the test process runs (the emulated EtherCAT drives;
+//! the benches' spy, streaming program and measuring threads): pinned to a
+//! CPU, SCHED_FIFO when a priority is given, memory locked — through
+//! `motion-rt`, as the supervisor sets up its cycle.
 
 /// Pins the calling thread to `cpu` (if given), SCHED_FIFO at `priority`
 /// (if given), memory locked. Returns what the OS refused, as warnings.

@@ -6,9 +6,9 @@
 //! reaped — also when the handle is dropped, so a failed test or an
 //! interrupted bench leaves no process behind.
 //!
-//! A bench's own SIGINT/SIGTERM is `motion-rt`'s termination handler (one
-//! handler for every binary of the workspace): it only records the signal;
-//! [`Running::wait`] sees it and ends the child.
+//! A process that installed `motion-rt`'s termination handler (a bench:
+//! one handler for every binary of the workspace) has its SIGINT/SIGTERM
+//! recorded; [`Running::wait`] sees it and ends the child.
 
 use std::io::{BufRead, BufReader, Read};
 use std::os::unix::process::{CommandExt, ExitStatusExt};
@@ -20,21 +20,10 @@ use std::time::{Duration, Instant};
 use nix::sys::signal::Signal;
 use nix::unistd::Pid;
 
-/// Installs the SIGINT/SIGTERM handler (a bench calls this first).
-pub fn install_stop_handler() {
-    if let Err(e) = motion_rt::termination::install() {
-        eprintln!("warning: {e}");
-    }
-}
-
-/// A SIGINT or SIGTERM arrived.
+/// A SIGINT or SIGTERM arrived (seen only where `motion-rt`'s termination
+/// handler is installed).
 pub fn stop_requested() -> bool {
     motion_rt::termination::received().is_some()
-}
-
-/// The signal that arrived (0: none).
-pub fn stop_signal() -> i32 {
-    motion_rt::termination::received().unwrap_or(0)
 }
 
 /// The last `n` lines of `s` (a child's output), joined with " | ".

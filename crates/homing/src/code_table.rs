@@ -815,6 +815,39 @@ pub const TABLE: &[Code] = &[
          connection): the jog stopped normally, ER stays clear.",
     )
     .remedy("Nothing, if the client ended; otherwise check the client and its link."),
+    code(ERR_MONITOR, EX_MONITOR_VELOCITY, &[F], "cycle monitor: commanded velocity above its bound")
+        .ours()
+        .cause("The independent cycle monitor found a command's velocity above the speed bound that applies (the cap: `max_speed`, `unhomed_speed` while not homed, the operation's own speed, the homing speeds; after a stop, the bound decaying at the stop's deceleration). The monitor stopped the axis itself: category 1 from the last command it passed, then the power stage off.")
+        .remedy("A defect in whatever planned that command: keep the log line (it has the values) and report it; `reset` to continue."),
+    code(ERR_MONITOR, EX_MONITOR_ACCELERATION, &[F], "cycle monitor: commanded acceleration above its bound")
+        .ours()
+        .cause("The second difference of the commanded positions over the cycle exceeded the acceleration bound (the operation's acceleration or deceleration, `stream_acceleration`, the homing accelerations; a stop at least `max_deceleration`).")
+        .remedy("As for 1021 / 1: keep the log line, report it; `reset`."),
+    code(ERR_MONITOR, EX_MONITOR_STEP, &[F], "cycle monitor: a set-point step larger than the speed bound allows")
+        .ours()
+        .cause("Two consecutive command positions lay further apart than the speed bound allows over the time between them.")
+        .remedy("As for 1021 / 1: keep the log line, report it; `reset`."),
+    code(ERR_MONITOR, EX_MONITOR_SOFT_LIMIT, &[F], "cycle monitor: commanded position beyond a travel limit")
+        .ours()
+        .cause("A homed linear axis was commanded outside `travel_limits`, or further out than the command before it once outside.")
+        .remedy("Move back inside the limits after `reset`; report the planner's defect with the log line."),
+    code(ERR_MONITOR, EX_MONITOR_ENABLE, &[F], "cycle monitor: the power stage asked on without a request")
+        .ours()
+        .cause("The power stage was asked on after a drive fault, a dropped power stage, a lost drive, a new I/O process, a shutdown, or a disable that had come to rest, without an explicit enable, home, jog, move or stream since.")
+        .remedy("`reset`, then `enable` explicitly; report the defect with the log line."),
+    code(ERR_MONITOR, EX_MONITOR_GANTRY, &[F], "cycle monitor: the gantry's sides moved apart")
+        .ours()
+        .cause("The sides of a gantry moved apart by more than `max_skew` from where they were at rest together.")
+        .remedy("Inspect the mechanics; `reset`, and home the gantry again if the skew is real."),
+    code(ERR_MONITOR, EX_MONITOR_NOT_FINITE, &[F], "cycle monitor: a command that is not a number")
+        .ours()
+        .cause("A command position or velocity was not finite: the monitor stopped the axis from the last command it passed (category 1; category 0 where the power stage was already off).")
+        .remedy("Report the defect with the log line; `reset`."),
+    code(ERR_MONITOR, 0, &[F], "cycle monitor: a command broke an invariant")
+        .any()
+        .ours()
+        .cause("The cycle monitor stopped the axis: a command broke one of its invariants.")
+        .remedy("See the EXERR's row; `reset`."),
     code(
         ERR_GEARING,
         EX_GEAR_SOFT_LIMIT,

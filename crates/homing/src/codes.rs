@@ -133,6 +133,18 @@ pub const EX_LIMIT_OFFSET: u16 = 36;
 pub const EX_REVERSE_NOT_APPLICABLE: u16 = 37;
 pub const EX_NO_LIMIT_SWITCHES: u16 = 38;
 
+/// The cycle monitor stopped the axis: a command broke one of its
+/// invariants (ours). EXERR: `EX_MONITOR_*`.
+pub const ERR_MONITOR: u16 = 1021;
+
+// EXERR under ERR 1021: the invariant the cycle monitor found broken.
+pub const EX_MONITOR_VELOCITY: u16 = 1;
+pub const EX_MONITOR_ACCELERATION: u16 = 2;
+pub const EX_MONITOR_STEP: u16 = 3;
+pub const EX_MONITOR_SOFT_LIMIT: u16 = 4;
+pub const EX_MONITOR_ENABLE: u16 = 5;
+pub const EX_MONITOR_GANTRY: u16 = 6;
+pub const EX_MONITOR_NOT_FINITE: u16 = 7;
 // --- gearing (MAG) -------------------------------------------------------
 
 /// Gearing (ours): a geared slave stopped with an error, or a gear refused

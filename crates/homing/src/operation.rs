@@ -668,9 +668,12 @@ pub enum StopCause {
     Released = 9,
     /// `Request::shutdown`: the power stage was switched off at once.
     Shutdown = 10,
+    /// The cycle monitor stopped the axis (ER 1021 / x): a command broke
+    /// one of its invariants.
+    Monitor = 11,
     /// Gearing stopped the slave with an error (ER 1025: a travel limit
     /// ahead, a master it cannot follow, the master's fault).
-    Gearing = 11,
+    Gearing = 12,
 }
 
 crate::spellings!(StopCause {
@@ -685,6 +688,7 @@ crate::spellings!(StopCause {
     Disable => "disable",
     Released => "released",
     Shutdown => "shutdown",
+    Monitor => "monitor",
     Gearing => "gearing",
 });
 

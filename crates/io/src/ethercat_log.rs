@@ -60,8 +60,10 @@ pub fn summary(interface: &str, st: &BusStatus) -> String {
     format!(
         "EtherCAT on {interface}: {} bus cycles, {} lost frame(s), {} late, {} working-counter \
          error(s), {} overrun(s), {} recovery(ies), {} drive loss(es), {} back in OP, {} \
-         re-configured after a power cycle, {} SubDevice(s) needing a restart; bus round trip \
-         (frame out → inputs back): {}",
+         re-configured after a power cycle, {} SubDevice(s) needing a restart, {} stop(s) by \
+         the bus thread's own watchdog, {} drive(s) stopped after a loss over which their \
+         command ran away, {} frame(s) moved off the supervisor's sequence (the clocks a cycle \
+         apart, or a stall); bus round trip (frame out → inputs back): {}",
         st.cycles,
         st.lost_frames,
         st.late_frames,
@@ -72,6 +74,9 @@ pub fn summary(interface: &str, st: &BusStatus) -> String {
         st.returns,
         st.reconfigured,
         st.needs_restart,
+        st.bus_watchdog_trips,
+        st.axes.iter().map(|a| a.gap_stops).sum::<u64>(),
+        st.handoff_corrections,
         st.roundtrip
     )
 }

@@ -21,6 +21,7 @@ mod run;
 mod say;
 mod scan;
 mod sim;
+mod stall;
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -39,11 +40,16 @@ use crate::sim::SimBackend;
 const SUPERVISOR_WAIT: Duration = Duration::from_secs(10);
 
 fn main() {
-    std::process::exit(real_main());
+    let code = real_main();
+    // what is still queued for stderr, unless stderr is blocked
+    say::flush(Duration::from_secs(1));
+    std::process::exit(code);
 }
 
 fn real_main() -> i32 {
     motion_rt::logging::init("motion-io");
+    // before going real-time: the writer thread stays SCHED_OTHER
+    say::start_writer();
     let opts = match Options::try_parse() {
         Ok(o) => o,
         Err(e) => {
@@ -93,6 +99,7 @@ fn real_main() -> i32 {
         say.always(format_args!("error: {e}"));
         return 1;
     }
+    stall::install();
     apply_rt(&opts, say);
 
     let mine = cfg.only_io(io);

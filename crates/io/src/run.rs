@@ -156,6 +156,7 @@ impl Loop<'_> {
 
     fn run(&mut self) -> Outcome {
         loop {
+            crate::stall::if_asked();
             if signals::received().is_some() {
                 self.stop_on_signal();
                 return Outcome::Signal;
@@ -357,12 +358,16 @@ impl Loop<'_> {
                 let silent = now.saturating_sub(self.last_command_ns);
                 let missed = silent / cycle;
                 if missed >= u64::from(self.s.watchdog_cycles) {
+                    // the stop first: saying so can wait (and never blocks)
+                    self.phase = Phase::Stopping;
+                    let done = self.stop_cycle(now);
                     say.always(format_args!(
                         "watchdog: no command for {missed} cycles ({:.1} ms): stopping every axis",
                         silent as f64 * 1e-6
                     ));
-                    self.phase = Phase::Stopping;
-                    self.stop_cycle(now);
+                    if done {
+                        self.say_stopped();
+                    }
                     if self.phase == Phase::Stopping {
                         self.next_tick_ns = now + cycle;
                     }
@@ -372,7 +377,9 @@ impl Loop<'_> {
                 }
             }
             Phase::Stopping => {
-                self.stop_cycle(now);
+                if self.stop_cycle(now) {
+                    self.say_stopped();
+                }
                 if self.phase == Phase::Stopping {
                     self.next_tick_ns += cycle;
                     if self.next_tick_ns <= now {
@@ -400,30 +407,34 @@ impl Loop<'_> {
         None
     }
 
-    /// One cycle of the watchdog stop.
-    fn stop_cycle(&mut self, now: u64) {
+    /// One cycle of the watchdog stop; `true` when it completed now.
+    fn stop_cycle(&mut self, now: u64) -> bool {
         let dt = self.dt_s();
         let done = self.publish_unsolicited(|b, f| b.watchdog_stop(dt, f));
         if done {
-            self.say()
-                .always(format_args!("watchdog: every axis stopped and disabled"));
             self.phase = Phase::Stopped { since: now };
             // first exit check / heartbeat one idle period from now
             self.next_tick_ns = now + IDLE_PERIOD_NS.min(EXIT_AFTER_STOP_NS);
         }
+        done
+    }
+
+    fn say_stopped(&self) {
+        self.say()
+            .always(format_args!("watchdog: every axis stopped and disabled"));
     }
 
     /// SIGINT/SIGTERM: controlled stop of every axis (simulated at once,
-    /// bounded), one last feedback frame.
+    /// bounded), one last feedback frame; said after the stop.
     fn stop_on_signal(&mut self) {
         let say = self.say();
+        let dt = self.dt_s();
+        let controlled = self.publish_unsolicited(|b, f| b.shutdown(dt, f));
         say.info(format_args!(
             "{} received after {} commands: stopping every axis",
             signals::received_name().unwrap_or("signal"),
             self.commands
         ));
-        let dt = self.dt_s();
-        let controlled = self.publish_unsolicited(|b, f| b.shutdown(dt, f));
         if controlled {
             say.info(format_args!("signal: every axis stopped"));
         } else {

@@ -113,17 +113,24 @@ fn parse_watchdog_line(line: &str) -> (u64, f64) {
     (n.parse().unwrap(), ms.parse().unwrap())
 }
 
-fn watchdog_stop_and_exit(spin: bool) {
-    // A 20 ms silence is the watchdog's trigger: the tests take turns (a
-    // spinning motion-io of another test next to this one, on 2 vCPUs, can
-    // starve this test's commands that long) and pace like the supervisor.
-    let _serial = serial();
+/// The machine's config, a prefix of its own (tidied after a panic) and
+/// the supervisor played on it, the test's thread paced like the
+/// supervisor. A 20 ms silence is the watchdog's trigger: the tests take
+/// turns (a spinning motion-io of another test next to this one, on 2
+/// vCPUs, can starve this test's commands that long).
+fn played() -> (TempConfig, String, DomainGuard, SupervisorPeer) {
     pace_like_the_supervisor();
     let cfg = machine().write("iotest_unused");
     let prefix = unique_prefix("iotest");
-    let _guard = DomainGuard(prefix.clone());
+    let guard = DomainGuard(prefix.clone());
+    let sup = SupervisorPeer::new(&prefix);
+    (cfg, prefix, guard, sup)
+}
+
+fn watchdog_stop_and_exit(spin: bool) {
+    let _serial = serial();
     // --quiet: no start line to wait for, so the supervisor side comes first
-    let mut sup = SupervisorPeer::new(&prefix);
+    let (cfg, prefix, _guard, mut sup) = played();
     let mut args = vec![
         "--config",
         cfg.arg(),
@@ -242,6 +249,117 @@ fn watchdog_then_commands_resume_with_the_fault_handshake() {
     io.signal(Signal::SIGTERM);
     let st = io.wait_exit(Duration::from_secs(5)).expect("exit");
     assert_eq!(st.code(), Some(0), "{}", io.stderr());
+    sup.finish();
+}
+
+/// stderr a pipe that nobody reads any more, full (a supervisor that
+/// stopped reading, a stuck terminal): motion-io's watchdog still stops
+/// every axis in its bound — it stops first and says so after, and its
+/// messages wait in a writer thread, never in the main loop — and SIGTERM
+/// still ends it (the exit waits at most 1 s for the writer).
+#[test]
+fn a_full_stderr_never_delays_the_watchdog_stop() {
+    use std::io::{Read, Write};
+    use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+    use std::os::unix::fs::OpenOptionsExt;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    let _serial = serial();
+    let (cfg, prefix, _guard, mut sup) = played();
+    // the pipe: small, its read end ours alone; a second, non-blocking
+    // description of its write end to fill it with
+    let mut fds = [0; 2];
+    // SAFETY: pipe2 fills two descriptors we then own.
+    assert_eq!(unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) }, 0);
+    // SAFETY: both are open and owned from here on.
+    let (rd, wr) = unsafe { (OwnedFd::from_raw_fd(fds[0]), OwnedFd::from_raw_fd(fds[1])) };
+    // SAFETY: F_SETPIPE_SZ on a pipe we own.
+    unsafe { libc::fcntl(wr.as_raw_fd(), libc::F_SETPIPE_SZ, 4096) };
+    let mut filler = std::fs::OpenOptions::new()
+        .write(true)
+        .custom_flags(libc::O_NONBLOCK | libc::O_CLOEXEC)
+        .open(format!("/proc/self/fd/{}", wr.as_raw_fd()))
+        .expect("the pipe's write end");
+    // SAFETY: O_NONBLOCK on our own read end (the child never has it).
+    unsafe { libc::fcntl(rd.as_raw_fd(), libc::F_SETFL, libc::O_NONBLOCK) };
+    let mut reader = std::fs::File::from(rd);
+    // read while it starts and serves, as a supervisor would
+    let draining = Arc::new(AtomicBool::new(true));
+    let drain = {
+        let draining = draining.clone();
+        std::thread::spawn(move || {
+            let mut text = Vec::new();
+            let mut buf = [0u8; 4096];
+            while draining.load(Ordering::Relaxed) {
+                match reader.read(&mut buf) {
+                    Ok(n) if n > 0 => text.extend_from_slice(&buf[..n]),
+                    _ => std::thread::sleep(Duration::from_millis(5)),
+                }
+            }
+            (reader, String::from_utf8_lossy(&text).into_owned())
+        })
+    };
+    let mut child = std::process::Command::new(bins::test_bin("motion-io"))
+        .args(["--config", cfg.arg(), "--service-prefix", &prefix])
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::from(wr))
+        .spawn()
+        .expect("motion-io");
+    let pid = nix::unistd::Pid::from_raw(child.id() as i32);
+    struct Kill(nix::unistd::Pid);
+    impl Drop for Kill {
+        fn drop(&mut self) {
+            let _ = nix::sys::signal::kill(self.0, Signal::SIGKILL);
+        }
+    }
+    let _kill = Kill(pid);
+    sup.connect(1);
+    let (last_pos, _) = drive_100(&mut sup);
+    // nobody reads any more, and the pipe is full
+    draining.store(false, Ordering::Relaxed);
+    let (_reader, said) = drain.join().unwrap();
+    let mut filled = 0;
+    while filler.write(&[b'x'; 512]).is_ok() {
+        filled += 512;
+    }
+    println!("pipe filled with {filled} bytes; motion-io said before:\n{said}");
+
+    // silence: the stop, read from the feedback frames
+    let t0 = Instant::now();
+    let mut frames = Vec::new();
+    let stopped = |f: &FeedbackFrame| {
+        let a = &f.axes[0];
+        f.answers_sequence == 0 && a.velocity == 0.0 && a.status_word == SW_FAULT
+    };
+    while !frames.last().is_some_and(stopped) {
+        assert!(
+            t0.elapsed() < Duration::from_secs(5),
+            "no stop within 5 s: {} frames, last {:?}",
+            frames.len(),
+            frames.last().map(|f: &FeedbackFrame| f.axes[0])
+        );
+        let _ = sup.ports.wait(Duration::from_millis(2));
+        while let Some(f) = sup.latest() {
+            frames.push(*f);
+        }
+    }
+    println!("stopped {:?} after the last command", t0.elapsed());
+    check_stop(&frames, last_pos);
+
+    // SIGTERM: it leaves although its last lines cannot be written
+    nix::sys::signal::kill(pid, Signal::SIGTERM).unwrap();
+    let t1 = Instant::now();
+    let st = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        assert!(t1.elapsed() < Duration::from_secs(5), "did not exit");
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    println!("exited {:?} after SIGTERM: {st:?}", t1.elapsed());
+    assert_eq!(st.code(), Some(0));
     sup.finish();
 }
 

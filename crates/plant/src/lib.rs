@@ -46,5 +46,6 @@ pub mod sensors;
 mod torque;
 
 pub use config::{PlantConfig, RegistrationInput, TorqueSpike};
+pub use num::feedback_numbers;
 pub use plant::Plant;
 pub use sensors::{Markers, Switch, SwitchEdge};

@@ -1,5 +1,21 @@
 //! Numeric helpers that keep every reported value finite and well defined.
 
+use motion_homing::Feedback;
+
+/// The numbers in a plant's feedback: position, velocity, torque and the
+/// two latched positions. Each one is finite whatever the input — the
+/// plant is total — and the plant's tests check it over this list, so a
+/// number added to the feedback is added here, once.
+pub fn feedback_numbers(fb: &Feedback) -> [f64; 5] {
+    [
+        fb.position,
+        fb.velocity,
+        fb.torque,
+        fb.marker_latch.position,
+        fb.switch_latch.position,
+    ]
+}
+
 /// Sign of `x` with `sign(0) = 0` (and `sign(NaN) = 0`). `f64::signum(0.0)` is
 /// `1.0`, which would make a standing axis feel friction.
 pub(crate) fn sign(x: f64) -> f64 {

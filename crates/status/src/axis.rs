@@ -109,6 +109,11 @@ crate::status_table! {
     /// HomedStatus comes from the stored reference of an absolute axis,
     /// applied at start-up without motion.
     restored: Flag @ 29, None, "restored", -, "Restored", |s| s.a.restored;
+    /// The independent cycle monitor stopped the axis (ERR 1021; EXERR
+    /// names the invariant, the log the value against its bound); cleared
+    /// by a reset.
+    monitor_tripped: Flag @ 40, None, "monitor_tripped", -, "MonitorTripped",
+        |s| s.a.monitor.is_some();
     /// The I/O process reports the axis's drive lost (it stopped answering
     /// on its fieldbus, left operation, or was power-cycled).
     drive_lost: Flag @ 30, None, "drive_lost", -, -, |s| s.status.drive_lost;

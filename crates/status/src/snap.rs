@@ -68,6 +68,10 @@ pub struct AxisSnap {
     pub owner: u64,
     /// This cycle's command position in axis coordinates.
     pub cmd_axis: Option<f64>,
+    /// The cycle monitor's trip in force (until a reset), and its trips
+    /// since start: the control thread logs each one with its values.
+    pub monitor: Option<motion_monitor::Trip>,
+    pub monitor_trips: u32,
 }
 
 impl AxisSnap {

@@ -16,7 +16,7 @@ mod variant;
 
 use clap::Parser;
 use cli::Opts;
-use motion_bench::drive::Binaries;
+use motion_bench::bins::Binaries;
 use motion_bench::outcome::{self, write_json, Bench};
 use report::Merged;
 use variant::Variant;

@@ -1,16 +1,17 @@
 //! The slices: one `motion-supervisor run` of one variant on the demo
 //! machine (with `--no-control-plane` for (a)), the clients attached for
 //! (b) and (c) once the daemon answers, then what it measured
-//! (`motion_harness::runs`); the variants alternate, odd slices in reverse
+//! (`motion_bench::runs`); the variants alternate, odd slices in reverse
 //! order (neither variant always follows the other).
 
 use crate::cli::Opts;
 use crate::variant::Variant;
+use motion_bench::bins::Binaries;
 use motion_bench::clients::{self, Clients};
-use motion_bench::drive::{self, runs, Binaries};
 use motion_bench::outcome::Bench;
 use motion_bench::slice::Slice;
 use motion_bench::table::us;
+use motion_bench::{drive, runs};
 use motion_bench::{machine, proc};
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};

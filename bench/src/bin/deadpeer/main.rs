@@ -9,7 +9,7 @@
 mod trial;
 
 use clap::{Parser, ValueEnum};
-use motion_bench::drive::Binaries;
+use motion_bench::bins::Binaries;
 use motion_bench::flags::{Cycle, Files};
 use motion_bench::outcome::{self, with, write_json, Bench};
 use motion_bench::proc;

@@ -12,7 +12,9 @@
 //! motion-io published (its own timestamp) shows when the silence began.
 
 use crate::{Opts, Sig};
-use motion_bench::drive::{self, Binaries};
+use motion_bench::bins::Binaries;
+use motion_bench::drive;
+use motion_bench::homing;
 use motion_bench::machine;
 use motion_bench::outcome::{self, Bench};
 use motion_bench::proc::{self, Running};
@@ -84,7 +86,7 @@ fn daemon(o: &Opts, b: &Binaries, tmp: &Path, prefix: &str) -> Result<(Running, 
     let s = o.cycle.supervisor(prefix);
     let (toml, _) = machine::long_seek_axis_with(&s, tmp.to_str(), o.speed, o.speed * 60.0)?;
     let daemon = drive::start_machine(b, tmp, prefix, &toml)?;
-    match drive::io_children(daemon.pid()).as_slice() {
+    match proc::io_children(daemon.pid()).as_slice() {
         [p] => Ok((daemon, *p)),
         io => {
             let e =
@@ -152,7 +154,7 @@ pub fn run(
     }
     let ended = drive::stop_run(daemon, Duration::from_secs(30));
     if !ended.success() {
-        let (how, tail) = (ended.describe(), drive::tail(&ended.stderr, 3));
+        let (how, tail) = (ended.describe(), proc::tail(&ended.stderr, 3));
         t.problems
             .push(format!("the supervisor ended with {how} ({tail})"));
     }
@@ -212,13 +214,13 @@ fn signal(o: &Opts, shared: &Shared, io_pid: u32, sig: Sig, t: &mut Trial) -> Re
 /// The homing's own result row.
 fn homing_result(t: &mut Trial, home: Running) {
     let ended = home.wait(Duration::from_secs(10), Duration::from_secs(3));
-    let Some(v) = drive::last_json(&ended.stdout) else {
-        let (how, tail) = (ended.describe(), drive::tail(&ended.stderr, 3));
+    let Some(v) = homing::last_json(&ended.stdout) else {
+        let (how, tail) = (ended.describe(), proc::tail(&ended.stderr, 3));
         return t
             .problems
             .push(format!("motionctl home printed nothing ({how}; {tail})"));
     };
-    match drive::rows_of(&v).first() {
+    match homing::rows_of(&v).first() {
         Some(r) => (t.err, t.exerr, t.error) = (Some(r.err), Some(r.exerr), r.error.clone()),
         None => t.problems.push(format!("motionctl home: no row: {v}")),
     }

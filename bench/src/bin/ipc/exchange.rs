@@ -1,7 +1,7 @@
 //! What the measuring thread does with a peer, whatever the peer is: the
 //! [`Exchange`] of one message and its answer. [`FrameSide`] is the
 //! supervisor's own ports with real frames (the motion-io modes); the bare
-//! modes' side is `motion_harness::bare::BareSide`. One trait, so that both
+//! modes' side is `motion_bench::bare::BareSide`. One trait, so that both
 //! are measured by the very same loop.
 
 use iceoryx2::prelude::ipc;

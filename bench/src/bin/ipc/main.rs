@@ -19,9 +19,9 @@ mod report;
 mod run_mode;
 
 use cli::Opts;
-use motion_bench::host;
 use motion_bench::outcome::{self, Bench};
 use motion_bench::proc;
+use motion_bench::{bins, host};
 use motion_ipc::Domain;
 use std::path::PathBuf;
 
@@ -37,8 +37,8 @@ fn main() {
 fn run(o: &Opts) -> Result<i32, String> {
     let io_bin = (o.io.clone())
         .or_else(|| std::env::var_os("MOTION_IO_BIN").map(PathBuf::from))
-        .or_else(|| host::beside_this_exe("motion-io"));
-    if o.modes.iter().any(|m| !m.bare()) && !io_bin.as_deref().is_some_and(host::is_executable) {
+        .or_else(|| bins::beside_this_exe("motion-io"));
+    if o.modes.iter().any(|m| !m.bare()) && !io_bin.as_deref().is_some_and(bins::is_executable) {
         return Err(
             "motion-io not found next to this binary; build it first: `cargo build \
                     --release --workspace --bins` (same CARGO_TARGET_DIR), or pass --io PATH"

@@ -8,6 +8,7 @@
 //! run the [`slices`], merge and judge them ([`report`]), print, write the
 //! [`files`].
 
+mod bus;
 mod cli;
 mod files;
 mod report;
@@ -15,11 +16,11 @@ mod slices;
 
 use clap::Parser;
 use cli::Opts;
-use motion_bench::drive::{self, Binaries};
+use motion_bench::bins::{self, Binaries};
 use motion_bench::ecat::EcatRig;
 use motion_bench::host;
 use motion_bench::outcome::{self, Bench};
-use motion_bench::proc::Running;
+use motion_bench::proc::{self, Running};
 use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
 
@@ -97,7 +98,7 @@ fn cyclictest(o: &Opts) -> Option<PathBuf> {
     let found = o
         .cyclictest
         .clone()
-        .or_else(|| host::find_in_path("cyclictest"));
+        .or_else(|| bins::find_in_path("cyclictest"));
     let Some(bin) = found else {
         eprintln!(
             "jitter: WARNING: cyclictest not found (install rt-tests: `apt-get install -y \
@@ -121,7 +122,7 @@ fn cyclictest(o: &Opts) -> Option<PathBuf> {
 fn start_stress(o: &Opts, slices: usize) -> Result<Running, String> {
     let bound = (3.0 * o.slicing.duration + 20.0 * slices as f64 + 60.0).ceil() as u64;
     let cpu = o.cycle.other_cpu();
-    let r = drive::stress(cpu, Duration::from_secs(bound)).map_err(|e| format!("--stress: {e}"))?;
+    let r = proc::stress(cpu, Duration::from_secs(bound)).map_err(|e| format!("--stress: {e}"))?;
     let pid = r.pid();
     eprintln!("jitter: stress-ng --cpu 1 --taskset {cpu} --timeout {bound}s (pid {pid})");
     Ok(r)

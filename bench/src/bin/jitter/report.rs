@@ -5,10 +5,10 @@
 //! deadline misses, the cycle's other figures, and what makes the numbers
 //! less than representative. Same numbers as the JSON, laid out for a CI log.
 
+use crate::bus::BusRun;
 use crate::cli::Opts;
 use crate::slices::{Collected, Names, Variant};
 use hdrhistogram::Histogram;
-use motion_bench::ecat::BusRun;
 use motion_bench::outcome::Bench;
 use motion_bench::slice::{Group, MAX_MISS_RATIO};
 use motion_bench::table::{ratio_cells, row, thousands, us, us_cells, Text, COLUMNS};

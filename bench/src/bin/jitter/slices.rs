@@ -7,16 +7,19 @@
 //! The first failure of any tool ends the slices (what ran is still
 //! reported); so does SIGINT/SIGTERM.
 
+use crate::bus::{bus_run, BusRun};
 use crate::cli::Opts;
+use motion_bench::bins::Binaries;
 use motion_bench::cyclictest::{self, CtHistogram};
-use motion_bench::drive::{self, runs, Binaries, Repeated};
-use motion_bench::ecat::{self, BusRun, EcatRig};
+use motion_bench::ecat::{self, EcatRig};
+use motion_bench::homing::Repeated;
 use motion_bench::host::OtherRt;
 use motion_bench::machine::{self, Machine};
 use motion_bench::outcome;
 use motion_bench::proc::{self, Running};
 use motion_bench::slice::Slice;
 use motion_bench::table::us;
+use motion_bench::{drive, runs};
 use motion_bench::{histogram, plot::RGBColor};
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -266,7 +269,7 @@ fn home_while(
 /// motion-io's bus round trip from the summary it logged (kept in `c`),
 /// as the progress line shows it.
 fn bus(c: &mut Collected, stderr: &str) -> String {
-    let Some(b) = ecat::bus_run(stderr) else {
+    let Some(b) = bus_run(stderr) else {
         let w = "EtherCAT: motion-io reported no bus summary in a slice";
         c.warnings.insert(w.into());
         return "; bus round trip not reported".into();

@@ -10,7 +10,8 @@
 use crate::cli::Opts;
 use crate::report::Part;
 use crate::Ctx;
-use motion_bench::drive::{self, HomeRun};
+use motion_bench::drive;
+use motion_bench::homing::{self, HomeRun};
 use motion_bench::proc::Ended;
 use motion_bench::spy::{Recording, Spy};
 use motion_bench::{host, machine, proc};
@@ -48,8 +49,8 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
         }
         let csv = ctx.tmp.join(format!("{prefix}-{i}.csv"));
         let run = match o.trace {
-            true => drive::traced_home(&ctx.b.motionctl, &prefix, "X", &csv, o.timeout)?,
-            false => drive::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?,
+            true => homing::traced_home(&ctx.b.motionctl, &prefix, "X", &csv, o.timeout)?,
+            false => homing::ctl_home(&ctx.b.motionctl, &prefix, &["X"], false, o.timeout)?,
         };
         if run.ended.interrupted {
             interrupted = true;
@@ -72,13 +73,13 @@ pub fn run(o: &Opts, ctx: &mut Ctx, n: u32, part: &mut Part) -> Result<bool, Str
         keep_block(ctx, &prefix, frames.as_ref(), &ended);
     }
     let report =
-        drive::last_json(&ended.stdout).and_then(|v| serde_json::from_value::<RunReport>(v).ok());
+        homing::last_json(&ended.stdout).and_then(|v| serde_json::from_value::<RunReport>(v).ok());
     match report {
         Some(r) => part.figures.add(&r),
         None => part.tally.note(format!(
             "{prefix}: the daemon printed no report ({}; {})",
             ended.describe(),
-            drive::tail(&ended.stderr, 5)
+            proc::tail(&ended.stderr, 5)
         )),
     }
     ctx.check_leftovers(&prefix);
@@ -123,7 +124,7 @@ fn keep_evidence(ctx: &Ctx, prefix: &str, i: u32, t_block: Instant, run: &HomeRu
         "rows": run.rows,
         "output": run.json,
         "ended": run.ended.describe(),
-        "stderr_tail": drive::tail(&run.ended.stderr, 20),
+        "stderr_tail": proc::tail(&run.ended.stderr, 20),
         "status_after": drive::status(&ctx.b.motionctl, prefix),
         "stats_after": stats,
         "loadavg": host::loadavg(),

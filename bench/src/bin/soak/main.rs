@@ -15,7 +15,8 @@ mod report;
 
 use clap::Parser;
 use cli::{Opts, Which};
-use motion_bench::drive::{self, Binaries};
+use motion_bench::bins::{self, Binaries};
+use motion_bench::drive;
 use motion_bench::outcome::{self, write_json, Bench};
 use motion_bench::{host, machine, proc};
 use report::Part;
@@ -42,7 +43,7 @@ fn run(o: &Opts) -> Result<i32, String> {
     }
     let bins = Binaries::find(o.files.supervisor.as_deref())?;
     let stress = o.stress_share > 0.0 || o.stress64;
-    if stress && (host::cpus() < 2 || host::find_in_path("stress-ng").is_none()) {
+    if stress && (host::cpus() < 2 || bins::find_in_path("stress-ng").is_none()) {
         let needed = "stress-ng (apt-get install -y stress-ng) and a second CPU are needed";
         return Err(format!("{needed} (or --stress-share 0)"));
     }

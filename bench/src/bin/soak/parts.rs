@@ -11,7 +11,7 @@ use crate::cli::{Opts, Via};
 use crate::daemon_block;
 use crate::report::{count_home_run, Part};
 use crate::Ctx;
-use motion_bench::drive::{self, HomeRun};
+use motion_bench::homing::{self, HomeRun};
 use motion_bench::{machine, proc};
 use motion_report::AxisResult;
 use std::process::Command;
@@ -27,7 +27,7 @@ pub struct OneAxis {
 /// stress-ng on the other CPU, bounded by its own timeout for `homings`.
 fn stress(o: &Opts, ctx: &Ctx, homings: u32) -> Result<motion_bench::proc::Running, String> {
     let bound = f64::from(homings) * (o.timeout + 10.0) + 60.0;
-    drive::stress(ctx.other_cpu, Duration::from_secs_f64(bound))
+    proc::stress(ctx.other_cpu, Duration::from_secs_f64(bound))
 }
 
 /// Runs the one-axis blocks. An `Err` is a block that could not be run.
@@ -139,7 +139,7 @@ fn fresh_home(
     cmd.args(["--json", "--timeout", &o.timeout.to_string()]);
     cmd.args(["--service-prefix", prefix]);
     let limit = Duration::from_secs_f64(o.timeout + 60.0);
-    let run = drive::home_run(&mut cmd, "motion-supervisor home", limit)?;
+    let run = homing::home_run(&mut cmd, "motion-supervisor home", limit)?;
     if run.ended.interrupted {
         return Ok(None);
     }

@@ -7,7 +7,7 @@
 
 use crate::cli::{Opts, Via};
 use crate::Ctx;
-use motion_bench::drive::{HomeRun, Tally};
+use motion_bench::homing::{HomeRun, Tally};
 use motion_bench::outcome::Bench;
 use motion_bench::table::{line, Text};
 use motion_report::{GapCounts, RunReport};

@@ -9,7 +9,8 @@
 //! circle − r).
 
 use crate::Opts;
-use motion_bench::drive::{self, Binaries};
+use motion_bench::bins::Binaries;
+use motion_bench::drive;
 use motion_bench::machine::{streamed_names, streamed_with};
 use motion_bench::outcome::Bench;
 use motion_bench::stream::{home_and_enable, Streamer};

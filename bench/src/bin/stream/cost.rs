@@ -5,11 +5,12 @@
 //! enable the axes the same way, only the stream differs), as ratios.
 
 use crate::Opts;
-use motion_bench::drive::{self, runs, Binaries};
+use motion_bench::bins::Binaries;
 use motion_bench::machine::{streamed_names, streamed_with};
 use motion_bench::outcome::Bench;
 use motion_bench::slice::{Group, Slice};
 use motion_bench::stream::{home_and_enable, Streamer};
+use motion_bench::{drive, runs};
 use serde_json::{json, Value};
 use std::time::Duration;
 

@@ -13,7 +13,8 @@
 //! twice between two cycles) is never commanded exactly: counted apart.
 
 use crate::Opts;
-use motion_bench::drive::{self, Binaries};
+use motion_bench::bins::Binaries;
+use motion_bench::drive;
 use motion_bench::machine::{streamed_names, streamed_with, STREAMED_COUNTS_PER_UNIT};
 use motion_bench::outcome::Bench;
 use motion_bench::spy::Spy;

@@ -7,15 +7,15 @@
 //! and README "Performance".
 //!
 //! This file is the command line, the sequence and the report; the machine
-//! and the streaming program are the harness's (`motion_harness::generated`,
-//! `motion_harness::stream`).
+//! and the streaming program are the bench library's (`motion_bench::machine`,
+//! `motion_bench::stream`).
 
 mod circle;
 mod cost;
 mod latency;
 
 use clap::Parser;
-use motion_bench::drive::Binaries;
+use motion_bench::bins::Binaries;
 use motion_bench::flags::{Cycle, Files, Slicing};
 use motion_bench::outcome::{self, write_json, Bench};
 use serde_json::json;

@@ -12,6 +12,11 @@ use crate::{IoBackend, MachineConfig};
 
 /// SCHED_FIFO priority of the bus thread without `motion-io --priority`.
 pub const DEFAULT_BUS_PRIORITY: i32 = 70;
+/// [`EthercatBus::new`]'s `watchdog_cycles`: `io_watchdog_cycles`'s default
+/// at a 1 ms cycle.
+pub const DEFAULT_WATCHDOG_CYCLES: u32 = 50;
+/// [`EthercatBus::new`]'s `feedback_timeout_ms`: the supervisor's default.
+pub const DEFAULT_FEEDBACK_TIMEOUT_MS: f64 = 10.0;
 
 /// One axis on the bus, in the bus's order.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -62,6 +67,15 @@ pub struct EthercatBus {
     pub priority: i32,
     /// Lock memory (`mlockall`) from the bus thread.
     pub lock_memory: bool,
+    /// `io_watchdog_cycles` of the supervisor: motion-io's watchdog. The
+    /// bus thread has its own, of twice as many cycles (see
+    /// `motion_ethercat::cycle`).
+    pub watchdog_cycles: u32,
+    /// `feedback_timeout_ms` of the supervisor: how long its engines go on
+    /// through missing feedback before they abort the motion. A drive
+    /// whose data was lost longer is not sent after a command that ran on
+    /// (see `motion_ethercat::axis`).
+    pub feedback_timeout_ms: f64,
 }
 
 impl EthercatBus {
@@ -78,6 +92,8 @@ impl EthercatBus {
             cpu: None,
             priority: DEFAULT_BUS_PRIORITY,
             lock_memory: true,
+            watchdog_cycles: DEFAULT_WATCHDOG_CYCLES,
+            feedback_timeout_ms: DEFAULT_FEEDBACK_TIMEOUT_MS,
         }
     }
 
@@ -151,6 +167,8 @@ impl EthercatBus {
             cpu,
             priority: priority.unwrap_or(DEFAULT_BUS_PRIORITY),
             lock_memory: machine.supervisor.lock_memory,
+            watchdog_cycles: machine.supervisor.io_watchdog_cycles,
+            feedback_timeout_ms: machine.supervisor.feedback_timeout_ms,
         };
         Ok((bus, map))
     }

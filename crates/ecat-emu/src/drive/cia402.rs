@@ -8,36 +8,8 @@
 //! pit one against the other.
 
 use super::motion::{After, Ramp};
+use super::state::State;
 use super::Drive;
-
-/// CiA 402 states (slave side).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum State {
-    NotReadyToSwitchOn,
-    SwitchOnDisabled,
-    ReadyToSwitchOn,
-    SwitchedOn,
-    OperationEnabled,
-    QuickStopActive,
-    FaultReactionActive,
-    Fault,
-}
-
-impl State {
-    /// The statusword's state bits.
-    pub(super) fn bits(self) -> u16 {
-        match self {
-            State::NotReadyToSwitchOn => 0x0000,
-            State::SwitchOnDisabled => 0x0040,
-            State::ReadyToSwitchOn => 0x0021,
-            State::SwitchedOn => 0x0033,
-            State::OperationEnabled => 0x0037,
-            State::QuickStopActive => 0x0017,
-            State::FaultReactionActive => 0x001F,
-            State::Fault => 0x0008,
-        }
-    }
-}
 
 impl Drive {
     /// Applies the controlword `cw` of a valid process-data cycle: at most

@@ -81,6 +81,11 @@ pub struct DriveConfig {
     pub limit_switches: bool,
     /// Objects the drive does not have (removed from its dictionary).
     pub without: Vec<u16>,
+    /// Its ESC's clock runs this many parts per million fast (negative:
+    /// slow) against the host's: a crystal's tolerance. The first DC
+    /// SubDevice is the bus's reference clock, so the master's cycle
+    /// follows it and drifts against the supervisor's by as much.
+    pub clock_ppm: f64,
 }
 
 impl DriveConfig {
@@ -114,6 +119,7 @@ impl DriveConfig {
             digital_inputs: true,
             limit_switches: true,
             without: Vec::new(),
+            clock_ppm: 0.0,
         }
     }
 }

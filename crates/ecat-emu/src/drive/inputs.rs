@@ -3,7 +3,7 @@
 //! velocity and torque in the objects' units, digital inputs (0x60FD: limit
 //! switches, home switch, an index-pulse bit), touch probes.
 
-use super::cia402::State;
+use super::state::State;
 use super::{Drive, ERR_FOLLOWING};
 
 impl Drive {

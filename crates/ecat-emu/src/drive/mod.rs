@@ -41,15 +41,16 @@ pub mod motion;
 pub mod pdo;
 pub mod probes;
 pub mod sdo;
+pub mod state;
 
 use motion_plant::Plant;
 
 use crate::od::Od;
 
-pub use cia402::State;
 pub use config::{DriveConfig, ModeDisplay, PdoProfile, TorqueObjects, SUPPORTED_METHODS};
 use motion::Ramp;
 use probes::ProbeUnit;
+pub use state::State;
 
 /// Error code (0x603F) of a following error (the plant's tolerance tripped).
 pub const ERR_FOLLOWING: u16 = 0x8611;

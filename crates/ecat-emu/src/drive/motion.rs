@@ -5,8 +5,8 @@
 
 use motion_homing::Command;
 
-use super::cia402::State;
 use super::config::TorqueObjects;
+use super::state::State;
 use super::{Drive, ERR_COMMUNICATION, ERR_FOLLOWING, ERR_LIMIT_WIRING};
 
 /// What a deceleration ramp ends in.

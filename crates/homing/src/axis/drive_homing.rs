@@ -40,7 +40,7 @@
 
 use super::intake::Sample;
 use super::plausible::Plausibility;
-use super::state::{Run, State};
+use super::state::{DriveRun, Run, State};
 use super::{Abort, Axis};
 use crate::codes::{ERR_SERVO_MESSAGE, EX_DRIVE_HOMING_ERROR};
 use crate::plan::Leg;
@@ -50,18 +50,6 @@ use crate::profile::Profile;
 /// for, or the leg fails (12 / 46): a drive that never takes homing mode is
 /// not waited for until the home timeout (which may be off).
 pub const DRIVE_ACK_NS: u64 = 2_000_000_000;
-
-/// The drive-homing leg's progress (`Run::Drive`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct DriveRun {
-    /// When the leg asked the drive to home, ns.
-    pub since: u64,
-    /// The drive reported homing active for this request.
-    pub seen_active: bool,
-    /// The drive reported home attained; the request has dropped and the
-    /// leg waits for the drive to hand back.
-    pub attained: bool,
-}
 
 impl Axis {
     /// The drive's presence as the I/O process reports it, before this

@@ -51,6 +51,7 @@ mod ops;
 mod plausible;
 mod reference;
 mod state;
+mod tripped;
 
 use crate::codes::*;
 use crate::config::*;

@@ -54,7 +54,7 @@ pub(super) enum Run {
     /// Home Position (a continue leg that only stops does not).
     Profile { to_home: bool },
     /// The drive homes the axis itself (`Leg::DriveHomes`).
-    Drive(super::drive_homing::DriveRun),
+    Drive(DriveRun),
 }
 
 impl Homing {
@@ -98,4 +98,16 @@ impl State {
             _ => false,
         }
     }
+}
+
+/// The drive-homing leg's progress (`Run::Drive`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct DriveRun {
+    /// When the leg asked the drive to home, ns.
+    pub since: u64,
+    /// The drive reported homing active for this request.
+    pub seen_active: bool,
+    /// The drive reported home attained; the request has dropped and the
+    /// leg waits for the drive to hand back.
+    pub attained: bool,
 }

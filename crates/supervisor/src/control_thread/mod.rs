@@ -21,7 +21,8 @@
 //! * `pages.rs` — status, statistics, trace and histogram log, paged;
 //! * `answer.rs` — the cycle's answers (domain words) as the wire's reasons;
 //! * `pump.rs` — what the cycle hands over (snapshots, histograms, trace
-//!   records, acknowledgements) and the keeper's and I/O processes' news.
+//!   records, acknowledgements) and the keeper's and I/O processes' news;
+//!   `trips.rs` — the cycle monitor's trips in the log.
 
 pub(crate) mod answer;
 mod axes;
@@ -29,6 +30,7 @@ mod ops;
 mod owners;
 mod pages;
 mod pump;
+mod trips;
 
 pub use pages::io_reports;
 
@@ -150,6 +152,7 @@ struct ControlThread {
     cache: Option<(pages::PageKey, Vec<u8>)>,
     hlog: Option<HlogFile>,
     ios: pump::IoWatch,
+    trips: trips::TripWatch,
     all_mask: u64,
     keeper: Keeper,
     owners: owners::Owners,
@@ -176,6 +179,7 @@ impl ControlThread {
             keeper,
             owners,
             ios: pump::IoWatch::new(s.machine.ios.len()),
+            trips: trips::TripWatch::new(s.machine.axes.len()),
             s,
             shared,
             hub,

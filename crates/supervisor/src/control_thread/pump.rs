@@ -50,6 +50,7 @@ impl ControlThread {
                     .then_some(id)
             });
             self.ios.watch(&self.s.machine, snap);
+            self.trips.watch(&self.s.machine, snap);
         }
     }
 }

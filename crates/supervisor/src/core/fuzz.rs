@@ -203,6 +203,9 @@ fn garbage_feedback_never_becomes_feedback_nor_motion() {
     runner
         .run(&(0u64..4000, script), |(warm, script)| {
             let mut b = Bench::new(motion_config::DEMO_TOML);
+            // a hostile peer's frames (a fault bit that comes and goes):
+            // the monitor may stop an axis, as it should
+            b.allow_trips = true;
             b.run(20);
             let all = b.core.all_mask();
             prop_assert!(b.home(all, false).axes[..axes].iter().all(|a| a.accepted()));

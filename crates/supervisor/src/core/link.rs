@@ -65,6 +65,9 @@ pub struct LinkCycle {
     /// The process (re)attached in this cycle (or restarted): its axes
     /// must be told.
     pub reconnected: bool,
+    /// It is a new process (another origin than before): its drives were
+    /// off or stopped by its watchdog in between.
+    pub restarted: bool,
     /// It answered the previous command (else: a late reply).
     pub answered_previous: bool,
     /// Command published → answer published, ns (when it answered a command
@@ -154,6 +157,7 @@ impl IoLink {
                 if !self.attached || new_origin {
                     if self.ever_attached && new_origin {
                         self.counts.incarnations += 1;
+                        out.restarted = true;
                     }
                     self.attached = true;
                     self.ever_attached = true;

@@ -62,6 +62,7 @@ pub struct CycleInfo {
     pub roundtrip_ns: Option<u64>,
 }
 
+#[derive(Clone)]
 pub struct Core {
     /// Per axis, in config order.
     slots: Vec<AxisSlot>,
@@ -78,6 +79,8 @@ pub struct Core {
     /// Operations delivered this cycle, answered after the step.
     pending: [Option<Pending>; MAX_PENDING],
     stream: StreamIntake,
+    /// Per gantry, the cycle monitor's check that its sides stay together.
+    together: Vec<motion_monitor::Together>,
 }
 
 impl Core {
@@ -117,6 +120,9 @@ impl Core {
             .map(|g| g.axes.iter().fold(0u64, |k, &i| k | 1 << i))
             .collect();
         Self {
+            together: (m.gantries.iter())
+                .map(|g| motion_monitor::Together::new(g.max_skew))
+                .collect(),
             stream: StreamIntake::new(None, &lead),
             gantry_mask,
             pending: [None; MAX_PENDING],
@@ -311,6 +317,21 @@ impl Core {
         ) {
             self.trace_out = Some(r);
         }
+        self.gantries_together(now_ns);
+    }
+
+    /// After every side's own verdict: a gantry whose sides moved apart is
+    /// stopped on every side by their monitors.
+    fn gantries_together(&mut self, now_ns: u64) {
+        for (g, together) in self.together.iter_mut().enumerate() {
+            let sides = self.gantries[g].sides();
+            let slots = &self.slots;
+            if let Err(apart) = together.judge(sides.iter().map(|&i| slots[i].side())) {
+                for &i in sides {
+                    self.slots[i].gantry_apart(now_ns, apart.value, apart.bound);
+                }
+            }
+        }
     }
 
     /// This cycle's trace record, if an armed trace is recording.
@@ -382,6 +403,8 @@ impl Core {
 }
 
 #[cfg(test)]
+mod campaign;
+#[cfg(test)]
 mod fuzz;
 #[cfg(test)]
 mod gear_tests;
@@ -393,3 +416,5 @@ mod stream_fuzz;
 pub(crate) mod testbench;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod together_tests;

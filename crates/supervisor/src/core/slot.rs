@@ -8,9 +8,15 @@
 //! `setpoint`, `jog_renew`, one step each); what the cycle keeps of them
 //! per axis — the jog's token, the operation id before a request — is
 //! here too, and their rules are in `ops.rs`.
+//!
+//! The engine's command goes through the axis's cycle monitor
+//! (`motion-monitor`) before it reaches the frame: the monitor passes it or
+//! stops the axis itself, and the engine is told in the same step
+//! (`Axis::monitor_tripped`).
 
 use motion_frames::{axis_to_feedback, AxisFeedback, SW_DRIVE_LOST, SW_NO_DATA};
 use motion_homing::{Axis, Command, Feedback, Operation, Phase, Request, Status};
+use motion_monitor::{Cycle, Invariant, Monitor, Side, Trip};
 
 use super::link::LinkCycle;
 use crate::shared::{AxisSnap, LostCause};
@@ -129,6 +135,8 @@ pub(super) struct LinkEvents {
     pub reconnected: bool,
     /// The I/O process is detached.
     pub detached: bool,
+    /// A new I/O process took over (its drives were off in between).
+    pub restarted: bool,
 }
 
 /// Everything the cycle keeps for one axis.
@@ -151,8 +159,12 @@ pub struct AxisSlot {
     last_feedback: Option<Feedback>,
     /// The drive's error code from the newest frame with data.
     drive_error: u16,
-    /// This cycle's command.
+    /// This cycle's command, as the monitor passed it (or its stop).
     pub(super) command: Command,
+    /// The cycle monitor of the axis, and the engine's own command of this
+    /// cycle (what a gantry's verdict, after every side's, stops from).
+    pub(super) monitor: Monitor,
+    engine_command: Command,
     /// The gantry side whose failure stopped it.
     pub(super) gantry_aborted_by: Option<u8>,
     /// The hold-to-run jog running on the axis: its token (0: none) and
@@ -189,6 +201,8 @@ impl AxisSlot {
             last_feedback: None,
             drive_error: 0,
             command: Command::default(),
+            monitor: Monitor::new(&a.engine),
+            engine_command: Command::default(),
             gantry_aborted_by: None,
             jog_token: 0,
             jog_op: 0,
@@ -224,6 +238,7 @@ impl AxisSlot {
         self.link = LinkEvents {
             reconnected: c.reconnected,
             detached,
+            restarted: c.restarted,
         };
         if c.reconnected {
             self.engine.reconnected(now_ns);
@@ -255,7 +270,21 @@ impl AxisSlot {
                 Some(Operation::Stop | Operation::Disable)
             );
         let (geared, faulted) = (self.engine.gear_master(), self.status().faulted);
-        self.command = (self.engine).step(now_ns, self.feedback.as_ref(), &self.rung.request);
+        let request = &self.rung.request;
+        self.engine_command = (self.engine).step(now_ns, self.feedback.as_ref(), request);
+        let trips = self.monitor.trips();
+        self.command = self.monitor.check(&Cycle {
+            now_ns,
+            feedback: self.feedback.as_ref(),
+            request,
+            status: self.engine.status(),
+            reference: self.engine.reference_offset(),
+            command: &self.engine_command,
+            io_restarted: self.link.restarted,
+        });
+        if self.monitor.trips() != trips {
+            self.tell_engine(now_ns);
+        }
         self.halted = stopped || started;
         self.operator_stop = false;
         self.stop_master = geared
@@ -280,6 +309,46 @@ impl AxisSlot {
             self.homed.observe(now_ns, self.engine.status(), self.link);
         }
         started
+    }
+
+    /// The monitor tripped in this cycle: the engine learns it (ER with
+    /// the monitor's ERR / EXERR, its motion ended, the power stage off).
+    fn tell_engine(&mut self, now_ns: u64) {
+        if let Some(t) = self.monitor.tripped() {
+            self.engine.monitor_tripped(now_ns, t.code());
+        }
+    }
+
+    /// This side of a gantry in this cycle, as its monitor passed it.
+    pub(super) fn side(&self) -> Side {
+        let s = self.engine.status();
+        Side {
+            position: self.command.position,
+            following: self.monitor.following(),
+            homing: s.ip || s.phase != Phase::Idle,
+            moved: self.monitor.moved(),
+        }
+    }
+
+    /// A gantry's sides moved apart: this side's monitor stops it from its
+    /// command before this cycle's.
+    pub(super) fn gantry_apart(&mut self, now_ns: u64, value: f64, bound: f64) {
+        let trips = self.monitor.trips();
+        self.command = (self.monitor).force(
+            now_ns,
+            &self.engine_command,
+            Invariant::Gantry,
+            value,
+            bound,
+        );
+        if self.monitor.trips() != trips {
+            self.tell_engine(now_ns);
+        }
+    }
+
+    /// The monitor's trip in force, if any.
+    pub fn trip(&self) -> Option<&Trip> {
+        self.monitor.tripped()
     }
 
     /// This cycle's fresh feedback, as the engine got it.
@@ -325,6 +394,8 @@ impl AxisSlot {
             offset: a.reference_offset(),
             restored: self.homed.restored && a.status().homed,
             cmd_axis: c.position.is_finite().then(|| a.to_axis(c.position)),
+            monitor: self.monitor.tripped().copied(),
+            monitor_trips: self.monitor.trips(),
             ..AxisSnap::default()
         }
     }

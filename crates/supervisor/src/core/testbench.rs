@@ -10,6 +10,7 @@ use motion_plant::Plant;
 pub const MS: u64 = 1_000_000;
 
 /// A Core, plants per axis and one frame pair per I/O process.
+#[derive(Clone)]
 pub struct Bench {
     pub m: MachineConfig,
     pub core: Core,
@@ -24,6 +25,10 @@ pub struct Bench {
     pub acks: Vec<Ack>,
     /// Setpoint frames for the next cycle's intake.
     pub setpoints: Vec<motion_frames::SetpointFrame>,
+    /// The cycle monitor may trip (a test that feeds garbage, or checks a
+    /// trip); otherwise every cycle asserts that it did not: the monitor
+    /// never trips in normal operation.
+    pub allow_trips: bool,
 }
 
 /// The session key of a [`Bench`]'s core (its setpoint frames carry it).
@@ -44,6 +49,7 @@ impl Bench {
             k: 0,
             acks: Vec::new(),
             setpoints: Vec::new(),
+            allow_trips: false,
             m,
         }
     }
@@ -74,6 +80,17 @@ impl Bench {
         self.core.step(now, false, &frames);
         let acks = &mut self.acks;
         self.core.answers(|a| acks.push(a));
+        if !self.allow_trips {
+            for (i, slot) in self.core.axes().iter().enumerate() {
+                assert!(
+                    slot.trip().is_none(),
+                    "cycle {}: the monitor tripped on axis {i}: {:?}\n{:?}",
+                    self.k,
+                    slot.trip(),
+                    slot.status()
+                );
+            }
+        }
         let dt = self.m.supervisor.cycle_us as f64 * 1e-6;
         for k in 0..self.cmd.len() {
             self.core.fill(k, &mut self.cmd[k]);

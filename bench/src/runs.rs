@@ -11,8 +11,8 @@ use motion_report::RunReport;
 use motion_supervisor::hlog;
 
 use crate::bins::Binaries;
-use crate::daemon::{run_command, write_config};
-use crate::process::{tail, Ended, Running};
+use crate::drive::{run_command, write_config};
+use crate::proc::{tail, Ended, Running};
 
 /// Starts the daemon of the machine `toml` (written to `dir/TAG.toml`)
 /// under `prefix` for `len` s, its intervals logged to `dir/TAG.hlog`, with

@@ -1,4 +1,4 @@
-//! A streaming program played by a test or bench: its axes homed and
+//! A streaming program played by a bench: its axes homed and
 //! enabled through the control service ([`home_and_enable`]), then a thread
 //! of this process at the stream's rate ([`Streamer`]) that takes the axes
 //! over and publishes one setpoint per axis per tick through

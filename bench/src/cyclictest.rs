@@ -4,7 +4,7 @@
 //! `# Min Latencies:`, `# Avg Latencies:`, `# Max Latencies:`, `# Histogram
 //! Overflows:` (samples at or above MAXUS, not in any bin).
 
-use crate::process::{tail, Ended};
+use crate::proc::{tail, Ended};
 use hdrhistogram::Histogram;
 use std::path::Path;
 use std::process::Command;

@@ -5,6 +5,7 @@
 //! `soak --print-config` shows the text as generated here.
 
 use motion_config::{MachineConfig, DEMO_TOML};
+use motion_harness::machines::checked;
 use std::fmt::Write as _;
 
 /// What goes into `[supervisor]`.
@@ -70,18 +71,6 @@ fn default_section(s: &Supervisor, state_dir: Option<&str>) -> String {
     }
     t.push('\n');
     t
-}
-
-/// `text` with the machine it parses to, or every problem in one line.
-pub(crate) fn checked(text: String) -> Result<(String, MachineConfig), String> {
-    match motion_config::parse(&text) {
-        Ok(m) => Ok((text, m)),
-        Err(problems) => Err(problems
-            .iter()
-            .map(|p| p.to_string())
-            .collect::<Vec<_>>()
-            .join("; ")),
-    }
 }
 
 /// The four kinds of axis of the 64-axis machine, in the order they repeat.

@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use crate::homing::{last_json, rows_of};
-use crate::process::{tail, Ended, Running};
+use crate::proc::{tail, Ended, Running};
 
 /// The kinds of request, in the order of [`Clients`]: `status --watch`
 /// (one per slice; failed = ended by itself while the supervisor ran),
@@ -340,7 +340,7 @@ mod tests {
 
     #[test]
     fn requests_are_made_on_time_counted_and_ended() {
-        let dir = crate::TempDir::new("clients");
+        let dir = motion_harness::TempDir::new("clients");
         let motionctl = fake_motionctl(dir.path());
         let (status_every, stats_every) = (Duration::from_millis(50), Duration::from_millis(150));
         let plan = Plan {

@@ -9,8 +9,7 @@ use std::time::{Duration, Instant};
 use motion_report::AxisResult;
 use serde::Serialize;
 
-pub use crate::process::tail;
-use crate::process::{Ended, Running};
+use crate::proc::{stop_requested, tail, Ended, Running};
 
 /// One `motionctl home --json` (or `motion-supervisor home --json`): how it
 /// ended and its rows.
@@ -105,7 +104,7 @@ pub fn traced_home(
     cmd.arg(csv).args(["--timeout", &timeout_s.to_string()]);
     let limit = Duration::from_secs_f64(timeout_s + 30.0);
     let mut run = home_run(&mut cmd, "motionctl trace", limit)?;
-    let status = crate::daemon::status(motionctl, prefix);
+    let status = motion_harness::daemon::status(motionctl, prefix);
     let row = |a: &motion_report::AxisStatus| AxisResult {
         name: a.name.clone(),
         pc: a.pc,
@@ -260,7 +259,7 @@ impl Repeated {
     ) -> Result<Repeated, String> {
         let mut h = Repeated::default();
         let running = |sup: &mut Running| sup.running() && t0.elapsed().as_secs_f64() < len;
-        while running(sup) && !crate::process::stop_requested() {
+        while running(sup) && !stop_requested() {
             let started = Instant::now();
             h.started += 1;
             let run = ctl_home(motionctl, prefix, &[], true, len + 10.0)?;
@@ -332,7 +331,7 @@ mod tests {
 
     #[test]
     fn a_traced_homing_takes_its_row_from_the_status() {
-        let dir = crate::TempDir::new("traced");
+        let dir = motion_harness::TempDir::new("traced");
         let mut st = motion_report::StatusReport::default();
         for (name, homed) in [("Y", false), ("X", true)] {
             let (pc, elapsed_s) = (homed, 1.5);
@@ -373,7 +372,7 @@ mod tests {
 
     #[test]
     fn homings_are_repeated_while_the_daemon_runs_and_counted() {
-        let dir = crate::TempDir::new("repeated");
+        let dir = motion_harness::TempDir::new("repeated");
         let ok = repeat(dir.path(), (true, false, 0, 0), 0.4);
         assert!(ok.started >= 2 && ok.ok == ok.started, "{ok:?}");
         assert_eq!(

@@ -1,6 +1,6 @@
 //! The slices of one variant merged: the slice benches (jitter, cpcost)
 //! run `motion-supervisor run --duration --json --hlog` in slices
-//! (`motion_harness::runs` starts one and reads it back) and report each
+//! ([`crate::runs`] starts one and reads it back) and report each
 //! variant as one.
 
 use crate::runs::Measured;

@@ -1,4 +1,4 @@
-//! Engine states for benchmarks and tests, reached by real homing against
+//! Engine states for the engine bench, reached by real homing against
 //! the sim plants (never built by hand, so they are states the engine
 //! really passes through): one axis's step inputs captured mid-homing
 //! ([`seek_state`], [`torque_state`]), and a whole [`Core`] of `n` axes

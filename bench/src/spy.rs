@@ -190,7 +190,7 @@ fn run<F: FnMut(&Cmd)>(
         fbs: Vec::with_capacity(capacity),
         error: None,
     };
-    for w in crate::placement::enter(Some(cpu), (priority > 0).then_some(priority)) {
+    for w in crate::host::enter_rt(Some(cpu), (priority > 0).then_some(priority)) {
         eprintln!("spy: warning: {w}");
     }
     let setup = || -> Result<_, String> {
