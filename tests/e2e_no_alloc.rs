@@ -48,10 +48,10 @@ fn run_mode_makes_no_system_allocator_call() {
     assert_clean(&prefix);
 }
 
-/// With the operations and a setpoint stream running: a jog, a move, and a
-/// program streaming a sine at 1 kHz (acquired after warm-up, so the cycle
-/// that maps the program's publisher is measured too), the cycle still
-/// makes no system-allocator call.
+/// With the operations and a setpoint stream running: a jog, a move, a
+/// gear, and a program streaming a sine at 1 kHz to the gear's master
+/// (acquired after warm-up, so the cycle that maps the program's publisher
+/// is measured too), the cycle still makes no system-allocator call.
 #[test]
 fn a_running_stream_makes_no_system_allocator_call() {
     use motion_control::Client;
@@ -79,6 +79,8 @@ fn a_running_stream_makes_no_system_allocator_call() {
     }));
     ctl(p, &["jog", "Z", "--speed", "2", "--for", "0.5"]).expect_code(0);
     ctl(p, &["move", "Z", "--to", "0"]).expect_code(0);
+    // Z geared to X while X streams (every cycle steps a geared slave).
+    ctl(p, &["gear", "Z", "--master", "X", "--ratio", "-1"]).expect_code(0);
     {
         let mut c = Client::connect(p, None).expect("client");
         let mut s = c.stream("noalloc", &["X".to_string()]).expect("acquired");

@@ -216,6 +216,22 @@ fn the_installed_client_reads_status_homes_and_operates() {
     assert!(wait_for(Duration::from_secs(5), || !d
         .axis("X")
         .registration_armed));
+    // gear() through the package: Y (unhomed) follows X until stopped
+    client(&["--prefix", p, "--enable", "Y"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || d
+        .axis("Y")
+        .servo_action));
+    let gear = format!(
+        "from motion_supervisor_client import Supervisor, accepted, refusals\n\
+         r = Supervisor({p:?}).gear('Y', master='X', ratio=-0.5, clutch=50)\n\
+         print('gear', accepted(r), refusals(r))"
+    );
+    let out = run(python_path, &["-c", &gear]);
+    out.expect_code(0);
+    assert!(out.stdout.contains("gear True []"), "{}", out.stdout);
+    assert!(d.axis("Y").gearing);
+    client(&["--prefix", p, "--stop", "Y"]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || !d.axis("Y").gearing));
     // the stream through the package: a sine of amplitude 1 from where X stands
     let x0 = value(d.axis("X").position, "X");
     let sine = Path::new(EXAMPLES_DIR).join("stream_sine.py");

@@ -42,7 +42,8 @@
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use motion_bench::engine::{
-    homing_core, move_state, phases, repeated_demo as machine, seek_state, torque_state, Captured,
+    geared_state, homing_core, move_state, phases, repeated_demo as machine, seek_state,
+    torque_state, Captured,
 };
 use motion_homing::profile::{Kinematics, Profile, Ramp};
 use motion_homing::{Axis, Command, Phase, Status};
@@ -71,6 +72,21 @@ fn check(name: &str, c: &Captured, phase: Phase) {
         c.feedback.position,
         c.feedback.torque,
         cmd.velocity
+    );
+}
+
+/// Checks that stepping a copy of `c` is an operation's real work: a jog
+/// or a gear running on.
+fn check_op(name: &str, c: &Captured) {
+    let mut a = c.axis.clone();
+    let cmd = a.step(c.now, Some(&c.feedback), &c.request);
+    let s = a.status();
+    assert!(s.jogging || s.gearing, "{name}: neither jogging nor geared");
+    eprintln!(
+        "{name}: cycle {}, command v {:.1}, {}",
+        c.cycle,
+        cmd.velocity,
+        if s.gearing { "geared" } else { "jogging" }
     );
 }
 
@@ -110,6 +126,13 @@ fn engine_step(c: &mut Criterion) {
         check(&format!("engine_step/{name}"), &state, phase);
         time(name, &state, cycle);
         if name == "seek" {
+            // Beside it: a jog's step (a trapezoid at its cruise) and the
+            // step of a slave geared to that jog (the follower, every cycle).
+            let (master, slave) = geared_state();
+            for (id, s) in [("jog_master", master), ("geared", slave)] {
+                check_op(&format!("engine_step/{id}"), &s);
+                time(id, &s, cycle);
+            }
             time("seek_cold", &state, BatchSize::SmallInput);
         }
     }
@@ -347,6 +370,8 @@ fn summary(dir: &Path, since: SystemTime) {
         ("engine_step/move_trapezoid".into(), 1, Some(50.0)),
         ("engine_step/move_scurve".into(), 1, None),
         ("engine_step/monitor".into(), 1, Some(50.0)),
+        ("engine_step/jog_master".into(), 1, Some(50.0)),
+        ("engine_step/geared".into(), 1, Some(50.0)),
     ];
     for what in ["plan", "plan_turn", "stop_at", "sample"] {
         for kind in ["trapezoid", "scurve"] {

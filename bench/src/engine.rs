@@ -8,7 +8,10 @@
 
 use motion_config::{MachineConfig, DEMO_TOML};
 use motion_frames::{axis_to_command, feedback_to_axis, CommandFrame, FeedbackFrame};
-use motion_homing::{Axis, Feedback, Phase, Request};
+use motion_homing::{
+    Axis, AxisConfig, Feedback, GearSpec, HomeSequence, JogSpec, MasterFeed, Operation, Phase,
+    Request,
+};
 use motion_plant::Plant;
 use motion_supervisor::core::Core;
 use motion_supervisor::shared::{Ask, Control};
@@ -221,4 +224,91 @@ pub fn move_state(jerk: f64) -> Captured {
         fb = plant.step(&cmd, dt);
     }
     panic!("axis X: the move never started");
+}
+
+/// A master jogging (a trapezoid at its cruise, 10 u/s) and a slave geared
+/// to it at ratio 2, both homed at 0 against their plants: the inputs of
+/// the next step of each (the slave's request carries the master's news of
+/// that step, as the cycle hands it). `(master, slave)`.
+pub fn geared_state() -> (Captured, Captured) {
+    const T: u64 = 1_000_000;
+    let cfg = AxisConfig {
+        counts_per_unit: 1000.0,
+        home_sequence: HomeSequence::Immediate,
+        home_speed: 20.0,
+        home_acceleration: 500.0,
+        home_deceleration: 500.0,
+        travel_limits: Some((-100.0, 100.0)),
+        max_speed: 50.0,
+        cycle_ns: T,
+        ..AxisConfig::default()
+    };
+    let plant = motion_plant::PlantConfig::default();
+    let (mut m, mut s) = (Axis::new(cfg), Axis::new(cfg));
+    let (mut mp, mut sp) = (Plant::new(plant), Plant::new(plant));
+    let (mut mfb, mut sfb) = (mp.feedback(), sp.feedback());
+    let op = |o: Operation| Request {
+        op: Some(o),
+        ..Request::default()
+    };
+    let script = |k: u64| match k {
+        1 => (op(Operation::Enable), op(Operation::Enable)),
+        20 => {
+            let home = Request {
+                home: true,
+                ..Request::default()
+            };
+            (home, home)
+        }
+        30 => (
+            Request::default(),
+            op(Operation::Gear(GearSpec::to(0, 2.0))),
+        ),
+        40 => (
+            op(Operation::Jog(JogSpec {
+                lease: Some(5.0),
+                ..JogSpec::at(10.0)
+            })),
+            Request::default(),
+        ),
+        _ => (Request::default(), Request::default()),
+    };
+    let feed = |m: &Axis| MasterFeed {
+        commanded: m.last_command().position,
+        actual: m.raw_position(),
+        accel: m.acceleration_bound(),
+        stopped: false,
+        faulted: m.status().faulted,
+    };
+    for k in 0..200u64 {
+        let (mreq, sreq) = script(k);
+        let mc = m.step(k * T, Some(&mfb), &mreq);
+        let sreq = Request {
+            master: Some(feed(&m)),
+            ..sreq
+        };
+        let sc = s.step(k * T, Some(&sfb), &sreq);
+        (mfb, sfb) = (mp.step(&mc, 1e-3), sp.step(&sc, 1e-3));
+    }
+    assert!(m.status().jogging && s.status().gearing, "a geared pair");
+    let k = 200u64;
+    let master = Captured {
+        axis: m.clone(),
+        feedback: mfb,
+        now: k * T,
+        request: Request::default(),
+        cycle: k,
+    };
+    m.step(k * T, Some(&mfb), &Request::default());
+    let slave = Captured {
+        axis: s,
+        feedback: sfb,
+        now: k * T,
+        request: Request {
+            master: Some(feed(&m)),
+            ..Request::default()
+        },
+        cycle: k,
+    };
+    (master, slave)
 }

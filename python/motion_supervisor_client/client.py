@@ -8,6 +8,7 @@ package from PyPI (the same version as the Rust crate, 0.10.0).
     entry = sup.wait_homed("X", r)        # X's AxisStatusEntry once done
     sup.enable(["X"]); sup.move("X", 12.5); sup.stop(); sup.unhome(["X"])
     sup.move("X", 2.0, relative=True, speed=5.0)
+    sup.gear("Y", master="X", ratio=-0.5)  # Y follows X until a stop
     with sup.jog("X", speed=-2.0) as jog:  # hold to run
         jog.hold(1.5)                      # renews the lease for 1.5 s
     with sup.stream(["X"], owner="me") as s:
@@ -297,6 +298,14 @@ class Supervisor:
                         return None if p is None or math.isnan(p) else p
             time.sleep(0.02)
         raise TimeoutError(f"{axis}: nothing latched within {timeout} s")
+
+    def gear(self, slave: str, *args, **params) -> ControlResponse:
+        """MAG: from now on `slave` follows its master's position change
+        times the ratio until a stop, disable or fault of either ends it.
+        The parameters are the engine's (`OPERATIONS["gear"]`): master,
+        ratio, actual, clutch — `gear("Y", "X", -0.5)`,
+        `gear("Y", master="X", ratio=2, actual=True, clutch=100)`."""
+        return self.operate("gear", [slave], *args, **params)
 
     def stream(self, axes, owner: str = "python") -> "SetpointStream":
         """Takes `axes` over for the supervised setpoint stream."""

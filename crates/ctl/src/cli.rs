@@ -3,7 +3,7 @@
 use crate::spec_args::SpecArgs;
 use clap::{Args, Parser, Subcommand};
 use motion_config::args::{axis, runtime_dir, seconds, service_prefix};
-use motion_control::{ArmSpec, ChangeSpec, JogSpec, MoveSpec, RedefineSpec};
+use motion_control::{ArmSpec, ChangeSpec, GearSpec, JogSpec, MoveSpec, RedefineSpec};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -11,7 +11,7 @@ use std::path::PathBuf;
     name = "motionctl",
     version,
     about = "The operator's tool for a running motion-supervisor: home, stop, unhome, status, \
-             stats, trace; enable, disable, reset, jog, move, stream, arm, disarm.",
+             stats, trace; enable, disable, reset, jog, move, stream, arm, disarm, gear.",
     after_help = "The supervisor is found by its service prefix: --service-prefix, else the \
                   config's [supervisor] service_prefix (--config), else \"motion\".\n\n\
                   Exit codes:\n  0  done (home: every named axis homed with PC set; move: \
@@ -99,6 +99,12 @@ pub enum Command {
     Arm(ArmArgs),
     /// MDR: disarm the registration of the named axes (all: every axis).
     Disarm(AxesArgs),
+    /// MAG: from now on SLAVE (or a gantry) follows MASTER's commanded
+    /// (--actual: actual) position change times R, from where both stand;
+    /// --clutch ramps the slave's velocity in at A (the distance lost while
+    /// ramping is not made up). Returns once accepted; `stop` or `disable`
+    /// of either axis, or a fault of either, ends it (`status`: gearing).
+    Gear(GearArgs),
 }
 
 #[derive(Debug, Args)]
@@ -211,6 +217,19 @@ pub struct ArmArgs {
 }
 
 #[derive(Debug, Args)]
+pub struct GearArgs {
+    /// The slave: the axis or gantry that follows.
+    #[arg(value_name = "SLAVE", value_parser = axis)]
+    pub slave: String,
+    /// The gear's parameters (the engine's `GearSpec`): --master MASTER
+    /// --ratio R [--actual] [--clutch A].
+    #[command(flatten)]
+    pub spec: SpecArgs<GearSpec>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
 pub struct StreamArgs {
     /// The axes (or gantries) of the file's columns, in order.
     #[arg(value_name = "AXIS", required = true, value_parser = axis)]
@@ -275,6 +294,7 @@ impl Command {
             Command::Stream(a) => a.json,
             Command::Change(a) => a.json,
             Command::Redefine(a) => a.json,
+            Command::Gear(a) => a.json,
             Command::Stats(a) => a.json,
             Command::Trace(a) => a.json,
         }

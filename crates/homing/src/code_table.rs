@@ -926,6 +926,19 @@ pub const TABLE: &[Code] = &[
          position, its offset or its soft limits would lie beyond ±`max_position`.",
     )
     .remedy("Give a finite position (`--position P`) or shift (`--by D`) of a sane size."),
+    code(
+        ERR_REDEFINE_REFUSED,
+        EX_REDEFINE_GEARED,
+        &[R],
+        "redefine refused: the axis is geared (master or slave)",
+    )
+    .ours()
+    .cause(
+        "Redefine position on an axis that follows a master, or that another axis \
+         follows: the gear follows its positions, so redefining them would move the \
+         slave.",
+    )
+    .remedy("Stop the gearing (`motionctl stop SLAVE`), then redefine."),
     code(ERR_REDEFINE_REFUSED, 0, &[R], "redefine position refused")
         .any()
         .ours()
@@ -976,6 +989,88 @@ pub const TABLE: &[Code] = &[
         .ours()
         .cause("A registration was refused; nothing was armed.")
         .remedy("See the EXERR's row."),
+    code(
+        ERR_GEARING,
+        EX_GEAR_SOFT_LIMIT,
+        &[F],
+        "gearing stopped: the slave would pass a travel limit",
+    )
+    .ours()
+    .cause(
+        "A geared slave (homed, linear, `travel_limits`) could no longer have stopped \
+         inside its travel limits at `max_deceleration` had it gone on following: it \
+         stopped, ending inside, and its master was stopped too.",
+    )
+    .remedy("Move the master back so the slave's path stays inside its limits; `reset`."),
+    code(
+        ERR_GEARING,
+        EX_GEAR_CANNOT_FOLLOW,
+        &[F],
+        "gearing stopped: the slave cannot follow its master",
+    )
+    .ours()
+    .cause(
+        "The geared position ran ahead of the slave further than it can catch up: the \
+         master × ratio is faster than the slave's speed cap (`max_speed`; \
+         `unhomed_speed` while not homed), or changes speed harder than the slave may \
+         (its `stream_acceleration`).",
+    )
+    .remedy("Lower the ratio or the master's speed and acceleration; `reset`."),
+    code(
+        ERR_GEARING,
+        EX_GEAR_MASTER_FAULTED,
+        &[F, R],
+        "gearing: the master is faulted",
+    )
+    .ours()
+    .cause("The master faulted while the slave followed it (or was faulted at the start).")
+    .remedy("Clear the master's fault (`reset` both axes), then gear again."),
+    code(
+        ERR_GEARING,
+        EX_GEAR_SELF,
+        &[R],
+        "gearing refused: the master is the slave",
+    )
+    .ours()
+    .cause("`gear` named the slave as its own master.")
+    .remedy("Name another axis with `--master`."),
+    code(
+        ERR_GEARING,
+        EX_GEAR_MASTER_UNAVAILABLE,
+        &[F, R],
+        "gearing: the master's position is not available",
+    )
+    .ours()
+    .cause(
+        "With `--actual`, the master has no valid actual position (its feedback is lost \
+         or not yet there); or the cycle could not read the master.",
+    )
+    .remedy("Restore the master's feedback, or gear on its command (without `--actual`)."),
+    code(
+        ERR_GEARING,
+        EX_GEAR_CHAINED,
+        &[R],
+        "gearing refused: chained gearing",
+    )
+    .ours()
+    .cause(
+        "The master is itself geared to another axis, or the slave is the master of a \
+         geared axis: gearing is one level deep.",
+    )
+    .remedy("Gear every slave to the first master directly (ratios multiply)."),
+    code(ERR_GEARING, 0, &[F, R], "gearing refused or stopped")
+        .any()
+        .ours()
+        .cause("A gear was refused, or a geared slave stopped with an error.")
+        .remedy("See the EXERR's row; `reset` after a fault."),
+    code(
+        ERR_PARAMETER_OUT_OF_RANGE,
+        EX_PARAM_RATIO,
+        &[R],
+        "parameter out of range: gear ratio",
+    )
+    .cause("A gear ratio that is not finite, or is 0.")
+    .remedy("Give a finite, non-zero `--ratio` (negative: the opposite direction)."),
 ];
 
 /// The row of `(err, exerr)`: its own, else the one for any EXERR of `err`.

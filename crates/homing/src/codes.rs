@@ -163,6 +163,9 @@ pub const EX_REDEFINE_NOT_HOMED: u16 = 1;
 /// The redefined position, shift or soft limits would not be finite, or
 /// would lie beyond ±`max_position`.
 pub const EX_REDEFINE_NOT_FINITE: u16 = 2;
+/// The axis is geared, as slave or as master: the gear follows its
+/// positions (refused by the cycle, which sees both ends of a gear).
+pub const EX_REDEFINE_GEARED: u16 = 3;
 /// A registration (MAR, `Operation::Arm`) was refused (ours): nothing was
 /// armed. EXERR: `EX_REGISTRATION_*`. (Homing in process refuses it with
 /// ERR 16 as every operation.)
@@ -176,3 +179,29 @@ pub const EX_REGISTRATION_NO_MARKER: u16 = 2;
 pub const EX_REGISTRATION_WINDOW_NOT_FINITE: u16 = 3;
 /// The window's LO lies above its HI.
 pub const EX_REGISTRATION_WINDOW_EMPTY: u16 = 4;
+
+// --- gearing (MAG) -------------------------------------------------------
+
+/// Gearing (ours): a geared slave stopped with an error, or a gear refused
+/// for what only gearing has (EXERR: `EX_GEAR_*`).
+pub const ERR_GEARING: u16 = 1025;
+/// The slave, going on, could no longer stop inside its travel limits at
+/// `max_deceleration`: it stops (ending inside) and its master stops too.
+pub const EX_GEAR_SOFT_LIMIT: u16 = 1;
+/// The slave lags the geared position further than it can catch up within
+/// its speed cap and acceleration bound.
+pub const EX_GEAR_CANNOT_FOLLOW: u16 = 2;
+/// The master faulted (or is faulted at the start): the slave stops.
+pub const EX_GEAR_MASTER_FAULTED: u16 = 3;
+/// The master is the slave itself.
+pub const EX_GEAR_SELF: u16 = 4;
+/// The master's position is not available (no valid actual position with
+/// `--actual`, or the cycle has nothing of the master).
+pub const EX_GEAR_MASTER_UNAVAILABLE: u16 = 5;
+/// Chained gearing: the master is itself geared, or the slave is the
+/// master of a geared axis.
+pub const EX_GEAR_CHAINED: u16 = 6;
+
+// EXERR under ERR 13, for gearing.
+/// A gear ratio that is not finite or is 0.
+pub const EX_PARAM_RATIO: u16 = 9;

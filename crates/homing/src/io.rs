@@ -4,7 +4,7 @@
 //! axis-position offset itself. The operations' types are in
 //! [`operation`](crate::operation).
 
-use crate::operation::{Operation, Setpoint};
+use crate::operation::{MasterFeed, Operation, Setpoint};
 
 /// A position latch as the drive reports it (CiA 402 touch probe style).
 ///
@@ -166,4 +166,7 @@ pub struct Request {
     /// alive: the loss of feedback that follows names the drive (ERR 12 /
     /// EXERR 45) instead of the I/O process, and the status shows it.
     pub drive_lost: bool,
+    /// A geared slave's master, this cycle (`None`: not geared, or the
+    /// cycle has nothing of it): what the slave follows.
+    pub master: Option<MasterFeed>,
 }

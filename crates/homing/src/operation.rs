@@ -23,7 +23,7 @@
 //! units/s, accelerations in units/s², times in ns.
 
 use crate::config::AxisConfig;
-use crate::params::{Carried, Fallback, Form, Param, Refused, Spec, Unit, Why};
+use crate::params::{AxisRef, Carried, Fallback, Form, Param, Refused, Spec, Unit, Why};
 
 /// Declares [`Operation`], its verbs [`OpKind`] (one row each: the
 /// number a status frame carries, the spelling, the OPC UA method's name,
@@ -441,6 +441,17 @@ operations! {
         all: true,
         summary: "MDR: disarm the axis's registration",
     }
+    /// MAG / MC_GearIn ([`GearSpec`]): from now on the axis follows its
+    /// master's position change times a ratio (`axis::ops::gear`).
+    Gear(GearSpec) = 13 {
+        name: "gear",
+        title: "Gear",
+        client: true,
+        moves: true,
+        held: false,
+        all: false,
+        summary: "MAG: this axis follows Master's position change times Ratio until stopped",
+    }
 }
 
 impl OpKind {
@@ -639,6 +650,70 @@ impl ArmSpec {
     }
 }
 
+crate::op_spec! {
+    /// MAG / MC_GearIn: from now on the axis (the slave) follows its
+    /// master's commanded (or, with `actual`, actual) position change times
+    /// `ratio`, from where both stand (no jump). With `clutch` the slave's
+    /// velocity ramps in to the geared velocity at that acceleration and
+    /// then locks; the distance lost while ramping is not made up (as
+    /// Logix MAG's clutch and PLCopen MC_GearIn do). It runs until a stop,
+    /// a disable or a fault on either axis ends it.
+    pub struct GearSpec {
+        /// The master axis (by name; the engine sees its index).
+        master: AxisRef = Param::new("Master", Unit::None).flag("master", "MASTER"),
+        /// Slave units per master unit, finite and not 0 (negative: the
+        /// slave runs the opposite way).
+        ratio: f64 = Param::new("Ratio", Unit::None).flag("ratio", "R"),
+        /// Follow the master's actual position instead of its command.
+        actual: bool = Param::new("Actual", Unit::None).flag("actual", ""),
+        /// Clutch: ramp the slave's velocity in at this acceleration,
+        /// units/s²; left out: the slave locks on at once.
+        clutch: Option<f64> = Param::new("Clutch", Unit::Acceleration).flag("clutch", "A"),
+    }
+}
+
+impl GearSpec {
+    /// Gearing to the axis of index `master` at `ratio`, on its command,
+    /// without a clutch.
+    pub fn to(master: u16, ratio: f64) -> Self {
+        GearSpec {
+            master: AxisRef::Index(master),
+            ratio,
+            actual: false,
+            clutch: None,
+        }
+    }
+
+    /// The master's index, once the control thread resolved its name.
+    pub fn master_index(&self) -> Option<u16> {
+        match self.master {
+            AxisRef::Index(i) => Some(i),
+            AxisRef::Name(_) => None,
+        }
+    }
+}
+
+/// What a geared slave's engine is given of its master each cycle
+/// (`Request::master`): the cycle reads it from the master's engine after
+/// the master stepped in the same cycle, so the slave follows without a
+/// cycle's lag. Nothing else crosses between the two engines.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MasterFeed {
+    /// The master's command position after its step, raw (never wrapped).
+    pub commanded: f64,
+    /// The master's newest valid actual position, raw (`None`: none).
+    pub actual: Option<f64>,
+    /// The hardest the master's motion may change its speed, units/s²
+    /// ([`Axis::acceleration_bound`](crate::Axis::acceleration_bound)).
+    pub accel: f64,
+    /// The master was stopped (MAS), disabled, or began homing in this
+    /// cycle: the gearing ends, the slave stops normally.
+    pub stopped: bool,
+    /// The master is faulted: the gearing ends, the slave stops with
+    /// ER 1025 / 3.
+    pub faulted: bool,
+}
+
 /// A jog's or move's speed, acceleration and deceleration as the engine
 /// plans with them, after [`Operation::resolve`]: a number still left out
 /// (no default configured) is NaN, which the operand checks refuse (13).
@@ -814,6 +889,9 @@ pub enum StopCause {
     /// The cycle monitor stopped the axis (ER 1021 / x): a command broke
     /// one of its invariants.
     Monitor = 11,
+    /// Gearing stopped the slave with an error (ER 1025: a travel limit
+    /// ahead, a master it cannot follow, the master's fault).
+    Gearing = 12,
 }
 
 crate::spellings!(StopCause {
@@ -829,6 +907,7 @@ crate::spellings!(StopCause {
     Released => "released",
     Shutdown => "shutdown",
     Monitor => "monitor",
+    Gearing => "gearing",
 });
 
 impl StopCause {

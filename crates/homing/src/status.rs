@@ -199,4 +199,7 @@ pub struct Status {
     /// Axis position of the edge the last registration latched (`None`
     /// from an arming until it latched).
     pub registration_position: Option<f64>,
+    /// GearingStatus: the axis follows its master (MAG), from the accepted
+    /// gear (a clutch ramping in included) until its stop begins.
+    pub gearing: bool,
 }

@@ -491,6 +491,100 @@ fn operations_make_no_allocation() {
     assert_eq!(during, 0, "allocator calls inside Axis::step");
 }
 
+#[test]
+fn gearing_makes_no_allocation() {
+    // A master jogged back and forth, a slave geared to it with a clutch,
+    // then at ratio 4 into its travel limit (1025 / 1), then geared on the
+    // master's actual position while the master's drive faults (1025 / 3).
+    const T: u64 = 1_000_000;
+    let cfg = AxisConfig {
+        counts_per_unit: 1000.0,
+        home_sequence: HomeSequence::Immediate,
+        home_speed: 20.0,
+        home_acceleration: 500.0,
+        home_deceleration: 500.0,
+        travel_limits: Some((-10.0, 10.0)),
+        max_speed: 50.0,
+        cycle_ns: T,
+        ..AxisConfig::default()
+    };
+    let (mut m, mut s) = (Axis::new(cfg), Axis::new(cfg));
+    let (mut mp, mut sp) = (
+        Plant::new(PlantConfig::default()),
+        Plant::new(PlantConfig::default()),
+    );
+    let (mut mfb, mut sfb) = (mp.feedback(), sp.feedback());
+    let op = |o: Operation| Request {
+        op: Some(o),
+        ..Request::default()
+    };
+    let jog = |speed: f64| {
+        op(Operation::Jog(JogSpec {
+            speed,
+            accel: Some(500.0),
+            decel: Some(500.0),
+            lease: Some(5.0),
+            jerk: None,
+        }))
+    };
+    let gear = |ratio: f64, actual: bool, clutch: Option<f64>| {
+        op(Operation::Gear(GearSpec {
+            actual,
+            clutch,
+            ..GearSpec::to(0, ratio)
+        }))
+    };
+    let home = Request {
+        home: true,
+        ..Request::default()
+    };
+    let (mut during, mut seen) = (0, [false; 3]);
+    for k in 0..4000u64 {
+        let (mreq, sreq) = match k {
+            1 => (op(Operation::Enable), op(Operation::Enable)),
+            10 => (home, home),
+            20 => (jog(2.0), gear(-1.5, false, Some(50.0))),
+            500 => (jog(-2.0), Request::default()),
+            1000 => (op(Operation::Stop), Request::default()),
+            1100 => (Request::default(), gear(4.0, false, None)),
+            1110 => (jog(5.0), Request::default()),
+            // The cycle stops the master of a faulted slave.
+            1700 => (op(Operation::Stop), Request::default()),
+            2500 => (op(Operation::Reset), op(Operation::Reset)),
+            2510 => (Request::default(), gear(1.0, true, None)),
+            2520 => (jog(-3.0), Request::default()),
+            _ => (Request::default(), Request::default()),
+        };
+        let stopped = matches!(mreq.op, Some(Operation::Stop));
+        let (mut mc, mut sc) = (Command::default(), Command::default());
+        during += counted(|| {
+            mc = m.step(k * T, Some(&mfb), &mreq);
+            let feed = MasterFeed {
+                commanded: mc.position,
+                actual: m.raw_position(),
+                accel: m.acceleration_bound(),
+                stopped,
+                faulted: m.status().faulted,
+            };
+            let sreq = Request {
+                master: Some(feed),
+                ..sreq
+            };
+            sc = s.step(k * T, Some(&sfb), &sreq);
+        });
+        (mfb, sfb) = (mp.step(&mc, 0.001), sp.step(&sc, 0.001));
+        if k == 2700 {
+            mp.inject_fault();
+        }
+        let st = s.status();
+        seen[0] |= st.gearing;
+        seen[1] |= st.exerr == codes::EX_GEAR_SOFT_LIMIT;
+        seen[2] |= st.exerr == codes::EX_GEAR_MASTER_FAULTED;
+    }
+    assert_eq!(seen, [true; 3]);
+    assert_eq!(during, 0, "allocator calls inside Axis::step");
+}
+
 /// A move the travel limits refuse.
 fn move_outside() -> Operation {
     Operation::Move(MoveSpec {

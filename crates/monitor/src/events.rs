@@ -80,6 +80,10 @@ impl Seen {
         let (req, st) = (c.request, c.status);
         let accepted = match req.op {
             Some(op) if st.op.id != self.op_id && st.op.kind == op.kind() => Some(op),
+            // answered in place (a change of dynamics, a registration):
+            // the running operation keeps its id; accepted when the engine
+            // left no refusal
+            Some(op) if op.kind().in_place() && st.op.refused.is_none() => Some(op),
             _ => None,
         };
         let fresh = c.feedback.filter(|f| valid(f)).map(|f| f.drive);

@@ -21,6 +21,10 @@ pub(crate) enum Asked {
     /// (the stream start counts as one), and whether it was released (it
     /// then lands on that setpoint).
     Stream { arrived_ns: u64, released: bool },
+    /// Gearing (MAG): the slave follows its master step by step, within
+    /// the bounds of the axis's step-by-step motions (its speed cap,
+    /// `stream_acceleration`), as long as the engine shows GearingStatus.
+    Gear,
 }
 
 /// What is allowed now: the motion asked for, and whether it is coming to
@@ -104,6 +108,22 @@ impl Mode {
                     released: false,
                 })
             }
+            Some(Operation::Gear(_)) => m = run(Asked::Gear),
+            // MCD: the running jog's or move's new dynamics (left out: as
+            // they were). A lower speed is reached at the deceleration, as
+            // after any drop of the cap (the envelope).
+            Some(Operation::Change(c)) => {
+                if let Asked::Op {
+                    speed,
+                    accel,
+                    decel,
+                } = &mut m.asked
+                {
+                    *speed = c.speed.unwrap_or(*speed).abs();
+                    *accel = c.accel.unwrap_or(*accel);
+                    *decel = c.decel.unwrap_or(*decel);
+                }
+            }
             Some(Operation::StreamEnd) => {
                 if let Asked::Stream { released, .. } = &mut m.asked {
                     *released = true;
@@ -123,6 +143,7 @@ impl Mode {
                 }
                 st.streaming || *released
             }
+            Asked::Gear => st.gearing,
             Asked::Rest | Asked::Homing => false,
         };
         if !running {
@@ -150,6 +171,12 @@ impl Mode {
                 accel,
                 decel.max(b.max_deceleration),
                 decel,
+            ),
+            Asked::Gear => (
+                b.speed_cap(homed),
+                b.stream_acceleration,
+                b.stream_acceleration.max(b.max_deceleration),
+                b.max_deceleration,
             ),
             Asked::Stream { arrived_ns, .. } => {
                 // A program that stops sending is stopped within the

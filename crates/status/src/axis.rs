@@ -229,11 +229,14 @@ crate::status_table! {
     /// an arming until it latched).
     registration_position: Maybe @ 15, Units, "registration_position", -,
         "RegistrationPosition", |s| s.status.registration_position;
+    /// GearingStatus: the axis follows its master (MAG), from the accepted
+    /// gear until its stop begins.
+    gearing: Flag @ 35, None, "gearing", "G", "GearingStatus", |s| s.status.gearing;
 }
 
 /// The rows that say the axis is in motion by an operation (a jog, a
-/// move, a stream); [`motion_mask`] is their bits.
-pub const IN_MOTION: &[&str] = &["jogging", "moving", "streaming"];
+/// move, a stream, a gear); [`motion_mask`] is their bits.
+pub const IN_MOTION: &[&str] = &["jogging", "moving", "streaming", "gearing"];
 
 /// The `flags` bits of the rows `names`.
 pub fn mask(names: &[&str]) -> u64 {

@@ -46,7 +46,7 @@ pub enum Type {
     U32,
     /// An enumeration's number in an `ints` slot: JSON its spelling; OPC UA
     /// a Byte with `EnumStrings`. The function names a number (the enum's
-    /// `spellings!` table); `None` past the last.
+    /// `spellings!` table); `None` for a number without a variant.
     Enum(fn(u32) -> Option<&'static str>),
 }
 
@@ -72,10 +72,17 @@ impl Type {
         }
     }
 
-    /// An enumeration's spellings by number, from 0 (empty for other types).
+    /// An enumeration's spellings by number, from 0 to its last (a number
+    /// without a variant: `""`, so an enum whose numbers have a gap keeps
+    /// every later spelling at its number); empty for other types.
     pub fn enum_names(&self) -> Vec<&'static str> {
         match self {
-            Type::Enum(name) => (0..).map_while(name).collect(),
+            Type::Enum(name) => {
+                let last = (0..=u32::from(u8::MAX)).rfind(|&n| name(n).is_some());
+                last.map_or(Vec::new(), |l| {
+                    (0..=l).map(|n| name(n).unwrap_or("")).collect()
+                })
+            }
             _ => Vec::new(),
         }
     }

@@ -2,6 +2,7 @@
 
 mod arm;
 mod csv;
+mod gear;
 mod home;
 mod jog;
 mod moves;
@@ -51,6 +52,7 @@ pub fn run(cli: Cli) -> i32 {
         Command::Stream(a) => stream::stream(&mut client, &a),
         Command::Change(a) => simple::change(&mut client, &a),
         Command::Redefine(a) => simple::redefine(&mut client, &a),
+        Command::Gear(a) => gear::gear(&mut client, &a),
         Command::Stats(a) => stats::stats(&mut client, &a),
         Command::Trace(a) => trace::trace(&mut client, &a),
         Command::Arm(a) => arm::arm(&mut client, &a),

@@ -324,6 +324,7 @@ impl Axis {
 
     fn requests(&mut self, now: u64, req: &Request) {
         let prev = self.request;
+        self.ops.master = req.master;
         self.request = Kept {
             home: req.home,
             stop: req.stop,
@@ -641,7 +642,7 @@ impl Axis {
 
     fn output(&mut self, now: u64) -> Command {
         let (mut p, mut v) = self.profile.at(now);
-        if let Some(vs) = self.stream_velocity(now) {
+        if let Some(vs) = self.stepwise_command_velocity(now) {
             v = vs;
         }
         if !p.is_finite() || !v.is_finite() {

@@ -74,7 +74,7 @@ impl Core {
                 exerr: 0,
             });
         }
-        if s.jogging || s.moving || s.streaming {
+        if s.jogging || s.moving || s.streaming || s.gearing {
             return Some(Refusal::Instruction {
                 err: ERR_EXECUTION_COLLISION,
                 exerr: 0,
@@ -132,9 +132,10 @@ impl Core {
     /// Stop (MAS) the axes of `mask`; a rising edge still pending is dropped.
     fn stop(&mut self, mut ack: Ack, mask: u64) -> Ack {
         for i in named(mask, self.slots.len()) {
-            let rung = &mut self.slots[i].rung;
-            rung.request.stop = true;
-            rung.pending = 0;
+            let slot = &mut self.slots[i];
+            slot.rung.request.stop = true;
+            slot.rung.pending = 0;
+            slot.operator_stop = true;
             ack.axes[i] = AxisAck::Accepted;
         }
         ack
@@ -196,6 +197,7 @@ impl Core {
             s.rung.pending = 0;
             s.rung.request.home = false;
             s.rung.request.stop = true;
+            s.operator_stop = true;
         }
     }
 }

@@ -21,9 +21,13 @@
 //! * `ops` — the operations around homing (enable … move, the stream's
 //!   acquire and release): delivery, the engines' answers, gantries whole.
 //! * [`stream`] — the setpoint stream's owners and intake.
+//! * `gear` — gearing across axes: slaves stepped after their masters with
+//!   their news, the rules only the cycle sees, a faulted slave's master
+//!   stopped.
 
 mod control;
 pub mod gantry;
+mod gear;
 pub mod link;
 mod ops;
 pub mod sequence;
@@ -175,6 +179,7 @@ impl Core {
         self.hand_setpoints();
         self.engines(now_ns, stalled);
         self.op_upkeep();
+        self.gear_upkeep();
         info
     }
 
@@ -281,22 +286,36 @@ impl Core {
     }
 
     /// Stage 4: every engine steps (leaving: once everything is at rest,
-    /// the drives are disabled); an armed trace records its axis.
+    /// the drives are disabled) — geared slaves after every other axis,
+    /// with their master's news of this cycle (`gear`); an armed trace
+    /// records its axis.
     fn engines(&mut self, now_ns: u64, stalled: bool) {
         let shutdown = self.exiting && self.all_at_rest();
         self.trace_out = None;
-        for (i, slot) in self.slots.iter_mut().enumerate() {
-            let started = slot.step(now_ns, stalled, shutdown);
-            if let Some(r) = self.tracer.record(
-                now_ns,
-                i,
-                &slot.engine,
-                &slot.command,
-                slot.feedback(),
-                started,
-            ) {
-                self.trace_out = Some(r);
-            }
+        let n = self.slots.len();
+        let slaves = self.slaves();
+        for i in named(!slaves, n) {
+            self.step_axis(i, now_ns, stalled, shutdown);
+        }
+        for i in named(slaves, n) {
+            self.feed_slave(i);
+            self.step_axis(i, now_ns, stalled, shutdown);
+        }
+    }
+
+    /// One engine's step, and the trace's record of it.
+    fn step_axis(&mut self, i: usize, now_ns: u64, stalled: bool, shutdown: bool) {
+        let slot = &mut self.slots[i];
+        let started = slot.step(now_ns, stalled, shutdown);
+        if let Some(r) = self.tracer.record(
+            now_ns,
+            i,
+            &slot.engine,
+            &slot.command,
+            slot.feedback(),
+            started,
+        ) {
+            self.trace_out = Some(r);
         }
         self.gantries_together(now_ns);
     }
@@ -387,6 +406,8 @@ impl Core {
 mod campaign;
 #[cfg(test)]
 mod fuzz;
+#[cfg(test)]
+mod gear_tests;
 #[cfg(test)]
 mod ops_tests;
 #[cfg(test)]

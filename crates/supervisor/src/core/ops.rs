@@ -79,7 +79,7 @@ impl Core {
         if (motion || *op == Operation::Enable) && !self.links[slot.io].attached() {
             return Some(Refusal::IoNotAttached);
         }
-        None
+        self.gear_refusal(i, op)
     }
 
     /// Delivers `op` (as the client gave it: each engine fills what was
@@ -322,7 +322,7 @@ impl Core {
             for i in named(sides & !over, self.slots.len()) {
                 let slot = &mut self.slots[i];
                 let s = slot.status();
-                if s.jogging || s.moving || s.streaming {
+                if s.jogging || s.moving || s.streaming || s.gearing {
                     slot.rung.request.op = Some(Operation::Stop);
                 }
                 slot.jog_token = 0;

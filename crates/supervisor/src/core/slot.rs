@@ -15,7 +15,7 @@
 //! (`Axis::monitor_tripped`).
 
 use motion_frames::{axis_to_feedback, AxisFeedback, SW_DRIVE_LOST, SW_NO_DATA};
-use motion_homing::{Axis, Command, Feedback, Phase, Request, Status};
+use motion_homing::{Axis, Command, Feedback, Operation, Phase, Request, Status};
 use motion_monitor::{Cycle, Invariant, Monitor, Side, Trip};
 
 use super::link::LinkCycle;
@@ -177,6 +177,14 @@ pub struct AxisSlot {
     /// `Status::faulted` after the previous step (its rising edge stops a
     /// gantry's other sides).
     pub(super) was_faulted: bool,
+    /// An operator's stop (`stop`, leaving) reaches the engine in this
+    /// step: for gearing, a stop of this axis as a master.
+    pub(super) operator_stop: bool,
+    /// In this step the axis was stopped by an operator, disabled, or began
+    /// homing: a slave geared to it stops (`MasterFeed::stopped`).
+    pub(super) halted: bool,
+    /// It faulted in this step while geared: its master (index) stops.
+    pub(super) stop_master: Option<usize>,
 }
 
 impl AxisSlot {
@@ -200,6 +208,9 @@ impl AxisSlot {
             jog_op: 0,
             op_before: 0,
             was_faulted: false,
+            operator_stop: false,
+            halted: false,
+            stop_master: None,
         }
     }
 
@@ -253,6 +264,12 @@ impl AxisSlot {
         let started = self.rung.edge(self.engine.status());
         self.rung.request.shutdown = shutdown;
         self.rung.request.stalled = stalled;
+        let stopped = self.operator_stop
+            || matches!(
+                self.rung.request.op,
+                Some(Operation::Stop | Operation::Disable)
+            );
+        let (geared, faulted) = (self.engine.gear_master(), self.status().faulted);
         let request = &self.rung.request;
         self.engine_command = (self.engine).step(now_ns, self.feedback.as_ref(), request);
         let trips = self.monitor.trips();
@@ -268,6 +285,12 @@ impl AxisSlot {
         if self.monitor.trips() != trips {
             self.tell_engine(now_ns);
         }
+        self.halted = stopped || started;
+        self.operator_stop = false;
+        self.stop_master = geared
+            .filter(|_| !faulted && self.status().faulted)
+            .map(usize::from);
+        self.rung.request.master = None;
         // The status shows only what the engine took: a refused sample
         // (not finite, out of range, implausible) is not a reading.
         if self.feedback.is_some() && self.engine.sampled_ns() == Some(now_ns) {

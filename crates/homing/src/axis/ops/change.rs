@@ -68,7 +68,8 @@ impl Axis {
                 let profile = Profile::move_from(t, k, mv.target, speed, mv.ramp());
                 (profile, Run::Move(mv))
             }
-            Run::Stream(_) => return Err(super::rules::COLLISION),
+            // A stream or a gear: their dynamics are the follower's, not a plan.
+            Run::Stream(_) | Run::Gear(_) => return Err(super::rules::COLLISION),
             Run::Halt(_) => return Err((ERR_EXECUTION_COLLISION, EX_NOTHING_TO_CHANGE)),
         };
         self.profile.set(profile);

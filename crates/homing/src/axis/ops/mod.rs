@@ -9,9 +9,10 @@
 //!   order: home in process 16, faulted 20, shutdown 12/12, not a servo
 //!   axis 5/1, no feedback 12/40, servo off 5) and the operand checks (13);
 //! * `power`: enable, disable, reset, the drive's faults and power stage;
-//! * `jog`, `moves`, `stream`: each motion, its start and its progress;
-//!   `change`: MCD, new dynamics for the running jog or move;
-//!   `follower`: the stream's bounded follower (one cycle of arithmetic);
+//! * `jog`, `moves`, `stream`, `gear`: each motion, its start and its
+//!   progress; `change`: MCD, new dynamics for the running jog or move;
+//!   `follower`: the bounded follower of the stream and the gear (one
+//!   cycle of arithmetic);
 //! * `limits`: software travel limits (homed, linear) and the hardware
 //!   limit switches;
 //! * `redefine`: redefine position (MRP), the offset alone;
@@ -65,6 +66,7 @@
 
 mod change;
 mod follower;
+mod gear;
 mod jog;
 mod limits;
 pub(super) mod motion;
@@ -98,6 +100,8 @@ pub(in crate::axis) struct Ops {
     /// The travel limits (raw) in force after the previous step: a stop
     /// planned in a step that lost the reference keeps them.
     pub limits_before: Option<(f64, f64)>,
+    /// This step's master of a geared slave (`Request::master`).
+    pub master: Option<crate::operation::MasterFeed>,
 }
 
 impl Axis {
@@ -131,6 +135,7 @@ impl Axis {
                 self.disarm_registration();
                 Ok(())
             }
+            Operation::Gear(g) => self.gear_op(now, &g),
         };
         match result {
             Err(code) => self.status.op.refused = Some(code),
@@ -187,22 +192,15 @@ impl Axis {
 
     /// The command state a motion continues from: time, and raw position,
     /// velocity and acceleration (the exact state of the profile: a re-plan
-    /// from it steps in none of them). A stream's command is made step by
-    /// step (`follower`), so a stream continues from the last command, at
+    /// from it steps in none of them). A stream's (and a gear's) command is
+    /// made step by step (`follower`), so it continues from the last command, at
     /// the previous step, with the velocity it had then (its acceleration
     /// taken as 0: its stops have no jerk): a stop planned from there
     /// continues the motion the drive was last given.
     fn motion_state(&mut self, now: u64) -> (u64, Kinematics) {
-        if let State::Motion(Motion {
-            run: Run::Stream(st),
-            ..
-        }) = self.state
-        {
+        if let Some(v) = self.stepwise_velocity() {
             if let Some(t) = self.ops.prev_step_ns {
-                return (
-                    t,
-                    Kinematics::moving(self.last_command.position, st.velocity),
-                );
+                return (t, Kinematics::moving(self.last_command.position, v));
             }
         }
         (now, self.profile.state(now))
@@ -218,8 +216,23 @@ impl Axis {
             .max(self.limits.stream_acceleration)
     }
 
+    /// The command's velocity over the last step of a motion made step by
+    /// step (a stream, a gear), whose profile only holds each command.
+    fn stepwise_velocity(&self) -> Option<f64> {
+        match self.state {
+            State::Motion(Motion {
+                run: Run::Stream(st),
+                ..
+            }) => Some(st.velocity),
+            State::Motion(Motion {
+                run: Run::Gear(g), ..
+            }) => Some(g.velocity),
+            _ => None,
+        }
+    }
+
     /// The deceleration of the running motion (a jog's or move's own, a
-    /// stream's stop's, a stop's; else `max_deceleration`).
+    /// stream's stop's, a stop's; else — a gear too — `max_deceleration`).
     fn running_decel(&self) -> f64 {
         match self.state {
             State::Motion(Motion {
@@ -360,6 +373,7 @@ impl Axis {
             Run::Jog(j) => self.advance_jog(now, m.op, j),
             Run::Move(mv) => self.advance_move(now, m.op, mv),
             Run::Stream(st) => self.advance_stream(now, m.op, st),
+            Run::Gear(g) => self.advance_gear(now, m.op, g),
             Run::Halt(h) if self.profile.is_done(now) => {
                 self.state = State::Idle;
                 let awaited = self.ops.await_rest.is_some_and(|(id, _)| id == m.op);
@@ -388,18 +402,15 @@ impl Axis {
 
     /// The status bits of the operations, after a step.
     pub(super) fn report_ops(&mut self) {
-        let (jog, mv, stream, halt) = match self.state {
-            State::Motion(m) => match m.run {
-                Run::Jog(_) => (true, false, false, false),
-                Run::Move(_) => (false, true, false, false),
-                Run::Stream(_) => (false, false, true, false),
-                Run::Halt(_) => (false, false, false, true),
-            },
-            _ => (false, false, false, false),
+        let run = match self.state {
+            State::Motion(m) => Some(m.run),
+            _ => None,
         };
-        self.status.jogging = jog;
-        self.status.moving = mv;
-        self.status.streaming = stream;
+        let halt = matches!(run, Some(Run::Halt(_)));
+        self.status.jogging = matches!(run, Some(Run::Jog(_)));
+        self.status.moving = matches!(run, Some(Run::Move(_)));
+        self.status.streaming = matches!(run, Some(Run::Stream(_)));
+        self.status.gearing = matches!(run, Some(Run::Gear(_)));
         self.status.stopping |= halt;
         self.status.servo_action = self.servo_action();
         let (neg, pos) = self.last.map_or((false, false), |s| self.switches(&s));
@@ -407,22 +418,21 @@ impl Axis {
         self.status.limit_positive = pos;
     }
 
-    /// The velocity the command carries while streaming, instead of the
-    /// profile's (which holds each step's command): the feed-forward while
-    /// the command is on the reference's segment, else the command's own
-    /// velocity over the step.
-    pub(super) fn stream_velocity(&self, now: u64) -> Option<f64> {
-        let State::Motion(Motion {
-            run: Run::Stream(st),
-            ..
-        }) = self.state
-        else {
-            return None;
-        };
-        Some(match st.feed_forward {
-            Some(ff) if st.on_reference && now <= st.seg_end_ns => ff,
-            _ => st.velocity,
-        })
+    /// The velocity the command carries while streaming or geared, instead
+    /// of the profile's (which holds each step's command): a stream's
+    /// feed-forward while the command is on the reference's segment, else
+    /// the command's own velocity over the step.
+    pub(super) fn stepwise_command_velocity(&self, now: u64) -> Option<f64> {
+        match self.state {
+            State::Motion(Motion {
+                run: Run::Stream(st),
+                ..
+            }) => Some(match st.feed_forward {
+                Some(ff) if st.on_reference && now <= st.seg_end_ns => ff,
+                _ => st.velocity,
+            }),
+            _ => self.stepwise_velocity(),
+        }
     }
 
     /// A motion of an operation is under way (not its stop).
@@ -430,7 +440,7 @@ impl Axis {
         matches!(
             self.state,
             State::Motion(Motion {
-                run: Run::Jog(_) | Run::Move(_) | Run::Stream(_),
+                run: Run::Jog(_) | Run::Move(_) | Run::Stream(_) | Run::Gear(_),
                 ..
             })
         )

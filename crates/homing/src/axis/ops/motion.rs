@@ -22,6 +22,34 @@ pub(in crate::axis) enum Run {
     Stream(Stream),
     /// Coming to rest (a stop, a lease, a release, a disable, a fault).
     Halt(Halt),
+    /// Following a master (MAG).
+    Gear(Gear),
+}
+
+/// Gearing: what the slave follows and how far it got. The geared
+/// position is `slave_from + ratio × (master − master_from)` once locked.
+#[derive(Clone, Copy, Debug)]
+pub(in crate::axis) struct Gear {
+    /// The master's axis index (the cycle feeds its position).
+    pub master: u16,
+    pub ratio: f64,
+    /// Follows the master's actual position (else its command).
+    pub actual: bool,
+    /// The clutch's acceleration (0: none).
+    pub clutch: f64,
+    /// Locked on: following the geared position (else the clutch is
+    /// still ramping the velocity in).
+    pub locked: bool,
+    /// Master and slave (raw) positions the geared position counts from.
+    pub master_from: f64,
+    pub slave_from: f64,
+    /// The master's position at the previous step (raw).
+    pub master_prev: f64,
+    /// The command's velocity over the last step, units/s.
+    pub velocity: f64,
+    /// The step the gear was accepted in: the master's velocity is known
+    /// from the next one on.
+    pub since_ns: u64,
 }
 
 /// A jog: the request, and how its profile was planned.

@@ -12,8 +12,9 @@
 //! | stream start | 3 on an axis in motion (stopping too) · then 13/7 as above · 1019/7 not homed (unless `stream_unhomed`) · 13/1 a speed cap of 0 (unhomed, no `unhomed_speed`) · 13/3 no `max_deceleration` |
 //! | setpoint (an axis fault, 1019) | 1 not finite · 2 outside the travel limits · 3 faster than the speed cap (unhomed: `unhomed_speed`) on the program's timeline, or the command held back by it further than it can follow · 4 a change of velocity above `stream_acceleration` on the program's timeline, or the command held back by it further than it can follow · 5 nothing for `stream_timeout_ms` since the last one arrived · 6 out of order · 7 not homed |
 //! | change (`change.rs`) | as jog's first two rows, then 3 streaming · 3/1 no jog or move runs · 13/1..3, 13/8 operands · 13/4 a stop that would end outside |
+//! | gear | as stream start, then 3 on an axis in motion (stopping too) · 13/9 ratio not finite or 0 · 13/2 clutch not above 0 · 13/3 no `max_deceleration` · 1025/3 the master faulted · 1025/5 no position of the master (the cycle's own: 1025/4 itself, 1025/6 chained) |
 //! | reset | 16 homing in process |
-//! | redefine | 16/25 homing in process · 20/25 faulted · 1023/1 not homed · 3/25 not at rest (jog, move, stream, stop or enable under way) · 12/40 no valid feedback · coupled to another axis (`coupling_allows_redefine`) · 1023/2 not finite |
+//! | redefine | 16/25 homing in process · 20/25 faulted · 1023/1 not homed · 3/25 not at rest (jog, move, stream, stop or enable under way) · 12/40 no valid feedback · 1023/3 geared, master or slave (`coupling_allows_redefine`, `Core::gear_refusal`) · 1023/2 not finite |
 //! | disable, stop, stream end | never |
 //!
 //! Home (the rung's rising edge) is refused with 20 when faulted and 3 while
@@ -69,7 +70,7 @@ impl Axis {
     pub(super) fn jog_collides(&self) -> Result<(), Code> {
         match self.state {
             State::Motion(Motion {
-                run: Run::Move(_) | Run::Stream(_),
+                run: Run::Move(_) | Run::Stream(_) | Run::Gear(_),
                 ..
             })
             | State::Stopping { .. } => Err(COLLISION),
@@ -140,11 +141,14 @@ impl Axis {
         }
     }
 
-    /// Redefine position on an axis coupled to another (geared, as master
-    /// or slave) would move the reference the coupling follows: the one
-    /// place that refuses it. Nothing couples axes yet, so nothing is
-    /// refused here; gearing adds its refusal to this predicate.
+    /// Redefine position on a geared slave would move the positions its
+    /// gear follows (1023 / 3). A master does not know it is one: the
+    /// cycle, which sees both ends of every gear, refuses it there with the
+    /// same code (`Core::gear_refusal`).
     pub(super) fn coupling_allows_redefine(&self) -> Result<(), Code> {
+        if self.status.gearing {
+            return Err((ERR_REDEFINE_REFUSED, EX_REDEFINE_GEARED));
+        }
         Ok(())
     }
 

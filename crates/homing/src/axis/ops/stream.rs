@@ -185,7 +185,7 @@ impl Axis {
 
     /// The length of a cycle, ns: the configured one, else the time since
     /// the previous step.
-    fn cycle_ns(&self, now: u64) -> u64 {
+    pub(super) fn cycle_ns(&self, now: u64) -> u64 {
         if self.cfg.cycle_ns > 0 {
             self.cfg.cycle_ns
         } else {
