@@ -1,4 +1,4 @@
-//! Issue 8's attacks, reproduced: each must end refused, in a safe stop with
+//! Hostile peers' attacks, reproduced: each must end refused, in a safe stop with
 //! a clear code, or in a correct home — never in a wrong reference reported
 //! as success, never with anything left in /dev/shm.
 //!

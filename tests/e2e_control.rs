@@ -29,7 +29,7 @@ fn motionctl_homes_stops_unhomes_reports_and_traces() {
     let d = Daemon::start(&cfg, &["bus0", "bus1"]);
     let p = cfg.prefix.clone();
 
-    // status --json: the fixed keys of interface.md (read from the JSON
+    // status --json: its fixed keys (docs/status.md; read from the JSON
     // itself: a typed field would have a default where a key was missing)
     let raw = d.ctl(&["status", "--json"]).json();
     let x = raw["axes"]

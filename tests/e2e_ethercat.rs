@@ -326,7 +326,7 @@ fn drive_fault_mid_homing_aborts_with_the_drive_error_code_kept() {
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(d.axis("S").drive_error_code, 0x2310);
 
-    // a drive fault needs a reset before the next homing (issue 15, as
+    // a drive fault needs a reset before the next homing (as
     // Logix: MAH on a faulted axis is ERR 20): refused, then reset (MAFR:
     // CiA 402 control word bit 7), then it homes
     let r = d.ctl(&["home", "S", "--no-wait", "--json"]);
@@ -407,7 +407,7 @@ fn unplugged_subdevice_aborts_its_axes_and_homes_again_after_replug() {
         s.raw.is_some() && !s.drive_lost
     }));
     // the axis faults (feedback lost in motion, the drives' own faults after
-    // their watchdog) need a reset before the next homing (issue 15)
+    // their watchdog) need a reset before the next homing (ERR 20)
     d.ctl(&["reset", "S", "T"]).expect_code(0);
     assert!(wait_for(Duration::from_secs(5), || {
         !d.axis("S").faulted && !d.axis("T").faulted
@@ -919,7 +919,7 @@ fn a_drive_power_cycled_mid_homing_is_reconfigured_without_restarting_motion_io(
         "the same motion-io"
     );
     // the axis fault of the lost drive needs a reset before homing again
-    // (issue 15: ERR 20 until then)
+    // (ERR 20 until then)
     d.ctl(&["reset", "S"]).expect_code(0);
     assert!(wait_for(Duration::from_secs(5), || !d.axis("S").faulted));
     let r = home_again(&d, &["S"]);

@@ -157,7 +157,7 @@ fn check_accepts_the_default_machine() {
         "{}",
         run.stdout
     );
-    // The operations' bounds of every axis, defaults resolved (issue 15).
+    // The operations' bounds of every axis, defaults resolved.
     assert!(
         run.stdout.contains(
             "axis X: operations: soft limits [-100, 100] while homed, max_speed 40, \

@@ -1,4 +1,4 @@
-//! The operations of issue 15 end to end, through real processes: the
+//! The operations (power, reset, jog, move, stream) end to end, through real processes: the
 //! daemon and its `motion-io` (sim), `motionctl` and a Rust program of the
 //! setpoint stream. The machine is `tests/machines/ops.toml`: X and Z
 //! (immediate homing, soft limits ±20 while homed, hard stops ±40 that

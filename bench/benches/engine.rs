@@ -17,7 +17,7 @@
 //! worth (64) per timed batch, so the axis's state is in the cache as in
 //! the cycle; `engine_step/seek_cold` streams its copies from memory
 //! instead (criterion's growing `SmallInput` batches), which is what the
-//! step measurements before issue 14 did: that figure is bounded by the
+//! step measurements of the first benches did: that figure is bounded by the
 //! size of `Axis` over the memory bandwidth (≈ 1.7 KB per step).
 //!
 //! `cargo bench -p motion-bench --bench engine` (≈ 20 s of measuring).

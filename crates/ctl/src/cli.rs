@@ -1,4 +1,4 @@
-//! `motionctl`'s command line (interface.md), parsed with clap.
+//! `motionctl`'s command line (fixed names; docs/commands.md), parsed with clap.
 
 use crate::spec_args::SpecArgs;
 use clap::{Args, Parser, Subcommand};
@@ -223,7 +223,7 @@ impl Command {
 mod tests {
     use super::*;
 
-    /// Issue 8, fuzzed: any argument vector is parsed or refused, never a
+    /// Fuzzed: any argument vector is parsed or refused, never a
     /// panic (`motion_config::cli_fuzz`).
     #[test]
     fn any_argument_vector_is_parsed_or_refused_without_panic() {

@@ -50,11 +50,26 @@ pub fn markdown(root: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// The files whose words must not point outside the repository: every text
-/// file but Rust sources (whose comments are swept on their own).
+/// The files whose words must not point outside the repository: every
+/// tracked text file — sources (their comments and doc comments), docs,
+/// configs, scripts, the package's files. Tracked means what `git ls-files`
+/// lists, so that a scratch file beside the checkout is not the repository's;
+/// outside a git checkout (a source tarball), every file the walk finds.
 pub fn worded(root: &Path) -> Vec<PathBuf> {
-    const TEXT: &[&str] = &["md", "toml", "sh", "py", "service", "conf", "json", "txt"];
-    files(root)
+    const TEXT: &[&str] = &[
+        "rs",
+        "md",
+        "toml",
+        "sh",
+        "py",
+        "service",
+        "conf",
+        "json",
+        "txt",
+        "proptest-regressions",
+    ];
+    tracked(root)
+        .unwrap_or_else(|| files(root))
         .into_iter()
         .filter(|p| {
             let ext = p.extension().map(|e| e.to_string_lossy().into_owned());
@@ -64,4 +79,28 @@ pub fn worded(root: &Path) -> Vec<PathBuf> {
                 || p.starts_with("deploy/debian")
         })
         .collect()
+}
+
+/// The files git tracks below `root` (relative paths, sorted), or `None`
+/// when `root` is not a git checkout or git cannot be run.
+fn tracked(root: &Path) -> Option<Vec<PathBuf>> {
+    let out = std::process::Command::new("git")
+        .arg("-C")
+        .arg(root)
+        .args(["ls-files", "-z", "--cached", "--", "."])
+        .stderr(std::process::Stdio::null())
+        .output()
+        .ok()?;
+    if !out.status.success() {
+        return None;
+    }
+    let mut paths: Vec<PathBuf> = out
+        .stdout
+        .split(|&b| b == 0)
+        .filter(|p| !p.is_empty())
+        .map(|p| PathBuf::from(String::from_utf8_lossy(p).into_owned()))
+        .filter(|p| root.join(p).is_file())
+        .collect();
+    paths.sort();
+    Some(paths)
 }

@@ -13,7 +13,7 @@
 //!   `CW_FAULT_RESET` (MAFR; CiA 402 controlword bit 7 on the drive). The
 //!   rising edge of `CW_ENABLE` does the same — the frames' older handshake,
 //!   kept because the `Backend` contract promises it; an engine that
-//!   refuses to enable a faulted axis (issue 15) never raises it on one, so
+//!   refuses to enable a faulted axis (ERR 20) never raises it on one, so
 //!   it never clears a fault behind the operator's back. Nothing is ever
 //!   enabled by a reset.
 //! * **Set-points**: while the drive is not in Operation enabled the target

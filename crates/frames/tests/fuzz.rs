@@ -1,4 +1,4 @@
-//! Issue 8, fuzzed: any bytes a peer may put in a feedback or command frame
+//! Fuzzed: any bytes a peer may put in a feedback or command frame
 //! go through the decoding the receiver uses (header check, active axes,
 //! `axis_to_feedback` / `axis_to_command`) without a panic, and a value
 //! that was not a number never decodes into a plausible one. (What the

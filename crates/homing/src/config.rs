@@ -2,7 +2,7 @@
 //!
 //! Plain data, `Copy`, no heap: a validated [`AxisConfig`] is moved into the
 //! engine once and never changes while the cycle runs. Each enum's
-//! spellings (interface.md) are its [`spellings!`](crate::spellings) table
+//! spellings (fixed: docs/configuration.md) are its [`spellings!`](crate::spellings) table
 //! right below it, in the order a config error lists them.
 
 /// Axis configuration (CIP "Axis Configuration").
@@ -263,7 +263,7 @@ pub struct AxisConfig {
     /// the `Status::ambiguous_marker` warning.
     pub refuse_ambiguous_marker: bool,
 
-    // --- the operations around homing (interface.md "Limits") -----------
+    // --- the operations around homing (their limits) ----------------------
     /// Speed cap (units/s) of jogs and moves while the axis is not homed
     /// (LinuxCNC jogs unhomed joints, slowly: without a reference no soft
     /// limit protects the machine). `0.0` = `home_speed`. See

@@ -2,7 +2,7 @@
 //! [`spellings!`](crate::spellings) table that gives it `NAMES`, `name()`,
 //! `from_number`, `FromStr` and `Display`. Config files, JSON and text
 //! reports, the status frame's phase and the trace CSV all read them from
-//! there (interface.md fixes the spellings).
+//! there (the spellings are fixed: users' files and scripts use them).
 //!
 //! `name()` is a `const fn` match with no allocation: the real-time cycle
 //! uses it to put the phase into the status frame.

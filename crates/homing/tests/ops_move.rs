@@ -79,7 +79,7 @@ fn targets_outside_the_travel_limits_are_refused_while_homed() {
     assert!(r.op(move_to(10.0)).is_ok());
     assert!(r.run_until(1000, |s| s.op.pc));
     assert_eq!(r.cmd_axis(), 10.0);
-    // Not homed: the limits do not apply (seed 003), max_position does.
+    // Not homed: the soft limits do not apply (no reference), max_position does.
     assert!(r.axis.clear_homed());
     assert!(r.op(move_to(11.0)).is_ok());
     assert!(r.run_until(1000, |s| s.op.pc));

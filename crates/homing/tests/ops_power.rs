@@ -192,7 +192,7 @@ fn a_fault_that_persists_comes_back_after_the_reset_window() {
 
 #[test]
 fn a_drive_fault_during_homing_needs_a_reset_before_the_next_homing() {
-    // Changed by issue 15: homing used to reset the fault itself (by
+    // Changed with the operations: homing used to reset the fault itself (by
     // toggling the enable); a faulted axis now refuses to home (ERR 20).
     let cfg = AxisConfig {
         max_speed: 50.0,

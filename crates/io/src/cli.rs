@@ -139,7 +139,7 @@ mod tests {
         assert!(p("scan --interface a/b").is_err());
     }
 
-    /// Issue 8, fuzzed: any argument vector is parsed or refused, never a
+    /// Fuzzed: any argument vector is parsed or refused, never a
     /// panic (`motion_config::cli_fuzz`).
     #[test]
     fn any_argument_vector_is_parsed_or_refused_without_panic() {

@@ -366,7 +366,7 @@ start = 1.0
         assert_eq!(fb.axes[0].status_word, SW_ENABLED);
     }
 
-    /// Issue 15's MAFR: the rising edge of `CW_FAULT_RESET` clears the
+    /// MAFR: the rising edge of `CW_FAULT_RESET` clears the
     /// plant's fault and enables nothing; the enable needs its own rising
     /// edge after that.
     #[test]
@@ -434,7 +434,7 @@ start = 1.0
         assert_eq!(fb.axes[0].status_word, SW_FAULT);
     }
 
-    /// Issue 8, fuzzed: command frames of any content (as a forger holding
+    /// Fuzzed: command frames of any content (as a forger holding
     /// the key could send; the ports checked key and layout), in any order
     /// with watchdog and emergency stops: no panic, and the feedback the
     /// drives give back stays a reading (finite, never the no-number

@@ -262,7 +262,7 @@ fn modes_seen_while(prefix: &str, f: impl FnOnce()) -> Vec<(String, u32)> {
     seen
 }
 
-/// Issue 8: creating a node in a fresh domain never leaves a file that
+/// Creating a node in a fresh domain never leaves a file that
 /// group or others could open, not even for a moment (iceoryx2 makes its
 /// node counter 0666 with fchmod; a chmod afterwards left a window).
 #[test]
@@ -298,7 +298,7 @@ fn no_file_of_a_new_node_is_ever_accessible_to_others() {
     }
 }
 
-/// Issue 8, attack 4: the node counter is 0666 in iceoryx2; ours is 0600
+/// A hostile local user's attack: the node counter is 0666 in iceoryx2; ours is 0600
 /// from its creation on, and a truncated one is refused instead of hanging
 /// node creation.
 #[test]

@@ -85,14 +85,8 @@ impl Mode {
                 accel: Some(accel),
                 decel: Some(decel),
                 ..
-            })) => {
-                m = run(Asked::Op {
-                    speed: speed.abs(),
-                    accel,
-                    decel,
-                })
-            }
-            Some(Operation::Move(MoveSpec {
+            }))
+            | Some(Operation::Move(MoveSpec {
                 speed: Some(speed),
                 accel: Some(accel),
                 decel: Some(decel),

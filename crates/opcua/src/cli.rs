@@ -1,4 +1,4 @@
-//! The command line (interface.md, "OPC UA").
+//! The command line (fixed names; docs/commands.md, `motion-opcua`).
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;

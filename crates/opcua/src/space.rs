@@ -18,7 +18,7 @@ use motion_status::{Row, Type, Unit};
 use opcua::types::{DataTypeId, NodeId, Variant};
 use std::sync::LazyLock;
 
-/// The namespace of every node of ours (interface.md).
+/// The namespace of every node of ours (fixed: clients browse by it; docs/opcua.md).
 pub const NAMESPACE_URI: &str = "urn:motion-supervisor";
 
 /// `Machine` and below.
@@ -267,7 +267,7 @@ mod tests {
         names.sort();
         names.dedup();
         assert_eq!(n, names.len(), "a variable named twice");
-        // interface.md: these names, these types.
+        // The fixed names and types clients rely on (docs/opcua.md).
         for b in ["HomedStatus", "HomingStatus", "PC", "ER", "EN", "DN", "IP"] {
             let v = AXIS_LIVE.iter().find(|v| v.name == b).unwrap();
             assert_eq!(v.data_type, DataTypeId::Boolean, "{b}");

@@ -1,5 +1,5 @@
 //! The plot of a traced homing (`motionctl trace --plot`): velocity against
-//! position, the way the seed documents draw homing sequences — each leg a
+//! position, the way Logix homing manuals draw homing sequences — each leg a
 //! line, the home event and the switch and marker edges marked.
 
 use crate::{canvas, failed};

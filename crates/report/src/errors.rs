@@ -1,4 +1,4 @@
-//! `{"errors": [...]}` (interface.md, "Errors as JSON"): with `--json`, every
+//! `{"errors": [...]}` (docs/commands.md, "JSON"): with `--json`, every
 //! command prints exactly one JSON object, also when it fails before doing
 //! anything.
 

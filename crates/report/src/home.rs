@@ -1,4 +1,4 @@
-//! `home --json` (interface.md) and `run --json`.
+//! `home --json` (fixed keys: docs/commands.md, "JSON") and `run --json`.
 
 use crate::{ErrorEntry, IoReport, Latency};
 use serde::{Deserialize, Serialize};

@@ -4,7 +4,7 @@
 //! nothing is read back with `.unwrap_or(0)`.
 //!
 //! * [`latency`] — percentiles of the three latencies (`home`/`run`/`stats`).
-//! * [`home`] — `home --json`: one row per axis (interface.md).
+//! * [`home`] — `home --json`: one row per axis (fixed keys).
 //! * [`status`] — `status --json`: the live state of every axis and I/O
 //!   process (its rows generated from `motion-status`'s table).
 //! * [`io`] — per I/O process: attached, frames, gaps by length.

@@ -1,4 +1,4 @@
-//! The command line (interface.md): `run`, `home`, `check`, parsed with
+//! The command line (fixed names; docs/commands.md): `run`, `home`, `check`, parsed with
 //! clap. Every value is checked by the same rules as the config file.
 
 use clap::{Args, Parser, Subcommand};
@@ -142,7 +142,7 @@ mod tests {
         assert!(p("run --service-prefix a_b").is_ok());
     }
 
-    /// Issue 8, fuzzed: any argument vector is parsed or refused, never a
+    /// Fuzzed: any argument vector is parsed or refused, never a
     /// panic (`motion_config::cli_fuzz`).
     #[test]
     fn any_argument_vector_is_parsed_or_refused_without_panic() {

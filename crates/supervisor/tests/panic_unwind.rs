@@ -1,5 +1,5 @@
-//! A panic unwinding through a command after the session started (issue 8:
-//! "axes stopped, shared memory cleaned" must hold on every way out): the
+//! A panic unwinding through a command after the session started ("axes
+//! stopped, shared memory cleaned" must hold on every way out): the
 //! session is dropped on the way, so the cycle ends through its orderly exit
 //! (every axis stopped, every drive disabled: `Control::Exit`), and nothing
 //! is left in /dev/shm nor a session file. Injected in-process with

@@ -1,4 +1,4 @@
-//! The supervised setpoint stream's figures (issue 15): the latency from a
+//! The supervised setpoint stream's figures: the latency from a
 //! program publishing a setpoint to the command frame that carries it, in
 //! cycles, at 1 and 4 kHz ([`latency`]); what a 1 kHz stream of 64 axes
 //! costs the cycle's compute and wake-up, against none, as ratios of one

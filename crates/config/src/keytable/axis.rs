@@ -271,13 +271,15 @@ keys! {
                   the EXERR naming the leg). 0: the default.")
         .example("250.0");
     MAX_SPEED: Key::new(Axis, "max_speed", Kind::Number)
-        .derived("2 × the fastest homing speed the sequence commands; none for passive and \
-                  immediate homing")
+        .derived("2 × the fastest homing speed the sequence commands; none when the homing \
+                  commands no motion (passive, immediate, absolute)")
         .range(0.0, SPEED)
         .unit("units/s")
         .meaning("The fastest the axis can move: feedback implying more is implausible, never an \
                   event (ERR 12 / EXERR 44); no jog, move or setpoint may go faster (ERR 13 / \
-                  EXERR 1, ERR 1019 / EXERR 3). 0: the default.")
+                  EXERR 1, ERR 1019 / EXERR 3). It is the speed bound of jog, move and stream: \
+                  an axis with none set or derived refuses them all (ERR 13 / EXERR 7; `check` \
+                  says so) and still homes. 0: the default.")
         .example("100.0");
     TORQUE_LIMIT: Key::new(Axis, "torque_limit", Kind::Number)
         .num(100.0)

@@ -18,9 +18,9 @@ keys! {
         .above_zero(SPEED)
         .unit("units/s")
         .fixed()
-        .meaning("Speed cap of jogs and moves while the axis is not homed (no soft limit protects \
-                  it then): above it ERR 13 / EXERR 1; a jog running when HomedStatus is lost \
-                  slows to it.")
+        .meaning("Speed cap of jogs, moves and streams while the axis is not homed (no soft limit \
+                  protects it then): above it ERR 13 / EXERR 1 (a setpoint: ERR 1019 / EXERR 3); \
+                  a jog running when HomedStatus is lost slows to it.")
         .example("10.0");
     LIMIT_SWITCHES: Key::new(Axis, "limit_switches", Kind::Bool)
         .flag(true)
@@ -34,23 +34,26 @@ keys! {
         .derived("`home_deceleration`")
         .above_zero(ACCELERATION)
         .unit("units/s²")
-        .meaning("Logix Maximum Deceleration: of the stop at a limit switch and the stops of the \
-                  stream; no jog or move may ask for more (ERR 13 / EXERR 3).")
+        .meaning("Logix Maximum Deceleration: of the stops of faults and limit switches (a \
+                  stream's stops: at least `stream_acceleration`); no jog or move may ask for \
+                  more (ERR 13 / EXERR 3).")
         .example("2000.0");
     STREAM_ACCELERATION: Key::new(Axis, "stream_acceleration", Kind::Number)
         .derived("10 × `home_acceleration`")
         .above_zero(ACCELERATION)
         .unit("units/s²")
-        .meaning("The largest change of segment velocity a setpoint stream may ask for (ERR 1019 / \
-                  EXERR 4 above it).")
+        .meaning("The largest change of velocity of a setpoint stream: of its segments on the \
+                  program's timeline (ERR 1019 / EXERR 4 above it), and of the command between \
+                  two cycles, whatever the setpoints' timestamps say.")
         .example("5000.0");
     STREAM_TIMEOUT_MS: Key::new(Axis, "stream_timeout_ms", Kind::Number)
         .num(50.0)
         // Longer than a second is no supervision.
         .range(1.0, 1000.0)
         .unit("ms")
-        .meaning("A stream silent this long after its last setpoint was reached stops the axis \
-                  (ERR 1019 / EXERR 5): a program that dies or hangs stops its axes.")
+        .meaning("A stream with no new setpoint this long after the last one arrived (however \
+                  far ahead it lay) stops the axis (ERR 1019 / EXERR 5): a program that dies or \
+                  hangs stops its axes.")
         .example("50");
     STREAM_UNHOMED: Key::new(Axis, "stream_unhomed", Kind::Bool)
         .flag(false)

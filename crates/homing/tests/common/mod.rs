@@ -173,7 +173,7 @@ pub fn run_with(
 }
 
 // ----------------------------------------------------------------------
-// Operations around homing (issue 15)
+// Operations around homing: power, reset, jog, move, stream
 // ----------------------------------------------------------------------
 
 /// 1 ms.

@@ -9,7 +9,7 @@ use motion_report::{print_json, table, AxisResult, ErrorEntry, HomeReport};
 use motion_rt::termination as signals;
 use std::time::Duration;
 
-/// `home`: the commissioning run of interface.md. It starts the daemon's
+/// `home`: the commissioning run (docs/commands.md). It starts the daemon's
 /// machinery in this process and homes through the control service, as
 /// `motionctl home` does against a running daemon.
 pub fn home(a: &HomeArgs) -> i32 {

@@ -22,7 +22,7 @@ pub fn run(c: Cli) -> i32 {
     }
 }
 
-/// Problems as the JSON error entries of interface.md.
+/// Problems as the JSON error entries (docs/commands.md, "JSON").
 pub fn entries(problems: &[Problem]) -> Vec<ErrorEntry> {
     problems.iter().map(ErrorEntry::from).collect()
 }

@@ -1,4 +1,4 @@
-//! Issue 8, fuzzed: feedback frames of any content reach the cycle the way
+//! Fuzzed: feedback frames of any content reach the cycle the way
 //! the real-time thread hands them over (after the ports' key and layout
 //! checks, which a forger with the key passes): the link, `axis_to_feedback`,
 //! the engines' feedback checks. Whatever arrives, and whenever during a

@@ -1,4 +1,4 @@
-//! Issue 15, fuzzed like the frame decoding: setpoint frames of any content
+//! Fuzzed like the frame decoding: setpoint frames of any content
 //! — any bytes, or chosen fields (wrong keys, stale and forged tokens,
 //! replayed and reordered sequence numbers, entries for axes not owned or
 //! beyond the machine, NaN / ±inf / huge positions) — go through the

@@ -80,7 +80,7 @@ fn two_io() -> String {
     )
 }
 
-/// Issue 7: losing one I/O process aborts homing only on its axes (12/40);
+/// Losing one I/O process aborts homing only on its axes (12/40);
 /// the other axes carry on. Its return clears HomedStatus and is counted.
 #[test]
 fn losing_one_io_process_aborts_only_its_axes() {

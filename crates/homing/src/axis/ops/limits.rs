@@ -2,7 +2,7 @@
 //! motion (homing keeps its own rule: 12 / 43 on a tripped switch in the
 //! direction of motion, and its search limit).
 //!
-//! * **Software overtravel** (seed 003: meaningful once HomedStatus is
+//! * **Software overtravel** (as in Logix: meaningful once HomedStatus is
 //!   set, off when it is cleared): while the axis is homed, linear and has
 //!   `travel_limits`, no jog, move or stream commands a position outside
 //!   them. A move's target outside is refused, a jog is planned to come to
