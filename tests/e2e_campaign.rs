@@ -31,10 +31,10 @@
 //!   where it was.
 //!
 //! Seeded: the seed is printed and `MOTION_MP_CAMPAIGN_SEED` sets it, so a
-//! failure runs again the same way; `MOTION_MP_CAMPAIGN_TRIALS` (default
-//! 1) runs more trials per cell. Each trial has its own service prefix and
-//! leaves nothing in /dev/shm. The EtherCAT cells need root (`SKIPPED: …`
-//! otherwise).
+//! failure runs again the same way; `MOTION_MP_CAMPAIGN_TRIALS` (one by
+//! default) runs more trials per cell. Each trial has its own service
+//! prefix and leaves nothing in /dev/shm. The EtherCAT cells need root
+//! (`SKIPPED: …` otherwise).
 
 use std::time::{Duration, Instant};
 
