@@ -6,43 +6,11 @@
 //! Every wait is for a state of the status service, never a time.
 
 use motion_harness::*;
-use motion_report::{AxisStatus, ErrorReport};
-use std::time::Duration;
-
-#[track_caller]
-fn wait_axis(d: &Daemon, name: &str, secs: u64, f: impl Fn(&AxisStatus) -> bool) -> AxisStatus {
-    let mut last = AxisStatus::default();
-    let ok = wait_for(Duration::from_secs(secs), || {
-        last = d.axis(name);
-        f(&last)
-    });
-    assert!(ok, "{name} never got there: {last:#?}");
-    last
-}
-
-fn at_rest(a: &AxisStatus) -> bool {
-    !a.jogging && !a.moving && !a.streaming && !a.gearing && !a.stopping && !a.op_ip
-}
+use motion_report::AxisStatus;
 
 /// The commanded position (axis coordinates).
 fn cmd(a: &AxisStatus) -> f64 {
     value(a.cmd_position, &a.name)
-}
-
-/// `motionctl ARGS --json` refused (exit 1) with ERR `err` / EXERR `exerr`.
-#[track_caller]
-fn refused_with(d: &Daemon, args: &[&str], err: u16, exerr: u16) {
-    let mut all = args.to_vec();
-    all.push("--json");
-    let r = d.ctl(&all);
-    let e: ErrorReport = r.expect_code(1).report();
-    assert!(
-        e.errors
-            .iter()
-            .any(|x| x.err == Some(err) && x.exerr == Some(exerr)),
-        "{args:?}: expected ERR {err} EXERR {exerr}: {}",
-        r.stdout
-    );
 }
 
 #[test]
@@ -52,12 +20,12 @@ fn a_geared_slave_follows_its_jogged_master_by_the_ratio_until_a_stop() {
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "X", "Z"]).expect_code(0);
     d.ctl(&["enable", "X", "Z"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
-    wait_axis(&d, "Z", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("X", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("Z", 5, |a| a.homed && a.servo_action);
 
     // refused: itself, a ratio of 0, an unknown master
-    refused_with(&d, &["gear", "Z", "--master", "Z", "--ratio", "1"], 1025, 4);
-    refused_with(&d, &["gear", "Z", "--master", "X", "--ratio", "0"], 13, 9);
+    d.refused_with(&["gear", "Z", "--master", "Z", "--ratio", "1"], 1025, 4);
+    d.refused_with(&["gear", "Z", "--master", "X", "--ratio", "0"], 13, 9);
     assert_ne!(
         d.ctl(&["gear", "Z", "--master", "Q", "--ratio", "1"])
             .code(),
@@ -68,12 +36,12 @@ fn a_geared_slave_follows_its_jogged_master_by_the_ratio_until_a_stop() {
     // geared at -0.5: the master jogs +4 u/s for 1 s, the slave follows
     d.ctl(&["gear", "Z", "--master", "X", "--ratio", "-0.5"])
         .expect_code(0);
-    let z = wait_axis(&d, "Z", 5, |a| a.gearing);
+    let z = d.wait_axis("Z", 5, |a| a.gearing);
     assert!(!z.er, "{z:#?}");
     d.ctl(&["jog", "X", "--speed", "4", "--for", "1"])
         .expect_code(0);
-    let x = wait_axis(&d, "X", 5, |a| !a.jogging && !a.stopping && !a.op_ip);
-    let z = wait_axis(&d, "Z", 5, |a| (cmd(a) + 0.5 * cmd(&x)).abs() <= COUNT);
+    let x = d.wait_axis("X", 5, |a| !a.jogging && !a.stopping && !a.op_ip);
+    let z = d.wait_axis("Z", 5, |a| (cmd(a) + 0.5 * cmd(&x)).abs() <= COUNT);
     assert!(cmd(&x) > 3.0, "{x:#?}");
     assert!(
         z.gearing && !z.er,
@@ -82,15 +50,15 @@ fn a_geared_slave_follows_its_jogged_master_by_the_ratio_until_a_stop() {
 
     // a stop of the slave ends it, normally
     d.ctl(&["stop", "Z"]).expect_code(0);
-    let z = wait_axis(&d, "Z", 5, at_rest);
+    let z = d.wait_axis("Z", 5, at_rest);
     assert!(!z.er && z.enabled, "{z:#?}");
 
     // geared again: a stop of the master ends it too
     d.ctl(&["gear", "Z", "--master", "X", "--ratio", "1"])
         .expect_code(0);
-    wait_axis(&d, "Z", 5, |a| a.gearing);
+    d.wait_axis("Z", 5, |a| a.gearing);
     d.ctl(&["stop", "X"]).expect_code(0);
-    let z = wait_axis(&d, "Z", 5, at_rest);
+    let z = d.wait_axis("Z", 5, at_rest);
     assert!(!z.er, "{z:#?}");
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
@@ -103,8 +71,8 @@ fn a_slave_at_its_travel_limit_stops_inside_it_and_stops_its_master() {
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "X", "Z"]).expect_code(0);
     d.ctl(&["enable", "X", "Z"]).expect_code(0);
-    wait_axis(&d, "Z", 5, |a| a.homed && a.servo_action);
-    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("Z", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("X", 5, |a| a.homed && a.servo_action);
 
     // ratio 4: Z reaches its limit 20 when X is at 5
     d.ctl(&[
@@ -113,10 +81,10 @@ fn a_slave_at_its_travel_limit_stops_inside_it_and_stops_its_master() {
     .expect_code(0);
     let r = d.ctl(&["jog", "X", "--speed", "4", "--for", "10"]);
     assert!(r.code().is_some(), "{}", r.stderr);
-    let z = wait_axis(&d, "Z", 10, |a| a.er && !a.stopping);
+    let z = d.wait_axis("Z", 10, |a| a.er && !a.stopping);
     assert_eq!((z.err, z.exerr), (1025, 1), "{z:#?}");
     assert!(!z.gearing && cmd(&z) <= 20.0 + COUNT, "{z:#?}");
-    let x = wait_axis(&d, "X", 5, |a| !a.jogging && !a.stopping);
+    let x = d.wait_axis("X", 5, |a| !a.jogging && !a.stopping);
     assert!(!x.er && cmd(&x) < 5.5, "the master was stopped: {x:#?}");
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);

@@ -18,23 +18,6 @@ fn ops(tag: &str) -> TempConfig {
     Machine::fixture("ops").write(tag)
 }
 
-/// Waits (at most `secs`) until axis `name` satisfies `f`; its status then.
-#[track_caller]
-fn wait_axis(d: &Daemon, name: &str, secs: u64, f: impl Fn(&AxisStatus) -> bool) -> AxisStatus {
-    let mut last = AxisStatus::default();
-    let ok = wait_for(Duration::from_secs(secs), || {
-        last = d.axis(name);
-        f(&last)
-    });
-    assert!(ok, "{name} never got there: {last:#?}");
-    last
-}
-
-/// At rest: no operation motion, not stopping.
-fn at_rest(a: &AxisStatus) -> bool {
-    !a.jogging && !a.moving && !a.streaming && !a.stopping && !a.op_ip
-}
-
 fn pos(a: &AxisStatus) -> f64 {
     value(a.position, &a.name)
 }
@@ -42,12 +25,6 @@ fn pos(a: &AxisStatus) -> f64 {
 /// The commanded position (axis coordinates).
 fn cmd(a: &AxisStatus) -> f64 {
     value(a.cmd_position, &a.name)
-}
-
-/// `motionctl ARGS --json` refused (exit 1) with ERR `err` / EXERR `exerr`.
-#[track_caller]
-fn refused_with(d: &Daemon, args: &[&str], err: u16, exerr: u16) {
-    d.refused_with(args, err, exerr);
 }
 
 /// `motionctl move ... --json`, its one row.
@@ -73,17 +50,17 @@ fn enable_jog_stop_move_and_reset_after_a_drive_fault() {
     );
 
     // servo off: jog and move refused (ERR 5), nothing moves
-    refused_with(&d, &["jog", "X", "--speed", "5"], 5, 0);
-    refused_with(&d, &["move", "X", "--to", "1"], 5, 0);
+    d.refused_with(&["jog", "X", "--speed", "5"], 5, 0);
+    d.refused_with(&["move", "X", "--to", "1"], 5, 0);
 
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.enabled && a.servo_action);
+    d.wait_axis("X", 5, |a| a.enabled && a.servo_action);
 
     // jog until `stop`: a normal end (no ER), motionctl exits 0
     let mut jog = spawn_motionctl(&["--service-prefix", &cfg.prefix, "jog", "X", "--speed", "5"]);
-    wait_axis(&d, "X", 5, |a| a.jogging && pos(a) > 0.5);
+    d.wait_axis("X", 5, |a| a.jogging && pos(a) > 0.5);
     d.ctl(&["stop", "X"]).expect_code(0);
-    let x = wait_axis(&d, "X", 5, at_rest);
+    let x = d.wait_axis("X", 5, at_rest);
     assert!(!x.er && !x.faulted && x.enabled, "{x:#?}");
     assert_eq!(x.last_stop, "operator");
     assert_eq!(
@@ -109,19 +86,19 @@ fn enable_jog_stop_move_and_reset_after_a_drive_fault() {
     let r = d.ctl(&["jog", "X", "--speed", "10", "--json"]);
     let m: MotionReport = r.expect_code(1).report();
     assert!(m.axes[0].er, "{}", r.stdout);
-    let x = wait_axis(&d, "X", 5, at_rest);
+    let x = d.wait_axis("X", 5, at_rest);
     assert!(x.er && x.faulted && !x.enabled, "{x:#?}");
     assert_eq!((x.err, x.exerr), (12, 16), "{x:#?}");
     assert_eq!(x.last_stop, "drive_fault");
 
     // faulted: everything but reset/stop/disable refused (ERR 20)
-    refused_with(&d, &["move", "X", "--to", "0"], 20, 0);
-    refused_with(&d, &["enable", "X"], 20, 0);
-    refused_with(&d, &["home", "X", "--no-wait"], 20, 0);
+    d.refused_with(&["move", "X", "--to", "0"], 20, 0);
+    d.refused_with(&["enable", "X"], 20, 0);
+    d.refused_with(&["home", "X", "--no-wait"], 20, 0);
 
     // reset: the fault is gone, nothing enabled or moved by itself
     d.ctl(&["reset", "X"]).expect_code(0);
-    let x = wait_axis(&d, "X", 5, |a| !a.faulted && !a.er);
+    let x = d.wait_axis("X", 5, |a| !a.faulted && !a.er);
     assert!(!x.enabled && !x.fault, "{x:#?}");
     let p = pos(&x);
     std::thread::sleep(Duration::from_millis(200));
@@ -129,7 +106,7 @@ fn enable_jog_stop_move_and_reset_after_a_drive_fault() {
 
     // enable again and move away from the stop
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.servo_action);
+    d.wait_axis("X", 5, |a| a.servo_action);
     let row = move_json(&d, &["X", "--to", "0"], 0);
     assert!(
         row.pc && (value(row.position, "X")).abs() <= 2.0 * COUNT,
@@ -138,7 +115,7 @@ fn enable_jog_stop_move_and_reset_after_a_drive_fault() {
 
     // disable: drive off
     d.ctl(&["disable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| !a.enabled && !a.servo_action);
+    d.wait_axis("X", 5, |a| !a.enabled && !a.servo_action);
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
 }
@@ -150,12 +127,12 @@ fn software_overtravel_is_enforced_when_homed_and_not_after_unhome() {
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "X"]).expect_code(0);
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("X", 5, |a| a.homed && a.servo_action);
 
     // a move outside the travel limits: refused, ERR 13 / EXERR 4
-    refused_with(&d, &["move", "X", "--to", "25"], 13, 4);
+    d.refused_with(&["move", "X", "--to", "25"], 13, 4);
     // above max_speed: ERR 13 / EXERR 1
-    refused_with(&d, &["move", "X", "--to", "5", "--speed", "50"], 13, 1);
+    d.refused_with(&["move", "X", "--to", "5", "--speed", "50"], 13, 1);
 
     // a jog towards the limit stops inside it, normally (no ER)
     let r = d.ctl(&["jog", "X", "--speed", "10", "--json"]);
@@ -165,7 +142,7 @@ fn software_overtravel_is_enforced_when_homed_and_not_after_unhome() {
     let x = d.axis("X");
     assert!(!x.er && x.last_stop == "soft_limit", "{x:#?}");
     // at the limit, a jog further out is refused
-    refused_with(&d, &["jog", "X", "--speed", "1"], 13, 4);
+    d.refused_with(&["jog", "X", "--speed", "1"], 13, 4);
 
     // unhome: no soft limits any more
     d.ctl(&["unhome", "X"]).expect_code(0);
@@ -181,13 +158,13 @@ fn a_jogging_motionctl_killed_stops_within_its_lease() {
     let cfg = ops("ops_jogkill");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.servo_action);
+    d.wait_axis("X", 5, |a| a.servo_action);
     let (v, decel) = (2.0, 100.0);
     let mut jog = spawn_motionctl(&["--service-prefix", &cfg.prefix, "jog", "X", "--speed", "2"]);
-    wait_axis(&d, "X", 5, |a| a.jogging && pos(a) > 0.2);
+    d.wait_axis("X", 5, |a| a.jogging && pos(a) > 0.2);
     jog.signal(Signal::SIGKILL);
     let at_kill = pos(&d.axis("X"));
-    let x = wait_axis(&d, "X", 5, at_rest);
+    let x = d.wait_axis("X", 5, at_rest);
     // hold to run: the lease (500 ms) runs out, a normal stop
     assert!(!x.er, "{x:#?}");
     assert_eq!(x.last_stop, "lease_expired");
@@ -231,7 +208,7 @@ fn a_stream_played_from_csv_ends_at_the_expected_position() {
     // acquire answers with the instruction's code)
     d.ctl(&["enable", "X"]).expect_code(0);
     d.ctl(&["home", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("X", 5, |a| a.homed && a.servo_action);
     let dir = TempDir::new("ops_csv");
     let csv = ramp_csv(&dir, "ramp.csv", 4.0, 1.0, 100.0);
     let r = d.ctl(&["stream", "X", "--csv", &csv, "--json"]);
@@ -261,7 +238,7 @@ fn the_owner_killed_mid_stream_stops_the_axis_within_the_bound() {
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "X"]).expect_code(0);
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("X", 5, |a| a.homed && a.servo_action);
     let dir = TempDir::new("ops_ownerkill");
     // 1 u/s for 10 s at 100 rows/s
     let csv = dir.file("slow.csv");
@@ -277,11 +254,11 @@ fn the_owner_killed_mid_stream_stops_the_axis_within_the_bound() {
         "--csv",
         &csv,
     ]);
-    let x = wait_axis(&d, "X", 5, |a| a.streaming && pos(a) > 0.5);
+    let x = d.wait_axis("X", 5, |a| a.streaming && pos(a) > 0.5);
     assert_eq!(x.owner.as_deref(), Some("motionctl"), "{x:#?}");
     s.signal(Signal::SIGKILL);
     let at_kill = pos(&d.axis("X"));
-    let x = wait_axis(&d, "X", 5, at_rest);
+    let x = d.wait_axis("X", 5, at_rest);
     // Whichever comes first: the stream silent longer than
     // stream_timeout_ms (200) after the last setpoint arrived (motionctl
     // publishes every 5 ms) — ERR 1019 / EXERR 5 — or the owner's node
@@ -301,11 +278,11 @@ fn the_owner_killed_mid_stream_stops_the_axis_within_the_bound() {
     let went = pos(&x) - at_kill;
     assert!(went <= bound, "went {went} after the kill, bound {bound}");
     // the ownership ended with it
-    wait_axis(&d, "X", 2, |a| a.owner.is_none());
+    d.wait_axis("X", 2, |a| a.owner.is_none());
     let _ = s.wait_exit(Duration::from_secs(1));
     if x.er {
         d.ctl(&["reset", "X"]).expect_code(0);
-        wait_axis(&d, "X", 5, |a| !a.faulted);
+        d.wait_axis("X", 5, |a| !a.faulted);
     }
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
@@ -327,8 +304,8 @@ fn ready(d: &Daemon) {
     d.ctl(&["home", "X"]).expect_code(0);
     d.ctl(&["home", "Z"]).expect_code(0);
     d.ctl(&["enable", "X", "Z"]).expect_code(0);
-    wait_axis(d, "X", 5, |a| a.homed && a.servo_action);
-    wait_axis(d, "Z", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("X", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("Z", 5, |a| a.homed && a.servo_action);
 }
 
 /// Streams `bad` after a few good setpoints at 1 kHz (`bad` gets the last
@@ -351,7 +328,7 @@ fn stops_with(d: &Daemon, c: &mut Client, exerr: u16, bad: impl FnOnce(&mut Stre
             std::thread::sleep(Duration::from_millis(1));
         }
         bad(&mut s, t, p);
-        let x = wait_axis(d, "X", 5, |a| !a.streaming && at_rest(a));
+        let x = d.wait_axis("X", 5, |a| !a.streaming && at_rest(a));
         assert!(x.er, "{x:#?}");
         assert_eq!((x.err, x.exerr), (1019, exerr), "{x:#?}");
         assert!(pos(&x).abs() <= 20.0 + COUNT, "past the limit: {x:#?}");
@@ -359,7 +336,7 @@ fn stops_with(d: &Daemon, c: &mut Client, exerr: u16, bad: impl FnOnce(&mut Stre
     }
     d.ctl(&["reset", "X"]).expect_code(0);
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(d, "X", 5, |a| !a.faulted && a.servo_action);
+    d.wait_axis("X", 5, |a| !a.faulted && a.servo_action);
 }
 
 #[test]
@@ -405,15 +382,15 @@ fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
             }
             other => panic!("a second owner was not refused: {:?}", other.err()),
         }
-        refused_with(&d, &["jog", "X", "--speed", "1"], 3, 0);
-        refused_with(&d, &["move", "X", "--to", "1"], 3, 0);
-        refused_with(&d, &["home", "X", "--no-wait"], 3, 0);
+        d.refused_with(&["jog", "X", "--speed", "1"], 3, 0);
+        d.refused_with(&["move", "X", "--to", "1"], 3, 0);
+        d.refused_with(&["home", "X", "--no-wait"], 3, 0);
         let x = d.axis("X");
         assert_eq!(x.owner.as_deref(), Some("e2e"), "{x:#?}");
         assert!(x.streaming && !x.er, "{x:#?}");
     }
     // released by its owner: a normal end
-    let x = wait_axis(&d, "X", 5, |a| a.owner.is_none() && at_rest(a));
+    let x = d.wait_axis("X", 5, |a| a.owner.is_none() && at_rest(a));
     assert!(!x.er, "{x:#?}");
     assert_eq!(x.last_stop, "released");
 
@@ -469,7 +446,7 @@ fn bad_setpoints_are_refused_or_stop_the_axis_with_their_code() {
         "{after:?}"
     );
     assert!(after.refused_key > before.refused_key, "{after:?}");
-    let x = wait_axis(&d, "X", 5, at_rest);
+    let x = d.wait_axis("X", 5, at_rest);
     assert!(!x.er && (pos(&x) - x0).abs() <= COUNT, "{x:#?}");
     assert!((pos(&d.axis("Z")) - z0).abs() <= COUNT, "Z moved");
     // the test's own nodes go before the daemon
@@ -537,7 +514,7 @@ fn a_gantry_jogs_moves_and_streams_as_one_axis_never_a_side_alone() {
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "G"]).expect_code(0);
     d.ctl(&["enable", "G"]).expect_code(0);
-    wait_axis(&d, "G2", 5, |a| a.homed && a.servo_action);
+    d.wait_axis("G2", 5, |a| a.homed && a.servo_action);
     // a side alone: refused with the reason
     for args in [
         &["move", "G1", "--to", "1", "--json"][..],
@@ -621,7 +598,7 @@ fn a_request_the_stalled_cycle_did_not_take_is_never_applied() {
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "X"]).expect_code(0);
     d.ctl(&["enable", "X"]).expect_code(0);
-    let before = wait_axis(&d, "X", 5, |a| a.homed && a.servo_action && at_rest(a));
+    let before = d.wait_axis("X", 5, |a| a.homed && a.servo_action && at_rest(a));
     let stalled_at = d.status().cycle;
     let r = {
         let _stopped = StoppedRt::stop(d.pid());
@@ -638,7 +615,7 @@ fn a_request_the_stalled_cycle_did_not_take_is_never_applied() {
     // The cycle runs again: well past the moment it took its queue.
     assert!(wait_for(Duration::from_secs(10), || d.status().cycle
         > stalled_at + 500));
-    let after = wait_axis(&d, "X", 10, |a| a.position.is_some());
+    let after = d.wait_axis("X", 10, |a| a.position.is_some());
     assert_eq!(
         (after.op_id, &after.op_kind),
         (before.op_id, &before.op_kind),
@@ -682,7 +659,7 @@ fn a_setpoint_far_ahead_in_time_buys_no_motion() {
             std::thread::sleep(Duration::from_millis(5));
         }
         // (the status trails the cycle: wait for the refusal itself)
-        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
+        let x = d.wait_axis("X", 5, |a| a.err == 1019 && at_rest(a));
         assert_eq!((x.err, x.exerr), (1019, 4), "{x:#?}");
         assert!((pos(&x) - x0).abs() <= 2.0 * COUNT, "moved: {x:#?}");
         let _ = s.release();
@@ -710,7 +687,7 @@ fn a_hung_program_is_stopped_from_its_last_setpoints_arrival() {
         put(&mut s, 5_000, x0);
         std::thread::sleep(Duration::from_millis(5));
         put(&mut s, 15_000, x0 + 9.0);
-        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
+        let x = d.wait_axis("X", 5, |a| a.err == 1019 && at_rest(a));
         assert_eq!((x.err, x.exerr), (1019, 5), "{x:#?}");
         let went = pos(&x) - x0;
         let bound = 0.9 * 0.051 + 0.81 / 2000.0 + 2.0 * COUNT;
@@ -735,8 +712,8 @@ fn an_unhomed_stream_obeys_unhomed_speed_and_no_speed_bound_moves_nothing() {
         .write("ops_caps");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["enable", "X", "Z"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.servo_action && !a.homed);
-    wait_axis(&d, "Z", 5, |a| a.servo_action);
+    d.wait_axis("X", 5, |a| a.servo_action && !a.homed);
+    d.wait_axis("Z", 5, |a| a.servo_action);
     let mut c = Client::connect(&cfg.prefix, None).expect("client");
     {
         // up at 500 u/s² (1 ms apart on the program's clock) to 15 u/s
@@ -748,13 +725,13 @@ fn an_unhomed_stream_obeys_unhomed_speed_and_no_speed_bound_moves_nothing() {
             put(&mut s, 1_000 + k, p);
             std::thread::sleep(Duration::from_millis(1));
         }
-        let x = wait_axis(&d, "X", 5, |a| a.err == 1019 && at_rest(a));
+        let x = d.wait_axis("X", 5, |a| a.err == 1019 && at_rest(a));
         assert_eq!((x.err, x.exerr), (1019, 3), "{x:#?}");
         let _ = s.release();
     }
     // Z: jog, move and stream refused naming max_speed (13 / 7) ...
-    refused_with(&d, &["move", "Z", "--to", "5", "--speed", "1000"], 13, 7);
-    refused_with(&d, &["jog", "Z", "--speed", "1"], 13, 7);
+    d.refused_with(&["move", "Z", "--to", "5", "--speed", "1000"], 13, 7);
+    d.refused_with(&["jog", "Z", "--speed", "1"], 13, 7);
     let r = d.ctl(&["move", "Z", "--to", "5"]);
     assert!(
         r.expect_code(1).stderr.contains("max_speed"),
@@ -769,7 +746,7 @@ fn an_unhomed_stream_obeys_unhomed_speed_and_no_speed_bound_moves_nothing() {
     }
     // ... while it still homes, and `check` says why it cannot move
     d.ctl(&["home", "Z"]).expect_code(0);
-    wait_axis(&d, "Z", 5, |a| a.homed);
+    d.wait_axis("Z", 5, |a| a.homed);
     let check = supervisor(&["check", "--config", cfg.path.to_str().expect("UTF-8")]);
     let out = check.expect_code(0);
     assert!(out.stdout.contains("max_speed: none set"), "{}", out.stdout);
@@ -789,7 +766,7 @@ fn a_restarted_motion_io_switches_no_drive_on_by_itself() {
     let cfg = ops("ops_iorestart");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.servo_action && a.enabled);
+    d.wait_axis("X", 5, |a| a.servo_action && a.enabled);
     let pid = find_process("motion-io", &cfg.prefix).expect("its motion-io");
     signal_pid(pid, Signal::SIGKILL);
     let attached_again = wait_for(Duration::from_secs(20), || {
@@ -811,7 +788,7 @@ fn a_restarted_motion_io_switches_no_drive_on_by_itself() {
         std::thread::sleep(Duration::from_millis(20));
     }
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.servo_action && a.enabled);
+    d.wait_axis("X", 5, |a| a.servo_action && a.enabled);
     d.stop().expect_code(0);
     assert_clean(&cfg.prefix);
 }
@@ -828,7 +805,7 @@ fn redefine_by_shifts_the_position_and_the_limits_numbers_not_the_machine() {
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["home", "X"]).expect_code(0);
     d.ctl(&["enable", "X"]).expect_code(0);
-    let x = wait_axis(&d, "X", 10, |a| a.homed && a.servo_action && !a.op_ip);
+    let x = d.wait_axis("X", 10, |a| a.homed && a.servo_action && !a.op_ip);
     assert_close!(x, position, 0.0, COUNT);
     assert_eq!(
         (x.soft_limit_negative, x.soft_limit_positive),
@@ -837,7 +814,7 @@ fn redefine_by_shifts_the_position_and_the_limits_numbers_not_the_machine() {
     let raw_before = value(x.raw, "X");
 
     d.ctl(&["redefine", "X", "--by", "5"]).expect_code(0);
-    let x = wait_axis(&d, "X", 10, |a| a.op_kind == "redefine" && a.op_pc);
+    let x = d.wait_axis("X", 10, |a| a.op_kind == "redefine" && a.op_pc);
     assert_close!(x, position, 5.0, COUNT);
     assert_close!(x, cmd_position, 5.0, 1e-9);
     assert_close!(x, raw, raw_before, COUNT);
@@ -851,17 +828,17 @@ fn redefine_by_shifts_the_position_and_the_limits_numbers_not_the_machine() {
     );
 
     // Past the shifted limit: refused; to it: ends on the same machine place.
-    refused_with(&d, &["move", "X", "--to", "25.5"], 13, 4);
+    d.refused_with(&["move", "X", "--to", "25.5"], 13, 4);
     let row = move_json(&d, &["X", "--to", "25"], 0);
     assert!(row.pc, "{row:#?}");
-    let x = wait_axis(&d, "X", 10, |a| !a.moving && !a.stopping);
+    let x = d.wait_axis("X", 10, |a| !a.moving && !a.stopping);
     assert_close!(x, position, 25.0, COUNT);
     assert_close!(x, raw, 20.0, COUNT);
     // A jog further out is refused at the limit (13 / 4), as before.
-    refused_with(&d, &["jog", "X", "--speed", "1"], 13, 4);
+    d.refused_with(&["jog", "X", "--speed", "1"], 13, 4);
 
     // Not homed: refused with its code, nothing changes.
-    refused_with(&d, &["redefine", "Z", "--position", "3"], 1023, 1);
+    d.refused_with(&["redefine", "Z", "--position", "3"], 1023, 1);
     let z = d.axis("Z");
     assert_close!(z, position, 0.0, COUNT);
     d.stop().expect_code(0);

@@ -6,7 +6,7 @@
 //! edge is sampled from the input bits). Unhomed: axis = raw.
 
 use motion_harness::*;
-use motion_report::{AxisStatus, RegistrationReport};
+use motion_report::RegistrationReport;
 use std::time::Duration;
 
 fn machine(tag: &str) -> TempConfig {
@@ -22,24 +22,13 @@ fn machine(tag: &str) -> TempConfig {
         .write(tag)
 }
 
-#[track_caller]
-fn wait_axis(d: &Daemon, name: &str, f: impl Fn(&AxisStatus) -> bool) -> AxisStatus {
-    let mut last = AxisStatus::default();
-    let ok = wait_for(Duration::from_secs(20), || {
-        last = d.axis(name);
-        f(&last)
-    });
-    assert!(ok, "{name} never got there: {last:#?}");
-    last
-}
-
 /// `motionctl arm ARGS --json` started in the background, and waited for
 /// until the registration is armed.
 fn arm_waiting(d: &Daemon, prefix: &str, axis: &str, args: &[&str]) -> Running {
     let mut all = vec!["--service-prefix", prefix, "arm", axis, "--json"];
     all.extend_from_slice(args);
     let running = spawn_motionctl(&all);
-    wait_axis(d, axis, |a| a.registration_armed);
+    d.wait_axis(axis, 20, |a| a.registration_armed);
     running
 }
 
@@ -57,7 +46,7 @@ fn arm_latches_the_switch_and_the_marker_exactly_where_the_drive_latches() {
     let cfg = machine("reg_exact");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", |a| a.servo_action);
+    d.wait_axis("X", 20, |a| a.servo_action);
 
     // --no-wait: armed, nothing latched yet; a jog across the switch
     d.ctl(&["arm", "X", "--no-wait"]).expect_code(0);
@@ -67,7 +56,7 @@ fn arm_latches_the_switch_and_the_marker_exactly_where_the_drive_latches() {
         "{x:#?}"
     );
     let mut jog = spawn_motionctl(&["--service-prefix", &cfg.prefix, "jog", "X", "--speed", "5"]);
-    let x = wait_axis(&d, "X", |a| !a.registration_armed);
+    let x = d.wait_axis("X", 20, |a| !a.registration_armed);
     assert!(x.jogging, "the jog runs on: {x:#?}");
     d.ctl(&["stop", "X"]).expect_code(0);
     assert_eq!(
@@ -83,7 +72,7 @@ fn arm_latches_the_switch_and_the_marker_exactly_where_the_drive_latches() {
     );
 
     // waiting, the falling edge, during a move
-    wait_axis(&d, "X", |a| !a.stopping && !a.jogging);
+    d.wait_axis("X", 20, |a| !a.stopping && !a.jogging);
     d.ctl(&["move", "X", "--to", "1"]).expect_code(0);
     let arm = arm_waiting(&d, &cfg.prefix, "X", &["--edge", "falling"]);
     d.ctl(&["move", "X", "--to", "6"]).expect_code(0);
@@ -112,7 +101,7 @@ fn without_a_drive_latch_arm_samples_the_edge_within_a_cycle_of_travel() {
     let cfg = machine("reg_sampled");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["enable", "Z"]).expect_code(0);
-    wait_axis(&d, "Z", |a| a.servo_action);
+    d.wait_axis("Z", 20, |a| a.servo_action);
     // speed 5 u/s, cycle 1 ms: the edge within 5 × 0.001 / 2 (and a count)
     let arm = arm_waiting(&d, &cfg.prefix, "Z", &[]);
     d.ctl(&["move", "Z", "--to", "6", "--speed", "5"])
@@ -127,7 +116,7 @@ fn without_a_drive_latch_arm_samples_the_edge_within_a_cycle_of_travel() {
     // disarm: nothing latched on the way back; the last position stays
     d.ctl(&["arm", "Z", "--no-wait"]).expect_code(0);
     d.ctl(&["disarm", "Z"]).expect_code(0);
-    let z = wait_axis(&d, "Z", |a| !a.registration_armed);
+    let z = d.wait_axis("Z", 20, |a| !a.registration_armed);
     assert_eq!(z.registration_position, None, "a new arming cleared it");
     d.ctl(&["move", "Z", "--to", "0"]).expect_code(0);
     assert!(!d.axis("Z").registration_armed);
@@ -161,7 +150,7 @@ fn ecat(
 fn enabled_on(b: &motion_harness::ecat::Bus) -> Daemon {
     let d = Daemon::start(&b.cfg, &["bus0"]);
     d.ctl(&["enable", "S"]).expect_code(0);
-    wait_axis(&d, "S", |a| a.servo_action);
+    d.wait_axis("S", 20, |a| a.servo_action);
     d
 }
 

@@ -10,43 +10,11 @@
 //! times.
 
 use motion_harness::*;
-use motion_report::{AxisStatus, ErrorReport, MotionReport};
+use motion_report::{AxisStatus, MotionReport};
 use std::time::Duration;
-
-/// Waits (at most `secs`) until axis `name` satisfies `f`; its status then.
-#[track_caller]
-fn wait_axis(d: &Daemon, name: &str, secs: u64, f: impl Fn(&AxisStatus) -> bool) -> AxisStatus {
-    let mut last = AxisStatus::default();
-    let ok = wait_for(Duration::from_secs(secs), || {
-        last = d.axis(name);
-        f(&last)
-    });
-    assert!(ok, "{name} never got there: {last:#?}");
-    last
-}
-
-fn at_rest(a: &AxisStatus) -> bool {
-    !a.jogging && !a.moving && !a.streaming && !a.stopping && !a.op_ip
-}
 
 fn speed(a: &AxisStatus) -> f64 {
     value(a.velocity, &a.name).abs()
-}
-
-/// `motionctl ARGS --json` refused (exit 1) with ERR `err` / EXERR `exerr`.
-#[track_caller]
-fn refused_with(d: &Daemon, args: &[&str], err: u16, exerr: u16) {
-    let mut all = args.to_vec();
-    all.push("--json");
-    let r = d.ctl(&all);
-    let e: ErrorReport = r.expect_code(1).report();
-    assert!(
-        e.errors
-            .iter()
-            .any(|x| x.err == Some(err) && x.exerr == Some(exerr)),
-        "{args:?}: expected ERR {err} EXERR {exerr}: {}",
-        r.stdout
-    );
 }
 
 #[test]
@@ -57,9 +25,9 @@ fn an_s_curve_move_and_a_change_through_motionctl() {
         .write("scurve");
     let d = Daemon::start(&cfg, &["io"]);
     d.ctl(&["enable", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.servo_action);
+    d.wait_axis("X", 5, |a| a.servo_action);
     d.ctl(&["home", "X"]).expect_code(0);
-    wait_axis(&d, "X", 5, |a| a.homed && at_rest(a));
+    d.wait_axis("X", 5, |a| a.homed && at_rest(a));
 
     // An S-curve move with its own jerk, followed to its end: PC, on the
     // target.
@@ -73,7 +41,7 @@ fn an_s_curve_move_and_a_change_through_motionctl() {
     );
 
     // Nothing runs: a change is refused (3 / 1).
-    refused_with(&d, &["change", "X", "--speed", "5"], 3, 1);
+    d.refused_with(&["change", "X", "--speed", "5"], 3, 1);
 
     // A slow move (2 u/s, the axis's jerk), followed by a motionctl of its
     // own. A change beyond max_deceleration or max_speed is refused (13 /
@@ -91,16 +59,16 @@ fn an_s_curve_move_and_a_change_through_motionctl() {
         "2",
         "--json",
     ]);
-    let before = wait_axis(&d, "X", 5, |a| a.moving && speed(a) > 1.5);
-    refused_with(&d, &["change", "X", "--decel", "1000"], 13, 3);
-    refused_with(&d, &["change", "X", "--speed", "25"], 13, 1);
+    let before = d.wait_axis("X", 5, |a| a.moving && speed(a) > 1.5);
+    d.refused_with(&["change", "X", "--decel", "1000"], 13, 3);
+    d.refused_with(&["change", "X", "--speed", "25"], 13, 1);
     assert!(
         d.axis("X").moving,
         "a refused change leaves the move running"
     );
     d.ctl(&["change", "X", "--speed", "15", "--jerk", "2000"])
         .expect_code(0);
-    let fast = wait_axis(&d, "X", 10, |a| speed(a) > 10.0 || !a.moving);
+    let fast = d.wait_axis("X", 10, |a| speed(a) > 10.0 || !a.moving);
     assert!(fast.moving && speed(&fast) > 10.0, "{fast:#?}");
     assert_eq!(
         fast.op_id, before.op_id,
@@ -108,7 +76,7 @@ fn an_s_curve_move_and_a_change_through_motionctl() {
     );
     let end = follower.wait_exit(Duration::from_secs(30));
     assert_eq!(end.and_then(|s| s.code()), Some(0), "{}", follower.stderr());
-    let x = wait_axis(&d, "X", 5, at_rest);
+    let x = d.wait_axis("X", 5, at_rest);
     assert!(x.op_pc && !x.er, "{x:#?}");
     assert!(
         (value(x.position, "X") + 15.0).abs() <= 2.0 * COUNT,

@@ -86,3 +86,9 @@ pub fn home_all(cfg: &TempConfig) -> (HomeReport, Ended) {
     assert_clean(&cfg.prefix);
     (v, run)
 }
+
+/// At rest: no operation's motion (jog, move, stream, gear), not stopping,
+/// no operation in process.
+pub fn at_rest(a: &motion_report::AxisStatus) -> bool {
+    !a.jogging && !a.moving && !a.streaming && !a.gearing && !a.stopping && !a.op_ip
+}

@@ -156,6 +156,20 @@ impl Daemon {
         ctl(&self.prefix, args)
     }
 
+    /// Waits (at most `secs`) until axis `name`'s status satisfies `f`; that
+    /// status. Fails the test with the last status seen otherwise: states
+    /// are awaited, never a wall-clock moment.
+    #[track_caller]
+    pub fn wait_axis(&self, name: &str, secs: u64, f: impl Fn(&AxisStatus) -> bool) -> AxisStatus {
+        let mut last = AxisStatus::default();
+        let ok = crate::wait_for(std::time::Duration::from_secs(secs), || {
+            last = self.axis(name);
+            f(&last)
+        });
+        assert!(ok, "{name} never got there: {last:#?}");
+        last
+    }
+
     /// `motionctl ARGS --json` against this daemon refused (exit 1) with
     /// ERR `err` / EXERR `exerr` among its errors.
     #[track_caller]

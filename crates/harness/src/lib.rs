@@ -43,7 +43,7 @@ pub mod temp;
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
-pub use check::{home_all, homed, named, value, COUNT};
+pub use check::{at_rest, home_all, homed, named, value, COUNT};
 pub use commands::{ctl, motionctl, spawn_io, spawn_motionctl, spawn_supervisor, supervisor};
 pub use daemon::{Attached, Daemon};
 pub use leftovers::{assert_clean, shm_leftovers, DomainGuard};
