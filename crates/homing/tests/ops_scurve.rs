@@ -47,13 +47,8 @@ fn jog_j(speed: f64, jerk: f64) -> Operation {
 /// A move to `target` at 20 (a = d = 500) with `jerk`.
 fn move_j(target: f64, jerk: f64) -> Operation {
     Operation::Move(MoveSpec {
-        target,
-        relative: false,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
-        supersede: false,
         jerk: Some(jerk),
+        ..move_spec(target)
     })
 }
 

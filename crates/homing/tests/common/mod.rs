@@ -354,9 +354,10 @@ pub fn jog(speed: f64) -> Operation {
     })
 }
 
-/// A move to `target` (axis position) at 20, acceleration and deceleration 500.
-pub fn move_to(target: f64) -> Operation {
-    Operation::Move(MoveSpec {
+/// The move most tests give: to `target` (axis position) at 20,
+/// acceleration and deceleration 500, a trapezoid, not superseding.
+pub fn move_spec(target: f64) -> MoveSpec {
+    MoveSpec {
         target,
         relative: false,
         speed: Some(20.0),
@@ -364,7 +365,12 @@ pub fn move_to(target: f64) -> Operation {
         decel: Some(500.0),
         supersede: false,
         jerk: None,
-    })
+    }
+}
+
+/// A move to `target` (axis position) at 20, acceleration and deceleration 500.
+pub fn move_to(target: f64) -> Operation {
+    Operation::Move(move_spec(target))
 }
 
 /// Largest |second difference| / cycle² of the commanded positions: the
