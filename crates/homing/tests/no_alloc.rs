@@ -567,15 +567,7 @@ fn gearing_makes_no_allocation() {
 
 /// A move the travel limits refuse.
 fn move_outside() -> Operation {
-    Operation::Move(MoveSpec {
-        target: 50.0,
-        relative: false,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
-        supersede: false,
-        jerk: None,
-    })
+    common::move_to(50.0)
 }
 
 #[test]
