@@ -190,21 +190,26 @@ fn a_normal_stop_keeps_the_jerk() {
     assert!(max_jerk(r.since(from)) <= 5_000.0 + JERK_ROUNDING);
 }
 
-#[test]
-fn a_faults_stop_does_not_keep_the_jerk() {
-    // Unhomed towards a limit switch at 3: the trip stops the axis at
-    // max_deceleration (500) with jerk 0 — the shortest stop, v²/2d past
-    // where it began — and ER 12 / 43.
+/// Unhomed and enabled at 0, jogging at 15 u/s with `jerk` towards a
+/// limit switch at 3.
+fn jogging_towards_a_switch(jerk: f64) -> Rig {
     let plant = motion_plant::PlantConfig {
         overtravel: Some((-3.0, 3.0)),
         ..op_plant(0.0)
     };
     let mut r = Rig::new(op_axis(), plant);
     r.enable();
-    r.op(jog_j(15.0, 2_000.0)).unwrap();
+    r.op(jog_j(15.0, jerk)).unwrap();
+    r
+}
+
+/// Steps with `request()` (at most 2000 cycles) until the limit switch
+/// has tripped and the stop it began has ended: the cycle of the step
+/// it tripped in, `None` if it never tripped.
+fn stopped_by_the_switch(r: &mut Rig, request: impl Fn() -> Request) -> Option<u64> {
     let mut tripped = None;
     for _ in 0..2000 {
-        r.step(renew());
+        r.step(request());
         let s = *r.axis.status();
         if tripped.is_none() && s.last_stop == StopCause::LimitSwitch {
             tripped = Some(r.k - 1);
@@ -213,7 +218,16 @@ fn a_faults_stop_does_not_keep_the_jerk() {
             break;
         }
     }
-    let k = tripped.expect("the limit switch stopped it");
+    tripped
+}
+
+#[test]
+fn a_faults_stop_does_not_keep_the_jerk() {
+    // Unhomed towards a limit switch at 3: the trip stops the axis at
+    // max_deceleration (500) with jerk 0 — the shortest stop, v²/2d past
+    // where it began — and ER 12 / 43.
+    let mut r = jogging_towards_a_switch(2_000.0);
+    let k = stopped_by_the_switch(&mut r, renew).expect("the limit switch stopped it");
     let s = *r.axis.status();
     assert_eq!((s.er, s.err, s.exerr), (true, 12, EX_OVERTRAVEL));
     let cmds = &r.cmds[(k - 1) as usize..];
@@ -237,29 +251,13 @@ fn a_fault_during_an_s_curve_stop_replans_it_without_jerk() {
     // stop at 2 would end ≈ 3.8: past the limit switch at 3. The switch
     // trips during the S-curve stop: a fault, which does not let the
     // gentle stop run on but stops with jerk 0 (the acceleration steps).
-    let plant = motion_plant::PlantConfig {
-        overtravel: Some((-3.0, 3.0)),
-        ..op_plant(0.0)
-    };
-    let mut r = Rig::new(op_axis(), plant);
-    r.enable();
-    r.op(jog_j(15.0, 1_000.0)).unwrap();
+    let mut r = jogging_towards_a_switch(1_000.0);
     while r.cmds.last().unwrap().position < 2.0 {
         r.step(renew());
     }
     r.op(Operation::Stop).unwrap();
-    let mut tripped = None;
-    for _ in 0..2000 {
-        r.step(Request::default());
-        let s = *r.axis.status();
-        if tripped.is_none() && s.last_stop == StopCause::LimitSwitch {
-            tripped = Some(r.k - 1);
-        }
-        if !s.stopping {
-            break;
-        }
-    }
-    let k = tripped.expect("the switch tripped during the stop");
+    let k = stopped_by_the_switch(&mut r, Request::default)
+        .expect("the switch tripped during the stop");
     let s = *r.axis.status();
     assert_eq!((s.er, s.err, s.exerr), (true, 12, EX_OVERTRAVEL), "{s:?}");
     let tail = &r.cmds[(k - 2) as usize..];
