@@ -99,10 +99,7 @@ fn a_stop_ends_a_jog_normally_after_its_stopping_distance() {
 
 #[test]
 fn a_request_stop_ends_the_jog_and_gives_it_pc() {
-    let mut r = Rig::at(0.0);
-    r.enable();
-    let id = r.op(jog(10.0)).unwrap();
-    r.run(50);
+    let (mut r, id) = jogging_with_id();
     r.step(Request {
         stop: true,
         ..Request::default()

@@ -354,6 +354,27 @@ pub fn jog(speed: f64) -> Operation {
     })
 }
 
+/// Unhomed, enabled at 0 and at rest ([`Rig::at`]).
+pub fn idle() -> Rig {
+    let mut r = Rig::at(0.0);
+    r.enable();
+    r
+}
+
+/// [`idle`], then jogging at 10 u/s for 50 steps (past its acceleration):
+/// the rig and the jog's operation id.
+pub fn jogging_with_id() -> (Rig, u32) {
+    let mut r = idle();
+    let id = r.op(jog(10.0)).unwrap();
+    r.run(50);
+    (r, id)
+}
+
+/// [`jogging_with_id`] without the id.
+pub fn jogging() -> Rig {
+    jogging_with_id().0
+}
+
 /// The move most tests give: to `target` (axis position) at 20,
 /// acceleration and deceleration 500, a trapezoid, not superseding.
 pub fn move_spec(target: f64) -> MoveSpec {
