@@ -270,13 +270,7 @@ fn a_jog_needs_an_enabled_axis_that_is_not_homing() {
     r.run(2);
     assert_eq!(r.op(jog(5.0)), Err((ERR_SERVO_OFF, 0)));
     // Homing in process: 16 (a switch homing seeking its switch).
-    let cfg = AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    };
-    let mut r = Rig::new(cfg, machine());
-    r.step(home());
-    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    let mut r = at_the_seek();
     assert_eq!(r.op(jog(5.0)), Err((ERR_HOME_IN_PROCESS, 0)));
     assert_eq!(r.op(move_to(5.0)), Err((ERR_HOME_IN_PROCESS, 0)));
     assert_eq!(r.op(Operation::StreamStart), Err((ERR_HOME_IN_PROCESS, 0)));

@@ -91,13 +91,7 @@ fn disable_stops_a_jog_first_then_switches_off() {
 
 #[test]
 fn disable_aborts_homing_with_12_1_then_switches_off() {
-    let cfg = AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    };
-    let mut r = Rig::new(cfg, machine());
-    r.step(home());
-    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    let mut r = at_the_seek();
     r.run(100);
     let id = r.op(Operation::Disable).unwrap();
     let s = *r.axis.status();
@@ -194,13 +188,7 @@ fn a_fault_that_persists_comes_back_after_the_reset_window() {
 fn a_drive_fault_during_homing_needs_a_reset_before_the_next_homing() {
     // Changed with the operations: homing used to reset the fault itself (by
     // toggling the enable); a faulted axis now refuses to home (ERR 20).
-    let cfg = AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    };
-    let mut r = Rig::new(cfg, machine());
-    r.step(home());
-    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    let mut r = at_the_seek();
     r.run(50);
     r.plant.inject_fault();
     r.fb = r.plant.feedback();
@@ -316,14 +304,6 @@ fn a_virtual_axis_is_enabled_and_jogged_without_a_drive() {
     r.op(jog(10.0)).unwrap();
     r.run(100);
     assert!(r.axis.status().jogging && r.cmd_axis() > 0.5);
-}
-
-/// A switch homing on the test machine, with a speed bound.
-fn switch_homing() -> AxisConfig {
-    AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    }
 }
 
 /// Homing, 100 steps in: seeking at 20 u/s.

@@ -354,6 +354,22 @@ pub fn jog(speed: f64) -> Operation {
     })
 }
 
+/// A switch homing on the test machine, with a speed bound.
+pub fn switch_homing() -> AxisConfig {
+    AxisConfig {
+        max_speed: 50.0,
+        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
+    }
+}
+
+/// [`switch_homing`] on the [`machine`], homing just begun: in its seek.
+pub fn at_the_seek() -> Rig {
+    let mut r = Rig::new(switch_homing(), machine());
+    r.step(home());
+    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    r
+}
+
 /// Unhomed, enabled at 0 and at rest ([`Rig::at`]).
 pub fn idle() -> Rig {
     let mut r = Rig::at(0.0);
