@@ -490,18 +490,26 @@ fn a_change_is_refused_where_it_cannot_be_kept() {
     );
 }
 
+/// Homed at 0, jogging at 20 u/s (a = d = 500, trapezoid) towards the
+/// travel limit 10, renewed until its command is at `at` or past it: the
+/// rig and the first cycle after homing.
+fn jogging_to_the_limit_past(at: f64) -> (Rig, u64) {
+    let mut r = Rig::at(0.0);
+    r.enable_and_home();
+    let from = r.k;
+    r.op(jog(20.0)).unwrap();
+    while r.cmd_axis() < at {
+        r.step(renew());
+    }
+    (r, from)
+}
+
 #[test]
 fn a_deceleration_that_cannot_stop_inside_the_limit_is_refused() {
     // Homed jog +20 towards the limit 10 (a = d = 500): at 8 its stop needs
     // 0.4; a deceleration of 100 would need 2 and end at 10+: refused
     // 13 / 4, and the jog still rests exactly on the limit.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k;
-    r.op(jog(20.0)).unwrap();
-    while r.cmd_axis() < 8.0 {
-        r.step(renew());
-    }
+    let (mut r, from) = jogging_to_the_limit_past(8.0);
     let softer = ChangeSpec {
         decel: Some(100.0),
         ..ChangeSpec::none()
@@ -531,13 +539,7 @@ fn a_supersede_whose_s_curve_stop_would_cross_the_limit_is_refused() {
     // Cruising at 20 towards 10, at 8: a move back to 0 must first stop.
     // With jerk 1000 that stop takes 2·√(20/1000) ≈ 0.28 s and ≈ 2.8
     // units — past the limit; the trapezoid's v²/2d = 0.4 would not be.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k;
-    r.op(jog(20.0)).unwrap();
-    while r.cmd_axis() < 8.0 {
-        r.step(renew());
-    }
+    let (mut r, _) = jogging_to_the_limit_past(8.0);
     let back = Operation::Move(MoveSpec {
         supersede: true,
         ..spec_of(move_j(0.0, 1_000.0))
@@ -548,12 +550,7 @@ fn a_supersede_whose_s_curve_stop_would_cross_the_limit_is_refused() {
     );
     // Earlier, at 5, the same move fits (ends ≈ 7.8): accepted, and it
     // never passes the limit on its way back.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    r.op(jog(20.0)).unwrap();
-    while r.cmd_axis() < 5.0 {
-        r.step(renew());
-    }
+    let (mut r, from) = jogging_to_the_limit_past(5.0);
     r.op(back).unwrap();
     assert!(r.run_until(5000, |s| !s.moving));
     assert_eq!(r.cmd_axis(), 0.0);
