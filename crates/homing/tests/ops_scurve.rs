@@ -75,13 +75,20 @@ fn change(r: &mut Rig, c: ChangeSpec) -> Result<(), (u16, u16)> {
     }
 }
 
+/// Enabled and homed at 0, at rest: the rig and the cycle of its last
+/// command before any motion (where `since` starts to see it all).
+fn homed_at_rest() -> (Rig, u64) {
+    let mut r = Rig::at(0.0);
+    r.enable_and_home();
+    let from = r.k - 1;
+    (r, from)
+}
+
 #[test]
 fn an_s_curve_jog_keeps_its_bounds_and_rests_exactly_on_the_limit() {
     // Homed, limits ±10, jog +20 at a = d = 500 with jerk 20 000: the
     // acceleration ramps over 500 / 20 000 = 25 ms instead of stepping.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k - 1;
+    let (mut r, from) = homed_at_rest();
     let id = r.op(jog_j(20.0, 20_000.0)).unwrap();
     for _ in 0..2000 {
         r.step(renew());
@@ -105,9 +112,7 @@ fn an_s_curve_jog_keeps_its_bounds_and_rests_exactly_on_the_limit() {
 
 #[test]
 fn an_s_curve_move_ends_exactly_on_its_target_within_its_bounds() {
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k - 1;
+    let (mut r, from) = homed_at_rest();
     let id = r.op(move_j(7.25, 10_000.0)).unwrap();
     assert!(r.run_until(3000, |s| !s.moving));
     let s = *r.axis.status();
@@ -372,6 +377,11 @@ fn a_change_of_a_jog_keeps_its_direction_and_its_lease() {
 #[test]
 fn a_change_is_refused_where_it_cannot_be_kept() {
     let none = ChangeSpec::none();
+    // A change any running motion could take.
+    let slower = ChangeSpec {
+        speed: Some(1.0),
+        ..none
+    };
     let nothing = (ERR_EXECUTION_COLLISION, EX_NOTHING_TO_CHANGE);
     let range = |ex| Err((ERR_PARAMETER_OUT_OF_RANGE, ex));
     let mut r = Rig::at(0.0);
@@ -437,29 +447,11 @@ fn a_change_is_refused_where_it_cannot_be_kept() {
     assert!(r.axis.status().jogging);
     // Stopping: nothing to change.
     r.op(Operation::Stop).unwrap();
-    assert_eq!(
-        change(
-            &mut r,
-            ChangeSpec {
-                speed: Some(1.0),
-                ..none
-            }
-        ),
-        Err(nothing)
-    );
+    assert_eq!(change(&mut r, slower), Err(nothing));
     assert!(r.run_until(1000, |s| !s.stopping));
     // A stream: its program owns the dynamics.
     r.op(Operation::StreamStart).unwrap();
-    assert_eq!(
-        change(
-            &mut r,
-            ChangeSpec {
-                speed: Some(1.0),
-                ..none
-            }
-        ),
-        Err((ERR_EXECUTION_COLLISION, 0))
-    );
+    assert_eq!(change(&mut r, slower), Err((ERR_EXECUTION_COLLISION, 0)));
     r.op(Operation::StreamEnd).unwrap();
     assert!(r.run_until(1000, |s| !s.stopping && !s.streaming));
     // Homing in process: 16.
@@ -478,16 +470,7 @@ fn a_change_is_refused_where_it_cannot_be_kept() {
     h.step(home());
     h.run(10);
     assert!(h.axis.status().ip);
-    assert_eq!(
-        change(
-            &mut h,
-            ChangeSpec {
-                speed: Some(1.0),
-                ..none
-            }
-        ),
-        Err((ERR_HOME_IN_PROCESS, 0))
-    );
+    assert_eq!(change(&mut h, slower), Err((ERR_HOME_IN_PROCESS, 0)));
 }
 
 /// Homed at 0, jogging at 20 u/s (a = d = 500, trapezoid) towards the
@@ -510,23 +493,23 @@ fn a_deceleration_that_cannot_stop_inside_the_limit_is_refused() {
     // 0.4; a deceleration of 100 would need 2 and end at 10+: refused
     // 13 / 4, and the jog still rests exactly on the limit.
     let (mut r, from) = jogging_to_the_limit_past(8.0);
+    // The softer deceleration, then a jerk so soft its stop runs past the
+    // limit: both refused.
     let softer = ChangeSpec {
         decel: Some(100.0),
         ..ChangeSpec::none()
     };
-    assert_eq!(
-        change(&mut r, softer),
-        Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET))
-    );
-    // A jerk so soft its stop runs past the limit: refused too.
     let soft_jerk = ChangeSpec {
         jerk: Some(100.0),
         ..ChangeSpec::none()
     };
-    assert_eq!(
-        change(&mut r, soft_jerk),
-        Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET))
-    );
+    for c in [softer, soft_jerk] {
+        assert_eq!(
+            change(&mut r, c),
+            Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET)),
+            "{c:?}"
+        );
+    }
     while r.axis.status().jogging {
         r.step(renew());
     }
