@@ -74,14 +74,32 @@ impl<'a> Reader<'a> {
 
     /// A number, or its default (the key's, `default` for a derived one).
     fn number(&mut self, key: &Key, default: f64) -> f64 {
+        self.typed(key, default, "a number", |v| match v {
+            toml::Value::Float(x) => Some(*x),
+            toml::Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        })
+    }
+
+    /// The key's value as `read` takes it, `default` when left out; a value
+    /// `read` does not take (`None`) is a problem ("expected `want`") and
+    /// gives `default`.
+    fn typed<T>(
+        &mut self,
+        key: &Key,
+        default: T,
+        want: &str,
+        read: impl FnOnce(&toml::Value) -> Option<T>,
+    ) -> T {
         match self.value(key) {
             None => default,
-            Some(toml::Value::Float(x)) => *x,
-            Some(toml::Value::Integer(i)) => *i as f64,
-            Some(v) => {
-                self.wrong_type(key, "a number", v);
-                default
-            }
+            Some(v) => match read(v) {
+                Some(x) => x,
+                None => {
+                    self.wrong_type(key, want, v);
+                    default
+                }
+            },
         }
     }
 
@@ -221,19 +239,12 @@ impl<'a> Reader<'a> {
     /// An integer key that must fit `T` (`what` names the range in the
     /// problem).
     fn integer<T: TryFrom<i64>>(&mut self, key: &Key, default: T, what: &str) -> T {
-        match self.value(key) {
+        match self.typed(key, None, "an integer", |v| v.as_integer().map(Some)) {
             None => default,
-            Some(toml::Value::Integer(i)) => {
-                let i = *i;
-                T::try_from(i).unwrap_or_else(|_| {
-                    self.problem(key, format!("{i} is not {what}"));
-                    default
-                })
-            }
-            Some(v) => {
-                self.wrong_type(key, "an integer", v);
+            Some(i) => T::try_from(i).unwrap_or_else(|_| {
+                self.problem(key, format!("{i} is not {what}"));
                 default
-            }
+            }),
         }
     }
 
@@ -243,27 +254,13 @@ impl<'a> Reader<'a> {
     }
 
     pub fn bool_or(&mut self, key: &Key, default: bool) -> bool {
-        match self.value(key) {
-            None => default,
-            Some(toml::Value::Boolean(b)) => *b,
-            Some(v) => {
-                self.wrong_type(key, "true or false", v);
-                default
-            }
-        }
+        self.typed(key, default, "true or false", toml::Value::as_bool)
     }
 
     /// A string (its default when left out; "" for a key without one).
     pub fn string(&mut self, key: &Key) -> String {
-        let default = key.default_text();
-        match self.value(key) {
-            None => default.to_string(),
-            Some(toml::Value::String(s)) => s.clone(),
-            Some(v) => {
-                self.wrong_type(key, "a string", v);
-                default.to_string()
-            }
-        }
+        let default = key.default_text().to_string();
+        self.typed(key, default, "a string", |v| v.as_str().map(str::to_string))
     }
 
     /// An absolute path of at most 200 characters without `..` (a
