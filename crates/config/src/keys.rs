@@ -116,18 +116,22 @@ impl<'a> Reader<'a> {
         let present = self.table.contains_key(key.name);
         let x = self.number(key, default);
         if present && !(x.is_finite() && x >= lo && x <= hi) {
-            let what = if x.is_finite() {
-                "is outside"
-            } else {
-                "is not a finite number; allowed:"
-            };
-            self.problem(
-                key,
-                format!("{} {what} {}..={} {}", num(x), num(lo), num(hi), key.unit),
-            );
+            self.outside(key, x, &format!("{}..={}", num(lo), num(hi)));
             return default;
         }
         x
+    }
+
+    /// The problem of `x`, given for `key`, outside `allowed` (the range as
+    /// the problem says it) or not a finite number at all.
+    fn outside(&mut self, key: &Key, x: f64, allowed: &str) {
+        let what = if x.is_finite() {
+            "is outside"
+        } else {
+            "is not a finite number; allowed:"
+        };
+        let unit = key.unit;
+        self.problem(key, format!("{} {what} {allowed} {unit}", num(x)));
     }
 
     /// A number in `(0, hi]` (the key's [`Bounds::AboveZero`](crate::keytable::Bounds::AboveZero)) when
@@ -147,15 +151,7 @@ impl<'a> Reader<'a> {
             return 0.0;
         }
         if present && !(x.is_finite() && x > 0.0 && x <= hi) {
-            let what = if x.is_finite() {
-                "is outside"
-            } else {
-                "is not a finite number; allowed:"
-            };
-            self.problem(
-                key,
-                format!("{} {what} 0 (excluded)..={} {unit}", num(x), num(hi)),
-            );
+            self.outside(key, x, &format!("0 (excluded)..={}", num(hi)));
             return 0.0;
         }
         x
