@@ -26,30 +26,6 @@ fn op(o: Operation) -> Request {
         ..Request::default()
     }
 }
-fn ready(lim: f64) -> Rig {
-    let mut r = Rig::new(axis(lim), PlantConfig::default());
-    r.step(op(Operation::Enable));
-    r.idle(50);
-    let rung = Request {
-        home: true,
-        ..Request::default()
-    };
-    for _ in 0..200 {
-        r.step(rung);
-    }
-    r.idle(10);
-    assert!(r.axis.status().homed, "homed");
-    r
-}
-fn jog(speed: f64, decel: f64, jerk: Option<f64>) -> Operation {
-    Operation::Jog(JogSpec {
-        speed,
-        lease: Some(0.2),
-        accel: Some(200.0),
-        decel: Some(decel),
-        jerk,
-    })
-}
 
 /// Armed around the switch edge (axis 3, window [2.5, 3.5]), then
 /// redefined by +100: the window follows the positions, so the same edge
