@@ -17,9 +17,17 @@ pub(crate) struct Envelope {
     value: f64,
     /// The cap in force in that cycle: it holds until this one.
     cap: f64,
+    /// What is left of the hold after the last drop, ns: an S-curve's
+    /// stop builds its deceleration up at its jerk before it reaches it.
+    held_ns: u64,
 }
 
 impl Envelope {
+    #[cfg(test)]
+    fn advance0(&mut self, cap: f64, decel: f64, dt_ns: u64) {
+        self.advance(cap, decel, dt_ns, 0)
+    }
+
     /// The bound for the interval that ends now: the cap, or the decaying
     /// bound at the interval's start.
     pub fn interval(&self, cap: f64) -> f64 {
@@ -35,9 +43,17 @@ impl Envelope {
     /// Moves the bound to the end of an interval of `dt_ns` with `cap` in
     /// force and deceleration `decel` allowed: the cap, the cap of the
     /// cycle before (a stop that begins now begins from it), or what
-    /// decayed from the bound before.
-    pub fn advance(&mut self, cap: f64, decel: f64, dt_ns: u64) {
-        let decayed = self.value - decel * ns_to_s(dt_ns);
+    /// decayed from the bound before. A drop of the cap starts a hold of
+    /// `hold_ns` (0 for a trapezoid) during which the bound does not
+    /// decay: a jerk-limited stop's speed stays above the line
+    /// `v − decel·(t − hold)` it then follows, never above the cap.
+    pub fn advance(&mut self, cap: f64, decel: f64, dt_ns: u64, hold_ns: u64) {
+        if cap < self.cap {
+            self.held_ns = hold_ns;
+        }
+        let held = self.held_ns.min(dt_ns);
+        self.held_ns -= held;
+        let decayed = self.value - decel * ns_to_s(dt_ns - held);
         let decayed = if decayed.is_nan() { 0.0 } else { decayed };
         self.value = cap.max(self.cap).max(decayed);
         self.cap = cap;
@@ -63,34 +79,60 @@ mod tests {
     #[test]
     fn a_dropped_cap_decays_from_the_cycle_after_it_dropped() {
         let mut e = Envelope::default();
-        e.advance(20.0, 500.0, MS);
+        e.advance0(20.0, 500.0, MS);
         assert_eq!((e.interval(0.0), e.now()), (20.0, 20.0));
         // the stop is seen: the interval before it and its own first
         // interval keep the speed allowed before
-        e.advance(0.0, 500.0, MS);
+        e.advance0(0.0, 500.0, MS);
         assert_eq!(e.now(), 20.0);
         assert_eq!(e.interval(0.0), 20.0);
-        e.advance(0.0, 500.0, MS);
+        e.advance0(0.0, 500.0, MS);
         assert!((e.now() - 19.5).abs() < 1e-12);
         for _ in 0..39 {
-            e.advance(0.0, 500.0, MS);
+            e.advance0(0.0, 500.0, MS);
         }
         assert!(e.at_rest(), "{}", e.now());
         // a cap that rises again is the bound at once
-        e.advance(5.0, 500.0, MS);
+        e.advance0(5.0, 500.0, MS);
         assert_eq!(e.now(), 5.0);
         // a second drop while the first decays: the cap in force until now
         // decays from now on
         let mut e = Envelope::default();
-        e.advance(20.0, 500.0, MS);
-        e.advance(10.0, 500.0, MS);
-        e.advance(10.0, 500.0, MS);
+        e.advance0(20.0, 500.0, MS);
+        e.advance0(10.0, 500.0, MS);
+        e.advance0(10.0, 500.0, MS);
         assert_eq!(e.now(), 19.5);
-        e.advance(10.0, 500.0, 10 * MS);
+        e.advance0(10.0, 500.0, 10 * MS);
         assert_eq!(e.now(), 14.5);
-        e.advance(1.0, 500.0, 10 * MS);
+        e.advance0(1.0, 500.0, 10 * MS);
         assert_eq!(e.now(), 10.0);
-        e.advance(1.0, 500.0, MS);
+        e.advance0(1.0, 500.0, MS);
         assert_eq!(e.now(), 9.5);
+    }
+
+    #[test]
+    fn a_jerk_limited_stop_is_allowed_its_ramp_in() {
+        // 20 u/s, decel 500, hold 30 ms: 30 ms at 20, then 500 u/s².
+        let mut e = Envelope::default();
+        e.advance(20.0, 500.0, MS, 30 * MS);
+        for _ in 0..30 {
+            e.advance(0.0, 500.0, MS, 30 * MS);
+        }
+        assert_eq!(e.now(), 20.0);
+        e.advance(0.0, 500.0, MS, 30 * MS);
+        assert!((e.now() - 19.5).abs() < 1e-12, "{}", e.now());
+        // an S-curve stop (jerk 20 000, from cruise: ramp-in 25 ms) stays
+        // under the bound with hold (accel + decel / 2) / jerk
+        let (v0, d, j) = (20.0f64, 500.0f64, 20_000.0f64);
+        let hold = ((500.0 + d / 2.0) / j * 1e9) as u64;
+        let mut e = Envelope::default();
+        e.advance(v0, d, MS, hold);
+        let (mut v, mut a) = (v0, 0.0f64);
+        for _ in 0..200 {
+            a = (a + j * 1e-3).min(d);
+            v = (v - a * 1e-3).max(0.0);
+            e.advance(0.0, d, MS, hold);
+            assert!(v <= e.now() + 1e-9, "{v} above {}", e.now());
+        }
     }
 }

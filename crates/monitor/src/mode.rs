@@ -15,8 +15,15 @@ pub(crate) enum Asked {
     Rest,
     /// A homing sequence (its legs, its abort's stop and release).
     Homing,
-    /// A jog or a move as its request carried it.
-    Op { speed: f64, accel: f64, decel: f64 },
+    /// A jog or a move as its request carried it (`jerk` 0: a
+    /// trapezoid; above 0 an S-curve, whose stops and slow-downs build up
+    /// their deceleration at that jerk).
+    Op {
+        speed: f64,
+        accel: f64,
+        decel: f64,
+        jerk: f64,
+    },
     /// The supervised setpoint stream: when its last setpoint arrived
     /// (the stream start counts as one), and whether it was released (it
     /// then lands on that setpoint).
@@ -58,6 +65,12 @@ pub(crate) struct Allowed {
     /// Deceleration its stops reach at least: the rate the speed bound
     /// decays at after the cap dropped.
     pub brake: f64,
+    /// How long after the cap dropped the bound may hold before it decays
+    /// at `brake`, ns: 0 for a trapezoid; for an S-curve the time its
+    /// stop needs to turn its acceleration into `brake` at the jerk
+    /// ((accel + brake / 2) / jerk — from +accel, through 0, to −brake:
+    /// the speed such a stop keeps above a linear decay from the cap).
+    pub hold_ns: u64,
 }
 
 impl Mode {
@@ -88,18 +101,21 @@ impl Mode {
                 speed,
                 accel: Some(accel),
                 decel: Some(decel),
+                jerk,
                 ..
             }))
             | Some(Operation::Move(MoveSpec {
                 speed: Some(speed),
                 accel: Some(accel),
                 decel: Some(decel),
+                jerk,
                 ..
             })) => {
                 m = run(Asked::Op {
                     speed: speed.abs(),
                     accel,
                     decel,
+                    jerk: jerk.unwrap_or(0.0),
                 })
             }
             Some(Operation::StreamStart) => {
@@ -117,11 +133,13 @@ impl Mode {
                     speed,
                     accel,
                     decel,
+                    jerk,
                 } = &mut m.asked
                 {
                     *speed = c.speed.unwrap_or(*speed).abs();
                     *accel = c.accel.unwrap_or(*accel);
                     *decel = c.decel.unwrap_or(*decel);
+                    *jerk = c.jerk.unwrap_or(*jerk);
                 }
             }
             Some(Operation::StreamEnd) => {
@@ -154,6 +172,7 @@ impl Mode {
 
     /// What this mode allows at `now_ns` on an axis homed or not.
     pub fn allowed(&self, b: &Bounds, homed: bool, now_ns: u64) -> Allowed {
+        let mut hold_ns = 0;
         let (cap, accel, decel, brake) = match self.asked {
             Asked::Rest => (0.0, 0.0, b.max_deceleration, b.max_deceleration),
             Asked::Homing => (
@@ -166,17 +185,27 @@ impl Mode {
                 speed,
                 accel,
                 decel,
-            } => (
-                speed.min(b.speed_cap(homed)),
-                accel,
-                decel.max(b.max_deceleration),
-                decel,
-            ),
+                jerk,
+            } => {
+                if jerk > 0.0 && jerk.is_finite() {
+                    let s = (accel + decel / 2.0) / jerk;
+                    hold_ns = if s.is_finite() { (s * 1e9) as u64 } else { 0 };
+                }
+                (
+                    speed.min(b.speed_cap(homed)),
+                    accel,
+                    decel.max(b.max_deceleration),
+                    decel,
+                )
+            }
+            // The follower slows a geared slave (its master stopping, its
+            // cap dropping) at no more than `stream_acceleration`: its
+            // bound decays no faster.
             Asked::Gear => (
                 b.speed_cap(homed),
                 b.stream_acceleration,
                 b.stream_acceleration.max(b.max_deceleration),
-                b.max_deceleration,
+                b.stream_acceleration.min(b.max_deceleration),
             ),
             Asked::Stream { arrived_ns, .. } => {
                 // A program that stops sending is stopped within the
@@ -197,6 +226,7 @@ impl Mode {
             accel: num(accel),
             decel: num(decel),
             brake: num(brake),
+            hold_ns,
         }
     }
 }

@@ -221,7 +221,12 @@ impl Monitor {
             .last
             .map_or(0, |(t, _)| c.now_ns.saturating_sub(t));
         let interval_bound = self.env.interval(a.cap);
-        self.env.advance(a.cap, self.before.brake.min(a.brake), dt);
+        self.env.advance(
+            a.cap,
+            self.before.brake.min(a.brake),
+            dt,
+            self.before.hold_ns.max(a.hold_ns),
+        );
         self.power
             .judge(cmd.enable, self.env.at_rest(), ev, c.request)?;
         self.following = self.follows(c, ev);

@@ -48,6 +48,21 @@ pub(super) struct Registration {
 }
 
 impl Axis {
+    /// A redefine position moved every axis position by `d`: an armed
+    /// window and a latched position follow, so both stay at their place
+    /// on the machine (the edge a window was armed around is still caught).
+    pub(super) fn registration_follows(&mut self, d: f64) {
+        if let Some((lo, hi)) = &mut self.reg.window {
+            *lo += d;
+            *hi += d;
+        }
+        if let Some(p) = &mut self.status.registration_position {
+            *p += d;
+        }
+    }
+}
+
+impl Axis {
     /// MAR: refused on a virtual axis, for a marker the axis lacks, on a
     /// bad window, without feedback and while homing; a new arming
     /// replaces the one before.

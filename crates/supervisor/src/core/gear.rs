@@ -110,15 +110,23 @@ impl Core {
     }
 
     /// After the step: the master of a slave that faulted while geared
-    /// stops (in the next cycle, as a gantry's other sides do).
+    /// stops (in the next cycle, as a gantry's other sides do) — a gantry
+    /// side as master stops with every side of its gantry, never alone.
     pub(super) fn gear_upkeep(&mut self) {
         for i in 0..self.slots.len() {
             let Some(m) = self.slots[i].stop_master.take() else {
                 continue;
             };
-            if let Some(master) = self.slots.get_mut(m) {
-                if master.rung.request.op.is_none() {
-                    master.rung.request.op = Some(Operation::Stop);
+            let sides = (self.gantry_mask.iter().copied())
+                .find(|g| g & (1 << m) != 0)
+                .unwrap_or(1 << m);
+            for k in 0..self.slots.len() {
+                if sides & (1 << k) == 0 {
+                    continue;
+                }
+                let side = &mut self.slots[k];
+                if side.rung.request.op.is_none() {
+                    side.rung.request.op = Some(Operation::Stop);
                 }
             }
         }

@@ -7,7 +7,7 @@
 use super::testbench::Bench;
 use crate::shared::{AxisAck, Refusal};
 use motion_homing::codes::*;
-use motion_homing::{GearSpec, JogSpec, Operation};
+use motion_homing::{GearSpec, JogSpec, MoveSpec, Operation};
 
 /// Axes of these names (config order), immediate homing at 0, max_speed
 /// 50, travel limits ±10, max_deceleration 100.
@@ -206,4 +206,97 @@ fn a_geared_axis_master_or_slave_is_not_redefined_until_the_gear_ends() {
     let m = b.snap().axes[0];
     assert!(m.status.op.refused.is_none(), "{:?}", m.status);
     assert!((m.cmd_position - before).abs() < 1e-12, "no motion");
+}
+
+/// Gantry G (A, B: switch homing) and S (±10), S to be geared to side A.
+fn gantry_and_slave() -> String {
+    let mut t = String::from("[supervisor]\ncycle_us = 1000\ncpu = 0\n");
+    for n in ["A", "B"] {
+        t += &format!(
+            "\n[[axis]]\nname = \"{n}\"\ncounts_per_unit = 1000.0\nhome_sequence = \"switch\"\n\
+             home_speed = 20.0\nhome_return_speed = 2.0\nhome_acceleration = 500.0\n\
+             home_deceleration = 500.0\nmax_speed = 50.0\ntravel_limits = [-100.0, 100.0]\n\
+             [axis.sim]\nstart = -10.0\nswitch = [0.0, 5.0]\n"
+        );
+    }
+    t += "\n[[axis]]\nname = \"S\"\ncounts_per_unit = 1000.0\nhome_sequence = \"immediate\"\n\
+          home_speed = 10.0\nhome_acceleration = 100.0\nhome_deceleration = 100.0\n\
+          max_speed = 50.0\ntravel_limits = [-10.0, 10.0]\n\
+          \n[[gantry]]\nname = \"G\"\naxes = [\"A\", \"B\"]\nmax_skew = 0.5\n";
+    t
+}
+
+#[test]
+fn a_slave_that_faults_stops_every_side_of_its_gantry_master() {
+    // S geared ×4 to side A while G moves to 50 at 5 u/s: S reaches its
+    // travel limit (1025 / 1) and its master stops — both sides of the
+    // gantry, together (before: A alone stopped and B moved on until the
+    // cycle monitor tripped on the skew). The bench fails on any trip.
+    let mut b = Bench::new(&gantry_and_slave());
+    b.run(5);
+    b.home(0b111, true);
+    b.run(4000);
+    b.op(0b111, Operation::Enable, 0);
+    b.run(20);
+    assert_eq!(gear(&mut b, 2, 0, 4.0), AxisAck::Accepted);
+    let to_50 = MoveSpec {
+        target: 50.0,
+        relative: false,
+        speed: Some(5.0),
+        accel: Some(100.0),
+        decel: Some(100.0),
+        supersede: false,
+        jerk: None,
+    };
+    b.op(0b011, Operation::Move(to_50), 0);
+    let mut skew: f64 = 0.0;
+    for _ in 0..3000 {
+        b.cycle();
+        let s = b.snap();
+        skew = skew.max((s.axes[0].cmd_position - s.axes[1].cmd_position).abs());
+    }
+    let s = b.snap();
+    assert_eq!(
+        (s.axes[2].status.err, s.axes[2].status.exerr),
+        (ERR_GEARING, EX_GEAR_SOFT_LIMIT)
+    );
+    for side in &s.axes[..2] {
+        assert!(!side.status.moving && side.cmd_position < 5.0, "{side:?}");
+    }
+    assert!(skew < 1e-6, "racked {skew}");
+}
+
+#[test]
+fn an_unhomed_geared_slave_slows_to_its_cap_without_a_trip() {
+    // S follows M at 40 u/s; unhomed, its cap drops to unhomed_speed 10:
+    // the follower slows at stream_acceleration (200), and the monitor's
+    // bound decays no faster (the bench fails on any trip; before, the
+    // monitor tripped at 37.2 against 37.0). Held to 10 while its master
+    // runs at 40, the slave falls behind beyond catching up: the gear ends
+    // with its own error (1025 / 2).
+    let toml = machine(&["M", "S"]).replace(
+        "max_speed = 50.0\n",
+        "max_speed = 50.0\nunhomed_speed = 10.0\nmax_deceleration = 1000.0\n\
+         stream_acceleration = 200.0\n",
+    );
+    let toml = toml.replace(
+        "travel_limits = [-10.0, 10.0]",
+        "travel_limits = [-1000.0, 1000.0]",
+    );
+    let mut b = ready(&toml);
+    assert_eq!(gear(&mut b, 1, 0, 1.0), AxisAck::Accepted);
+    b.op(1, jog(40.0), 7);
+    b.run(1000);
+    assert!(b.snap().axes[1].cmd_velocity > 39.0);
+    b.ask(9, crate::shared::Ask::Unhome { mask: 0b10 });
+    b.run(500);
+    let s = b.snap().axes[1];
+    assert_eq!(
+        (s.status.err, s.status.exerr),
+        (ERR_GEARING, 2),
+        "{:?}",
+        s.status
+    );
+    assert!(!s.status.gearing && b.core.axes()[1].trip().is_none());
+    assert!(s.cmd_velocity.abs() <= 10.0 + 1e-9, "{}", s.cmd_velocity);
 }

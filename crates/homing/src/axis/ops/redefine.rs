@@ -75,6 +75,7 @@ impl Axis {
         let id = self.accept_op(OpKind::Redefine);
         self.offset += delta;
         self.shift += delta;
+        self.registration_follows(delta);
         self.last_redefine = Some((id, delta));
         self.status.redefines = self.status.redefines.wrapping_add(1);
         self.op_done(id, true);
@@ -90,6 +91,7 @@ impl Axis {
             Some((last, delta)) if last == id && self.status.op.id == id => {
                 self.offset -= delta;
                 self.shift -= delta;
+                self.registration_follows(-delta);
                 self.last_redefine = None;
                 self.status.redefines = self.status.redefines.wrapping_sub(1);
                 self.status.op.pc = false;
