@@ -379,6 +379,15 @@ fn home_again(d: &Daemon, axes: &[&str]) -> CtlHomeReport {
     r.report()
 }
 
+/// `motionctl reset AXIS`, the axis fault seen cleared within 5 s, then
+/// [`home_again`]: an axis fault needs a reset before the next homing.
+#[track_caller]
+fn reset_and_home_again(d: &Daemon, axis: &str) -> CtlHomeReport {
+    d.ctl(&["reset", axis]).expect_code(0);
+    assert!(wait_for(Duration::from_secs(5), || !d.axis(axis).faulted));
+    home_again(d, &[axis])
+}
+
 #[test]
 fn drive_fault_mid_homing_aborts_with_the_drive_error_code_kept() {
     let _serial = serial();
@@ -410,9 +419,7 @@ fn drive_fault_mid_homing_aborts_with_the_drive_error_code_kept() {
     let r = d.ctl(&["home", "S", "--no-wait", "--json"]);
     r.expect_code(1);
     assert!(r.stdout.contains("\"err\":20"), "{}", r.stdout);
-    d.ctl(&["reset", "S"]).expect_code(0);
-    assert!(wait_for(Duration::from_secs(5), || !d.axis("S").faulted));
-    let r = home_again(&d, &["S"]);
+    let r = reset_and_home_again(&d, "S");
     // sampled switch at 1 u/s: ± one cycle of travel
     assert_close!(named(&r.axes, "S"), event_raw, 0.0, 0.001 + COUNT);
     let st = d.axis("S");
@@ -674,9 +681,7 @@ fn a_drive_short_on_process_data_leaves_the_others_served() {
     assert_eq!(v.position, at, "moved: {v:?}");
     assert!(!d.axis("S").enabled);
     // after a reset it homes again
-    d.ctl(&["reset", "S"]).expect_code(0);
-    assert!(wait_for(Duration::from_secs(5), || !d.axis("S").faulted));
-    let v = home_again(&d, &["S"]);
+    let v = reset_and_home_again(&d, "S");
     assert!(named(&v.axes, "S").pc);
     d.stop().expect_code(0);
     assert_clean(&b.cfg.prefix);
@@ -998,9 +1003,7 @@ fn a_drive_power_cycled_mid_homing_is_reconfigured_without_restarting_motion_io(
     );
     // the axis fault of the lost drive needs a reset before homing again
     // (ERR 20 until then)
-    d.ctl(&["reset", "S"]).expect_code(0);
-    assert!(wait_for(Duration::from_secs(5), || !d.axis("S").faulted));
-    let r = home_again(&d, &["S"]);
+    let r = reset_and_home_again(&d, "S");
     assert!(named(&r.axes, "S").pc);
     let end = d.stop().expect_code(0).stderr.clone();
     assert!(end.contains("1 re-configured after a power cycle"), "{end}");

@@ -43,31 +43,48 @@ pub fn home_until(name: &str, mut stop: impl FnMut(&Axis, &Feedback) -> bool) ->
         .iter()
         .find(|a| a.name == name)
         .expect("demo axis exists");
-    let mut axis = Axis::new(a.engine);
-    let mut plant = Plant::new(a.sim);
+    let plant = Plant::new(a.sim);
+    // the rung goes high in cycle 1: a rising edge
     let dt_ns = m.supervisor.cycle_ns();
-    let dt = dt_ns as f64 * 1e-9;
-    let mut fb = plant.feedback();
-    for k in 0..200_000u64 {
-        let now = k * dt_ns;
-        // the rung goes high in cycle 1: a rising edge
+    capture(Axis::new(a.engine), plant, dt_ns, 200_000, |k, axis, fb| {
         let request = Request {
             home: k >= 1,
             ..Request::default()
         };
-        if k > 1 && stop(&axis, &fb) {
-            return Captured {
+        let now = k > 1 && stop(axis, fb);
+        (request, now)
+    })
+    .unwrap_or_else(|| panic!("axis {name}: the state to capture was never reached"))
+}
+
+/// Steps `axis` against `plant` every `dt_ns`, for at most `cycles` cycles:
+/// `next(cycle, axis, feedback)` gives the cycle's request and whether to
+/// capture that step's inputs instead of taking it. `None`: never captured.
+fn capture(
+    mut axis: Axis,
+    mut plant: Plant,
+    dt_ns: u64,
+    cycles: u64,
+    mut next: impl FnMut(u64, &Axis, &Feedback) -> (Request, bool),
+) -> Option<Captured> {
+    let dt = dt_ns as f64 * 1e-9;
+    let mut fb = plant.feedback();
+    for k in 0..cycles {
+        let now = k * dt_ns;
+        let (request, take) = next(k, &axis, &fb);
+        if take {
+            return Some(Captured {
                 axis,
                 feedback: fb,
                 now,
                 request,
                 cycle: k,
-            };
+            });
         }
         let cmd = axis.step(now, Some(&fb), &request);
         fb = plant.step(&cmd, dt);
     }
-    panic!("axis {name}: the state to capture was never reached");
+    None
 }
 
 /// Axis X (switch then marker) in the middle of its first leg: seeking the
@@ -181,49 +198,44 @@ pub fn move_state(jerk: f64) -> Captured {
     let m = demo();
     let a = m.axes.iter().find(|a| a.name == "X").expect("demo axis X");
     // Immediate homing derives no speed bound: the homing speed is it.
-    let mut axis = Axis::new(motion_homing::AxisConfig {
+    let axis = Axis::new(motion_homing::AxisConfig {
         home_sequence: HomeSequence::Immediate,
         max_speed: a.engine.max_speed.max(a.engine.home_speed),
         ..a.engine
     });
-    let mut plant = Plant::new(a.sim);
-    let dt_ns = m.supervisor.cycle_ns();
-    let dt = dt_ns as f64 * 1e-9;
-    let mut fb = plant.feedback();
+    let plant = Plant::new(a.sim);
     let mut started = None;
-    for k in 0..10_000u64 {
-        let now = k * dt_ns;
-        let s = *axis.status();
-        let mut request = Request {
-            home: s.servo_action,
-            ..Request::default()
-        };
-        if k == 1 {
-            request.op = Some(Operation::Enable);
-        }
-        if s.homed && s.servo_action && started.is_none() {
-            started = Some(k);
-            request.op = Some(Operation::Move(MoveSpec {
-                target: 40.0,
-                relative: true,
-                jerk: Some(jerk),
-                ..MoveSpec::to(0.0)
-            }));
-        }
-        if started.is_some_and(|s0| k == s0 + 10) {
-            assert!(axis.status().moving, "the move runs");
-            return Captured {
-                axis,
-                feedback: fb,
-                now,
-                request,
-                cycle: k,
+    capture(
+        axis,
+        plant,
+        m.supervisor.cycle_ns(),
+        10_000,
+        |k, axis, _| {
+            let s = *axis.status();
+            let mut request = Request {
+                home: s.servo_action,
+                ..Request::default()
             };
-        }
-        let cmd = axis.step(now, Some(&fb), &request);
-        fb = plant.step(&cmd, dt);
-    }
-    panic!("axis X: the move never started");
+            if k == 1 {
+                request.op = Some(Operation::Enable);
+            }
+            if s.homed && s.servo_action && started.is_none() {
+                started = Some(k);
+                request.op = Some(Operation::Move(MoveSpec {
+                    target: 40.0,
+                    relative: true,
+                    jerk: Some(jerk),
+                    ..MoveSpec::to(0.0)
+                }));
+            }
+            let now = started.is_some_and(|s0| k == s0 + 10);
+            if now {
+                assert!(axis.status().moving, "the move runs");
+            }
+            (request, now)
+        },
+    )
+    .expect("axis X: the move never started")
 }
 
 /// A master jogging (a trapezoid at its cruise, 10 u/s) and a slave geared

@@ -74,14 +74,32 @@ impl<'a> Reader<'a> {
 
     /// A number, or its default (the key's, `default` for a derived one).
     fn number(&mut self, key: &Key, default: f64) -> f64 {
+        self.typed(key, default, "a number", |v| match v {
+            toml::Value::Float(x) => Some(*x),
+            toml::Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        })
+    }
+
+    /// The key's value as `read` takes it, `default` when left out; a value
+    /// `read` does not take (`None`) is a problem ("expected `want`") and
+    /// gives `default`.
+    fn typed<T>(
+        &mut self,
+        key: &Key,
+        default: T,
+        want: &str,
+        read: impl FnOnce(&toml::Value) -> Option<T>,
+    ) -> T {
         match self.value(key) {
             None => default,
-            Some(toml::Value::Float(x)) => *x,
-            Some(toml::Value::Integer(i)) => *i as f64,
-            Some(v) => {
-                self.wrong_type(key, "a number", v);
-                default
-            }
+            Some(v) => match read(v) {
+                Some(x) => x,
+                None => {
+                    self.wrong_type(key, want, v);
+                    default
+                }
+            },
         }
     }
 
@@ -98,18 +116,22 @@ impl<'a> Reader<'a> {
         let present = self.table.contains_key(key.name);
         let x = self.number(key, default);
         if present && !(x.is_finite() && x >= lo && x <= hi) {
-            let what = if x.is_finite() {
-                "is outside"
-            } else {
-                "is not a finite number; allowed:"
-            };
-            self.problem(
-                key,
-                format!("{} {what} {}..={} {}", num(x), num(lo), num(hi), key.unit),
-            );
+            self.outside(key, x, &format!("{}..={}", num(lo), num(hi)));
             return default;
         }
         x
+    }
+
+    /// The problem of `x`, given for `key`, outside `allowed` (the range as
+    /// the problem says it) or not a finite number at all.
+    fn outside(&mut self, key: &Key, x: f64, allowed: &str) {
+        let what = if x.is_finite() {
+            "is outside"
+        } else {
+            "is not a finite number; allowed:"
+        };
+        let unit = key.unit;
+        self.problem(key, format!("{} {what} {allowed} {unit}", num(x)));
     }
 
     /// A number in `(0, hi]` (the key's [`Bounds::AboveZero`](crate::keytable::Bounds::AboveZero)) when
@@ -129,15 +151,7 @@ impl<'a> Reader<'a> {
             return 0.0;
         }
         if present && !(x.is_finite() && x > 0.0 && x <= hi) {
-            let what = if x.is_finite() {
-                "is outside"
-            } else {
-                "is not a finite number; allowed:"
-            };
-            self.problem(
-                key,
-                format!("{} {what} 0 (excluded)..={} {unit}", num(x), num(hi)),
-            );
+            self.outside(key, x, &format!("0 (excluded)..={}", num(hi)));
             return 0.0;
         }
         x
@@ -221,19 +235,12 @@ impl<'a> Reader<'a> {
     /// An integer key that must fit `T` (`what` names the range in the
     /// problem).
     fn integer<T: TryFrom<i64>>(&mut self, key: &Key, default: T, what: &str) -> T {
-        match self.value(key) {
+        match self.typed(key, None, "an integer", |v| v.as_integer().map(Some)) {
             None => default,
-            Some(toml::Value::Integer(i)) => {
-                let i = *i;
-                T::try_from(i).unwrap_or_else(|_| {
-                    self.problem(key, format!("{i} is not {what}"));
-                    default
-                })
-            }
-            Some(v) => {
-                self.wrong_type(key, "an integer", v);
+            Some(i) => T::try_from(i).unwrap_or_else(|_| {
+                self.problem(key, format!("{i} is not {what}"));
                 default
-            }
+            }),
         }
     }
 
@@ -243,27 +250,13 @@ impl<'a> Reader<'a> {
     }
 
     pub fn bool_or(&mut self, key: &Key, default: bool) -> bool {
-        match self.value(key) {
-            None => default,
-            Some(toml::Value::Boolean(b)) => *b,
-            Some(v) => {
-                self.wrong_type(key, "true or false", v);
-                default
-            }
-        }
+        self.typed(key, default, "true or false", toml::Value::as_bool)
     }
 
     /// A string (its default when left out; "" for a key without one).
     pub fn string(&mut self, key: &Key) -> String {
-        let default = key.default_text();
-        match self.value(key) {
-            None => default.to_string(),
-            Some(toml::Value::String(s)) => s.clone(),
-            Some(v) => {
-                self.wrong_type(key, "a string", v);
-                default.to_string()
-            }
-        }
+        let default = key.default_text().to_string();
+        self.typed(key, default, "a string", |v| v.as_str().map(str::to_string))
     }
 
     /// An absolute path of at most 200 characters without `..` (a

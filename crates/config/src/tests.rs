@@ -546,11 +546,9 @@ fn the_gantry_example_has_orders_a_gantry_and_an_absolute_axis() {
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
 }
 
-/// The keys of the operations: parsed, defaults left to the engine (0),
-/// every mistake named by axis and key.
-#[test]
-fn the_keys_of_the_operations() {
-    let base = r#"
+/// Axis X homed where it stands, Home Speed 20, Home Acceleration 400 and
+/// Deceleration 500: the base the operation keys are added to.
+const IMMEDIATE_X: &str = r#"
 [[axis]]
 name = "X"
 home_sequence = "immediate"
@@ -558,6 +556,12 @@ home_speed = 20.0
 home_acceleration = 400.0
 home_deceleration = 500.0
 "#;
+
+/// The keys of the operations: parsed, defaults left to the engine (0),
+/// every mistake named by axis and key.
+#[test]
+fn the_keys_of_the_operations() {
+    let base = IMMEDIATE_X;
     let m = parse(base).unwrap_or_else(|p| panic!("{p:#?}"));
     let e = &m.axes[0].engine;
     assert_eq!(
@@ -612,14 +616,7 @@ home_deceleration = 500.0
 /// negative; a gantry's sides must agree on it (they jog and move alike).
 #[test]
 fn the_jerk_key() {
-    let base = r#"
-[[axis]]
-name = "X"
-home_sequence = "immediate"
-home_speed = 20.0
-home_acceleration = 400.0
-home_deceleration = 500.0
-"#;
+    let base = IMMEDIATE_X;
     let m = parse(base).unwrap_or_else(|p| panic!("{p:#?}"));
     assert_eq!(m.axes[0].engine.jerk, 0.0);
     let m = parse(&format!("{base}jerk = 20000.0\n")).unwrap_or_else(|p| panic!("{p:#?}"));

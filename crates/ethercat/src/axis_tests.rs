@@ -23,6 +23,19 @@ fn cmd(enable: bool, target: i64) -> AxisCommand {
     }
 }
 
+/// One cycle of `a`: the command [`cmd`]`(enable, target)` in `mode`, the
+/// drive reporting [`inputs`]`(state, pos)`.
+fn cycle(
+    a: &mut AxisLogic,
+    enable: bool,
+    target: i64,
+    mode: Mode,
+    state: State,
+    pos: i32,
+) -> (DriveOutputs, AxisFeedback) {
+    a.step(&cmd(enable, target), mode, Some(&inputs(state, pos)))
+}
+
 fn inputs(state: State, pos: i32) -> DriveInputs {
     DriveInputs {
         statusword: state.statusword() | 0x0200,
@@ -34,10 +47,13 @@ fn inputs(state: State, pos: i32) -> DriveInputs {
 #[test]
 fn enabling_walks_the_state_machine_and_target_tracks_actual() {
     let mut a = logic();
-    let (o, fb) = a.step(
-        &cmd(true, 500),
+    let (o, fb) = cycle(
+        &mut a,
+        true,
+        500,
         Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, 123)),
+        State::SwitchOnDisabled,
+        123,
     );
     assert_eq!(o.controlword, 0x0006);
     assert_eq!(o.target_position, 123, "not enabled: follows actual");
@@ -46,31 +62,29 @@ fn enabling_walks_the_state_machine_and_target_tracks_actual() {
     assert_eq!(o.mode, 8);
     assert_eq!(fb.status_word, 0);
     assert_eq!(fb.position, 123);
-    let (o, _) = a.step(
-        &cmd(true, 500),
-        Mode::Normal,
-        Some(&inputs(State::ReadyToSwitchOn, 123)),
-    );
+    let (o, _) = cycle(&mut a, true, 500, Mode::Normal, State::ReadyToSwitchOn, 123);
     assert_eq!(o.controlword, 0x0007);
-    let (o, _) = a.step(
-        &cmd(true, 500),
-        Mode::Normal,
-        Some(&inputs(State::SwitchedOn, 123)),
-    );
+    let (o, _) = cycle(&mut a, true, 500, Mode::Normal, State::SwitchedOn, 123);
     assert_eq!(o.controlword, 0x000F);
     assert_eq!(o.target_position, 123);
-    let (o, fb) = a.step(
-        &cmd(true, 500),
+    let (o, fb) = cycle(
+        &mut a,
+        true,
+        500,
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 124)),
+        State::OperationEnabled,
+        124,
     );
     assert_eq!(o.target_position, 500);
     assert_eq!(fb.status_word, SW_ENABLED);
     // disable
-    let (o, fb) = a.step(
-        &cmd(false, 500),
+    let (o, fb) = cycle(
+        &mut a,
+        false,
+        500,
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 500)),
+        State::OperationEnabled,
+        500,
     );
     assert_eq!(o.controlword, 0x0006);
     assert_eq!(o.target_position, 500);
@@ -81,25 +95,17 @@ fn enabling_walks_the_state_machine_and_target_tracks_actual() {
 fn positions_extend_over_the_32_bit_wrap() {
     let mut a = logic();
     let mut p = i32::MAX - 5;
-    let (_, fb) = a.step(
-        &cmd(false, 0),
-        Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, p)),
-    );
+    let (_, fb) = cycle(&mut a, false, 0, Mode::Normal, State::SwitchOnDisabled, p);
     assert_eq!(fb.position, i64::from(i32::MAX) - 5);
     for _ in 0..10 {
         p = p.wrapping_add(3);
-        a.step(
-            &cmd(false, 0),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, p)),
-        );
+        cycle(&mut a, false, 0, Mode::Normal, State::SwitchOnDisabled, p);
     }
     assert_eq!(a.last_feedback().position, i64::from(i32::MAX) + 25);
     // a target beyond 2^31 goes out modulo 2^32
     let t = i64::from(i32::MAX) + 30;
     for s in [State::OperationEnabled, State::OperationEnabled] {
-        let (o, _) = a.step(&cmd(true, t), Mode::Normal, Some(&inputs(s, p)));
+        let (o, _) = cycle(&mut a, true, t, Mode::Normal, s, p);
         assert_eq!(o.target_position, t as i32);
     }
 }
@@ -107,21 +113,16 @@ fn positions_extend_over_the_32_bit_wrap() {
 #[test]
 fn bad_setpoints_are_refused_with_a_fault_until_the_handshake() {
     let mut a = logic();
-    a.step(
-        &cmd(true, 0),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
-    let (o, _) = a.step(
-        &cmd(true, 10),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
+    cycle(&mut a, true, 0, Mode::Normal, State::OperationEnabled, 0);
+    let (o, _) = cycle(&mut a, true, 10, Mode::Normal, State::OperationEnabled, 0);
     assert_eq!(o.target_position, 10);
-    let (o, fb) = a.step(
-        &cmd(true, INVALID_COUNTS),
+    let (o, fb) = cycle(
+        &mut a,
+        true,
+        INVALID_COUNTS,
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 10)),
+        State::OperationEnabled,
+        10,
     );
     assert_eq!(o.target_position, 10, "last good target held");
     assert_eq!(o.controlword, 0x0002, "quick stop on the drive's ramp");
@@ -129,50 +130,33 @@ fn bad_setpoints_are_refused_with_a_fault_until_the_handshake() {
     assert_eq!(a.counters.rejected_setpoints, 1);
     // too far away
     let mut b = logic();
-    b.step(
-        &cmd(true, 0),
+    cycle(&mut b, true, 0, Mode::Normal, State::OperationEnabled, 0);
+    cycle(
+        &mut b,
+        true,
+        MAX_TARGET_DISTANCE + 1,
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
-    b.step(
-        &cmd(true, MAX_TARGET_DISTANCE + 1),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
+        State::OperationEnabled,
+        0,
     );
     assert_eq!(b.counters.rejected_setpoints, 1);
     // NaN torque limit
     let mut c = logic();
     let mut n = cmd(true, 0);
     n.torque_limit_positive = f32::NAN;
-    c.step(
-        &cmd(true, 0),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
+    cycle(&mut c, true, 0, Mode::Normal, State::OperationEnabled, 0);
     c.step(&n, Mode::Normal, Some(&inputs(State::OperationEnabled, 0)));
     assert_eq!(c.counters.rejected_setpoints, 1);
     // fault stays while enable stays; drive now disabled
-    let (o, fb) = a.step(
-        &cmd(true, 10),
-        Mode::Normal,
-        Some(&inputs(State::ReadyToSwitchOn, 10)),
-    );
+    let (o, fb) = cycle(&mut a, true, 10, Mode::Normal, State::ReadyToSwitchOn, 10);
     assert_eq!(
         o.controlword, 0x0000,
         "held in Switch on disabled until a reset"
     );
     assert_eq!(fb.status_word, SW_FAULT);
     // handshake
-    a.step(
-        &cmd(false, 10),
-        Mode::Normal,
-        Some(&inputs(State::ReadyToSwitchOn, 10)),
-    );
-    let (o, fb) = a.step(
-        &cmd(true, 10),
-        Mode::Normal,
-        Some(&inputs(State::ReadyToSwitchOn, 10)),
-    );
+    cycle(&mut a, false, 10, Mode::Normal, State::ReadyToSwitchOn, 10);
+    let (o, fb) = cycle(&mut a, true, 10, Mode::Normal, State::ReadyToSwitchOn, 10);
     assert_eq!(o.controlword, 0x0007);
     assert_eq!(fb.status_word, 0);
 }
@@ -193,22 +177,14 @@ fn drive_fault_code_kept_and_reset_on_the_edge() {
     let (_, fb) = a.step(&cmd(true, 0), Mode::Normal, Some(&f));
     assert_eq!(fb.error_code, 0x2310);
     // out of fault: code 0
-    let (_, fb) = a.step(
-        &cmd(true, 0),
-        Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, 0)),
-    );
+    let (_, fb) = cycle(&mut a, true, 0, Mode::Normal, State::SwitchOnDisabled, 0);
     assert_eq!((fb.status_word, fb.error_code), (0, 0));
 }
 
 #[test]
 fn watchdog_stop_quick_stops_then_disables_with_a_fault() {
     let mut a = logic();
-    a.step(
-        &cmd(true, 0),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
+    cycle(&mut a, true, 0, Mode::Normal, State::OperationEnabled, 0);
     let mut moving = inputs(State::OperationEnabled, 100);
     moving.velocity = 50_000;
     let (o, _) = a.step(&cmd(true, 0), Mode::WatchdogStop, Some(&moving));
@@ -230,42 +206,57 @@ fn watchdog_stop_quick_stops_then_disables_with_a_fault() {
     let (o, fb) = a.step(&cmd(true, 0), Mode::WatchdogStop, Some(&qs));
     assert_eq!(o.controlword, 0x0000, "quick stop active → disable voltage");
     assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
-    let (_, fb) = a.step(
-        &cmd(true, 0),
+    let (_, fb) = cycle(
+        &mut a,
+        true,
+        0,
         Mode::WatchdogStop,
-        Some(&inputs(State::SwitchOnDisabled, 210)),
+        State::SwitchOnDisabled,
+        210,
     );
     assert!(a.at_rest_and_disabled());
     assert_eq!(fb.status_word, SW_FAULT);
     // commands again: enable still true → no edge → fault stays
-    let (o, fb) = a.step(
-        &cmd(true, 210),
+    let (o, fb) = cycle(
+        &mut a,
+        true,
+        210,
         Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, 210)),
+        State::SwitchOnDisabled,
+        210,
     );
     assert_eq!(
         o.controlword, 0x0000,
         "held in Switch on disabled until a reset"
     );
     assert_eq!(fb.status_word, SW_FAULT);
-    a.step(
-        &cmd(false, 210),
+    cycle(
+        &mut a,
+        false,
+        210,
         Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, 210)),
+        State::SwitchOnDisabled,
+        210,
     );
-    let (_, fb) = a.step(
-        &cmd(true, 210),
+    let (_, fb) = cycle(
+        &mut a,
+        true,
+        210,
         Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, 210)),
+        State::SwitchOnDisabled,
+        210,
     );
     assert_eq!(fb.status_word, 0);
 
     // an axis that never asked to be enabled: no fault
     let mut b = logic();
-    let (_, fb) = b.step(
-        &cmd(false, 0),
+    let (_, fb) = cycle(
+        &mut b,
+        false,
+        0,
         Mode::WatchdogStop,
-        Some(&inputs(State::SwitchOnDisabled, 0)),
+        State::SwitchOnDisabled,
+        0,
     );
     assert_eq!(fb.status_word, 0);
     assert!(b.at_rest_and_disabled());
@@ -274,55 +265,34 @@ fn watchdog_stop_quick_stops_then_disables_with_a_fault() {
 #[test]
 fn commands_back_in_the_middle_of_a_watchdog_stop_never_enable_again() {
     let mut a = logic();
-    a.step(
-        &cmd(true, 0),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
-    let (o, _) = a.step(
-        &cmd(true, 0),
+    cycle(&mut a, true, 0, Mode::Normal, State::OperationEnabled, 0);
+    let (o, _) = cycle(
+        &mut a,
+        true,
+        0,
         Mode::WatchdogStop,
-        Some(&inputs(State::OperationEnabled, 0)),
+        State::OperationEnabled,
+        0,
     );
     assert_eq!(o.controlword, 0x0002);
     // the drive ended its quick stop by itself; the commands come back
     // before the stop saw it: enable still asked for, no edge
     for _ in 0..5 {
-        let (o, fb) = a.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::SwitchOnDisabled, 0)),
-        );
+        let (o, fb) = cycle(&mut a, true, 0, Mode::Normal, State::SwitchOnDisabled, 0);
         assert_eq!(o.controlword, 0x0000, "never walked to enabled");
         assert_eq!(fb.status_word, SW_FAULT);
     }
     // a reset (the enable edge) and it enables
-    a.step(
-        &cmd(false, 0),
-        Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, 0)),
-    );
-    let (o, fb) = a.step(
-        &cmd(true, 0),
-        Mode::Normal,
-        Some(&inputs(State::SwitchOnDisabled, 0)),
-    );
+    cycle(&mut a, false, 0, Mode::Normal, State::SwitchOnDisabled, 0);
+    let (o, fb) = cycle(&mut a, true, 0, Mode::Normal, State::SwitchOnDisabled, 0);
     assert_eq!((o.controlword, fb.status_word), (0x0006, 0));
 }
 
 #[test]
 fn emergency_is_disable_voltage_and_a_fault() {
     let mut a = logic();
-    a.step(
-        &cmd(true, 0),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
-    let (o, fb) = a.step(
-        &cmd(true, 0),
-        Mode::Emergency,
-        Some(&inputs(State::OperationEnabled, 0)),
-    );
+    cycle(&mut a, true, 0, Mode::Normal, State::OperationEnabled, 0);
+    let (o, fb) = cycle(&mut a, true, 0, Mode::Emergency, State::OperationEnabled, 0);
     assert_eq!(o.controlword, 0x0000);
     assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);
 }
@@ -359,11 +329,7 @@ fn a_stop_without_data_is_sent_blind_on_time_alone() {
             0.001,
         )
     });
-    let (o, _) = a.step(
-        &cmd(true, 100),
-        Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 90)),
-    );
+    let (o, _) = cycle(&mut a, true, 100, Mode::Normal, State::OperationEnabled, 90);
     assert_eq!(o.controlword, 0x000F);
     // enabled and following: the target goes on, the state machine is not
     // stepped blind
@@ -384,10 +350,13 @@ fn a_stop_without_data_is_sent_blind_on_time_alone() {
     // not counted as stopped: its state was not seen
     assert!(!a.at_rest_and_disabled());
     // data again: Switch on disabled seen, the stop complete, a fault
-    let (o, fb) = a.step(
-        &cmd(true, 120),
+    let (o, fb) = cycle(
+        &mut a,
+        true,
+        120,
         Mode::WatchdogStop,
-        Some(&inputs(State::SwitchOnDisabled, 95)),
+        State::SwitchOnDisabled,
+        95,
     );
     assert_eq!(o.controlword, 0x0000);
     assert!(a.at_rest_and_disabled());
@@ -403,10 +372,13 @@ fn a_stop_without_data_is_sent_blind_on_time_alone() {
             0.001,
         )
     });
-    a.step(
-        &cmd(true, 100),
+    cycle(
+        &mut a,
+        true,
+        100,
         Mode::Normal,
-        Some(&inputs(State::OperationEnabled, 100)),
+        State::OperationEnabled,
+        100,
     );
     let words: Vec<u16> = (0..22)
         .map(|_| {
@@ -426,11 +398,7 @@ fn a_stop_without_data_is_sent_blind_on_time_alone() {
         (Mode::Emergency, true, 0x0000),
     ] {
         let mut a = logic();
-        a.step(
-            &cmd(true, 0),
-            Mode::Normal,
-            Some(&inputs(State::OperationEnabled, 0)),
-        );
+        cycle(&mut a, true, 0, Mode::Normal, State::OperationEnabled, 0);
         let (o, _) = a.step(&cmd(enable, 0), mode, None);
         assert_eq!(o.controlword, word, "{mode:?}");
     }
@@ -536,10 +504,13 @@ fn a_drive_ignoring_quick_stop_is_switched_off_within_the_bound() {
     let k = crate::stop::QS_ACK_CYCLES as usize;
     assert!(words[..k].iter().all(|w| *w == 0x0002), "{words:x?}");
     assert_eq!(words[k], 0x0000, "disable voltage: {words:x?}");
-    let (_, fb) = a.step(
-        &cmd(true, 0),
+    let (_, fb) = cycle(
+        &mut a,
+        true,
+        0,
         Mode::WatchdogStop,
-        Some(&inputs(State::SwitchOnDisabled, 0)),
+        State::SwitchOnDisabled,
+        0,
     );
     assert!(a.at_rest_and_disabled());
     assert_eq!(fb.status_word & SW_FAULT, SW_FAULT);

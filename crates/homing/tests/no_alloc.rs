@@ -3,6 +3,8 @@
 //! coordination, feedback-trouble and stored-reference paths, and over the
 //! operations around homing (power, jog, move, stream, limits, faults).
 
+mod common;
+
 use motion_homing::*;
 use motion_plant::{Plant, PlantConfig};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -292,21 +294,13 @@ fn coordination_feedback_trouble_and_references_make_no_allocation() {
 /// every kind.
 #[test]
 fn operations_make_no_allocation() {
-    const T: u64 = 1_000_000;
+    const T: u64 = common::MS;
     let cfg = AxisConfig {
-        counts_per_unit: 1000.0,
-        home_sequence: HomeSequence::Immediate,
-        home_speed: 20.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-10.0, 10.0)),
-        max_speed: 50.0,
         max_deceleration: 2000.0,
-        cycle_ns: T,
         marker: true,
         marker_latch: true,
         registration: true,
-        ..AxisConfig::default()
+        ..common::op_axis()
     };
     let mut axis = Axis::new(cfg);
     let mut plant = Plant::new(PlantConfig {
@@ -329,13 +323,9 @@ fn operations_make_no_allocation() {
     };
     let mv = |target: f64, supersede: bool| {
         Operation::Move(MoveSpec {
-            target,
-            relative: false,
-            speed: Some(20.0),
-            accel: Some(500.0),
-            decel: Some(500.0),
             supersede,
             jerk: (!supersede).then_some(5_000.0),
+            ..common::move_spec(target)
         })
     };
     // MCD on the S-curve move, then on nothing (refused).
@@ -496,18 +486,8 @@ fn gearing_makes_no_allocation() {
     // A master jogged back and forth, a slave geared to it with a clutch,
     // then at ratio 4 into its travel limit (1025 / 1), then geared on the
     // master's actual position while the master's drive faults (1025 / 3).
-    const T: u64 = 1_000_000;
-    let cfg = AxisConfig {
-        counts_per_unit: 1000.0,
-        home_sequence: HomeSequence::Immediate,
-        home_speed: 20.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-10.0, 10.0)),
-        max_speed: 50.0,
-        cycle_ns: T,
-        ..AxisConfig::default()
-    };
+    const T: u64 = common::MS;
+    let cfg = common::op_axis();
     let (mut m, mut s) = (Axis::new(cfg), Axis::new(cfg));
     let (mut mp, mut sp) = (
         Plant::new(PlantConfig::default()),
@@ -587,15 +567,7 @@ fn gearing_makes_no_allocation() {
 
 /// A move the travel limits refuse.
 fn move_outside() -> Operation {
-    Operation::Move(MoveSpec {
-        target: 50.0,
-        relative: false,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
-        supersede: false,
-        jerk: None,
-    })
+    common::move_to(50.0)
 }
 
 #[test]

@@ -99,10 +99,7 @@ fn a_stop_ends_a_jog_normally_after_its_stopping_distance() {
 
 #[test]
 fn a_request_stop_ends_the_jog_and_gives_it_pc() {
-    let mut r = Rig::at(0.0);
-    r.enable();
-    let id = r.op(jog(10.0)).unwrap();
-    r.run(50);
+    let (mut r, id) = jogging_with_id();
     r.step(Request {
         stop: true,
         ..Request::default()
@@ -273,13 +270,7 @@ fn a_jog_needs_an_enabled_axis_that_is_not_homing() {
     r.run(2);
     assert_eq!(r.op(jog(5.0)), Err((ERR_SERVO_OFF, 0)));
     // Homing in process: 16 (a switch homing seeking its switch).
-    let cfg = AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    };
-    let mut r = Rig::new(cfg, machine());
-    r.step(home());
-    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    let mut r = at_the_seek();
     assert_eq!(r.op(jog(5.0)), Err((ERR_HOME_IN_PROCESS, 0)));
     assert_eq!(r.op(move_to(5.0)), Err((ERR_HOME_IN_PROCESS, 0)));
     assert_eq!(r.op(Operation::StreamStart), Err((ERR_HOME_IN_PROCESS, 0)));

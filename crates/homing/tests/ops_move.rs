@@ -34,13 +34,8 @@ fn a_move_lands_exactly_on_its_target_with_pc() {
     assert!(cmds.windows(2).all(|w| w[1].position >= w[0].position));
     // Relative: +2 from the command position.
     r.op(Operation::Move(MoveSpec {
-        target: 2.0,
         relative: true,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
-        supersede: false,
-        jerk: None,
+        ..move_spec(2.0)
     }))
     .unwrap();
     assert!(r.run_until(1000, |s| s.op.pc));
@@ -58,13 +53,8 @@ fn targets_outside_the_travel_limits_are_refused_while_homed() {
     assert_eq!(r.op(move_to(-11.0)), target);
     let by = |d: f64| {
         Operation::Move(MoveSpec {
-            target: d,
             relative: true,
-            speed: Some(20.0),
-            accel: Some(500.0),
-            decel: Some(500.0),
-            supersede: false,
-            jerk: None,
+            ..move_spec(d)
         })
     };
     assert_eq!(r.op(by(10.5)), target);
@@ -98,13 +88,8 @@ fn a_move_on_a_jogging_or_moving_axis_needs_supersede() {
     assert_eq!(r.op(move_to(-5.0)), Err((ERR_EXECUTION_COLLISION, 0)));
     assert!(r.axis.status().jogging);
     let sup = Operation::Move(MoveSpec {
-        target: -5.0,
-        relative: false,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
         supersede: true,
-        jerk: None,
+        ..move_spec(-5.0)
     });
     let id = r.op(sup).unwrap();
     assert!(r.axis.status().moving && !r.axis.status().jogging);
@@ -151,13 +136,8 @@ fn a_supersede_that_could_not_stop_inside_the_limits_is_refused() {
         r.run(1);
     }
     let back = Operation::Move(MoveSpec {
-        target: 0.0,
-        relative: false,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
         supersede: true,
-        jerk: None,
+        ..move_spec(0.0)
     });
     assert_eq!(
         r.op(back),
@@ -217,30 +197,23 @@ fn cyclic_axes_move_the_shortest_way_and_have_no_travel_limits() {
     r.enable_and_home();
     assert_eq!(r.axis.axis_position(), Some(10.0));
     // 10 → 350: backwards through 0 (20 degrees), not forwards (340).
-    let m = Operation::Move(MoveSpec {
-        target: 350.0,
-        relative: false,
-        speed: Some(100.0),
-        accel: Some(5000.0),
-        decel: Some(5000.0),
-        supersede: false,
-        jerk: None,
-    });
+    // At 100 u/s, accelerations 5000.
+    let brisk = |target: f64, relative: bool| {
+        Operation::Move(MoveSpec {
+            relative,
+            speed: Some(100.0),
+            accel: Some(5000.0),
+            decel: Some(5000.0),
+            ..move_spec(target)
+        })
+    };
+    let m = brisk(350.0, false);
     r.op(m).unwrap();
     assert!(r.run_until(1000, |s| s.op.pc));
     assert_eq!(r.cmds.last().unwrap().position, -20.0);
     assert_eq!(r.cmd_axis(), 350.0);
     // Relative: whole revolutions.
-    r.op(Operation::Move(MoveSpec {
-        target: 720.0,
-        relative: true,
-        speed: Some(100.0),
-        accel: Some(5000.0),
-        decel: Some(5000.0),
-        supersede: false,
-        jerk: None,
-    }))
-    .unwrap();
+    r.op(brisk(720.0, true)).unwrap();
     assert!(r.run_until(20_000, |s| s.op.pc));
     assert_eq!(r.cmds.last().unwrap().position, 700.0);
     // Jogs run on, homed, without any limit.
@@ -270,13 +243,9 @@ fn without_a_speed_bound_nothing_moves_but_homing_still_works() {
     r.enable_and_home();
     let none = Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_NO_MAX_SPEED));
     let fast = Operation::Move(MoveSpec {
-        target: 5.0,
-        relative: false,
         speed: Some(1e6),
         accel: Some(1e9),
-        decel: Some(500.0),
-        supersede: false,
-        jerk: None,
+        ..move_spec(5.0)
     });
     assert_eq!(r.op(fast), none);
     assert_eq!(r.op(move_to(5.0)), none);

@@ -91,13 +91,7 @@ fn disable_stops_a_jog_first_then_switches_off() {
 
 #[test]
 fn disable_aborts_homing_with_12_1_then_switches_off() {
-    let cfg = AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    };
-    let mut r = Rig::new(cfg, machine());
-    r.step(home());
-    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    let mut r = at_the_seek();
     r.run(100);
     let id = r.op(Operation::Disable).unwrap();
     let s = *r.axis.status();
@@ -194,13 +188,7 @@ fn a_fault_that_persists_comes_back_after_the_reset_window() {
 fn a_drive_fault_during_homing_needs_a_reset_before_the_next_homing() {
     // Changed with the operations: homing used to reset the fault itself (by
     // toggling the enable); a faulted axis now refuses to home (ERR 20).
-    let cfg = AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    };
-    let mut r = Rig::new(cfg, machine());
-    r.step(home());
-    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    let mut r = at_the_seek();
     r.run(50);
     r.plant.inject_fault();
     r.fb = r.plant.feedback();
@@ -292,10 +280,7 @@ fn refusals_before_anything_can_move() {
 
 #[test]
 fn shutdown_ends_a_jog_and_switches_off_at_once() {
-    let mut r = Rig::at(0.0);
-    r.enable();
-    let id = r.op(jog(10.0)).unwrap();
-    r.run(50);
+    let (mut r, id) = jogging_with_id();
     r.step(Request {
         shutdown: true,
         ..Request::default()
@@ -321,14 +306,6 @@ fn a_virtual_axis_is_enabled_and_jogged_without_a_drive() {
     assert!(r.axis.status().jogging && r.cmd_axis() > 0.5);
 }
 
-/// A switch homing on the test machine, with a speed bound.
-fn switch_homing() -> AxisConfig {
-    AxisConfig {
-        max_speed: 50.0,
-        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
-    }
-}
-
 /// Homing, 100 steps in: seeking at 20 u/s.
 fn seeking() -> Rig {
     let mut r = Rig::new(switch_homing(), machine());
@@ -336,15 +313,6 @@ fn seeking() -> Rig {
         r.step(home());
     }
     assert_eq!(r.axis.status().phase, Phase::Seek);
-    r
-}
-
-/// Enabled at 0, jogging at 10 u/s for 50 steps.
-fn jogging() -> Rig {
-    let mut r = Rig::at(0.0);
-    r.enable();
-    r.op(jog(10.0)).unwrap();
-    r.run(50);
     r
 }
 
@@ -415,11 +383,7 @@ fn a_fault_or_dropped_power_stage_withdraws_the_enable_in_every_state() {
     // and each way the drive can go: the next command asks for it off.
     type Setup = fn() -> Rig;
     let states: [(&str, Setup); 7] = [
-        ("idle", || {
-            let mut r = Rig::at(0.0);
-            r.enable();
-            r
-        }),
+        ("idle", idle),
         ("enabling", || {
             let plant = PlantConfig {
                 enable_delay_cycles: 100_000,
@@ -484,10 +448,7 @@ fn a_fault_during_a_reset_is_a_fault() {
     // the power stage is requested off — not hidden for enable_timeout
     // while the command runs away from a drive that no longer follows.
     for late in [0u64, 1, 5, 300] {
-        let mut r = Rig::at(0.0);
-        r.enable();
-        r.op(jog(10.0)).unwrap();
-        r.run(50);
+        let mut r = jogging();
         let reset = r.op(Operation::Reset).unwrap();
         r.run(late);
         r.plant.inject_fault();
@@ -531,11 +492,7 @@ fn a_lost_drive_or_a_restarted_io_process_withdraws_the_enable_in_every_state() 
     // would otherwise be switched on by a request left standing.
     type Setup = fn() -> Rig;
     let states: [(&str, Setup); 5] = [
-        ("idle, enabled", || {
-            let mut r = Rig::at(0.0);
-            r.enable();
-            r
-        }),
+        ("idle, enabled", idle),
         ("homed by an active homing", || {
             let mut r = Rig::new(switch_homing(), machine());
             r.step(home());
@@ -595,12 +552,7 @@ fn lost_feedback_withdraws_the_enable_once_nothing_is_left_to_stop() {
     // then it is withdrawn. A new I/O process never gets a standing
     // request.
     for moving in [false, true] {
-        let mut r = Rig::at(0.0);
-        r.enable();
-        if moving {
-            r.op(jog(10.0)).unwrap();
-            r.run(50);
-        }
+        let mut r = if moving { jogging() } else { idle() };
         r.frame = |_, _| None;
         assert!(r.run_until(200, |s| !s.feedback_ok), "lost");
         assert!(r.run_until(200, |s| !s.stopping && !s.jogging));

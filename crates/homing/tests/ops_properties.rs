@@ -41,6 +41,18 @@ fn runner(cases: u32) -> TestRunner {
     })
 }
 
+/// The operations without parameters, each as likely as the others.
+fn bare_op() -> impl Strategy<Value = Operation> {
+    prop::sample::select(vec![
+        Operation::StreamStart,
+        Operation::StreamEnd,
+        Operation::Stop,
+        Operation::Reset,
+        Operation::Enable,
+        Operation::Disable,
+    ])
+}
+
 /// Operations with numbers a user might give, limits crossed often.
 fn sane_op() -> impl Strategy<Value = Operation> {
     let dynamics = (1.0..60.0f64, 50.0..5000.0f64, 50.0..6000.0f64);
@@ -61,12 +73,7 @@ fn sane_op() -> impl Strategy<Value = Operation> {
                 decel: Some(decel),
                 supersede, jerk: None, })
         ),
-        1 => Just(Operation::StreamStart),
-        1 => Just(Operation::StreamEnd),
-        1 => Just(Operation::Stop),
-        1 => Just(Operation::Reset),
-        1 => Just(Operation::Enable),
-        1 => Just(Operation::Disable),
+        6 => bare_op(),
     ]
 }
 
@@ -306,12 +313,7 @@ fn wild_op() -> impl Strategy<Value = Operation> {
                     decel,
                     supersede, jerk: None, })
             }),
-        1 => Just(Operation::StreamStart),
-        1 => Just(Operation::StreamEnd),
-        1 => Just(Operation::Stop),
-        1 => Just(Operation::Reset),
-        1 => Just(Operation::Enable),
-        1 => Just(Operation::Disable),
+        6 => bare_op(),
     ]
 }
 

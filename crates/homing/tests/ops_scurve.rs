@@ -47,13 +47,8 @@ fn jog_j(speed: f64, jerk: f64) -> Operation {
 /// A move to `target` at 20 (a = d = 500) with `jerk`.
 fn move_j(target: f64, jerk: f64) -> Operation {
     Operation::Move(MoveSpec {
-        target,
-        relative: false,
-        speed: Some(20.0),
-        accel: Some(500.0),
-        decel: Some(500.0),
-        supersede: false,
         jerk: Some(jerk),
+        ..move_spec(target)
     })
 }
 
@@ -80,13 +75,20 @@ fn change(r: &mut Rig, c: ChangeSpec) -> Result<(), (u16, u16)> {
     }
 }
 
+/// Enabled and homed at 0, at rest: the rig and the cycle of its last
+/// command before any motion (where `since` starts to see it all).
+fn homed_at_rest() -> (Rig, u64) {
+    let mut r = Rig::at(0.0);
+    r.enable_and_home();
+    let from = r.k - 1;
+    (r, from)
+}
+
 #[test]
 fn an_s_curve_jog_keeps_its_bounds_and_rests_exactly_on_the_limit() {
     // Homed, limits ±10, jog +20 at a = d = 500 with jerk 20 000: the
     // acceleration ramps over 500 / 20 000 = 25 ms instead of stepping.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k - 1;
+    let (mut r, from) = homed_at_rest();
     let id = r.op(jog_j(20.0, 20_000.0)).unwrap();
     for _ in 0..2000 {
         r.step(renew());
@@ -110,9 +112,7 @@ fn an_s_curve_jog_keeps_its_bounds_and_rests_exactly_on_the_limit() {
 
 #[test]
 fn an_s_curve_move_ends_exactly_on_its_target_within_its_bounds() {
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k - 1;
+    let (mut r, from) = homed_at_rest();
     let id = r.op(move_j(7.25, 10_000.0)).unwrap();
     assert!(r.run_until(3000, |s| !s.moving));
     let s = *r.axis.status();
@@ -195,21 +195,26 @@ fn a_normal_stop_keeps_the_jerk() {
     assert!(max_jerk(r.since(from)) <= 5_000.0 + JERK_ROUNDING);
 }
 
-#[test]
-fn a_faults_stop_does_not_keep_the_jerk() {
-    // Unhomed towards a limit switch at 3: the trip stops the axis at
-    // max_deceleration (500) with jerk 0 — the shortest stop, v²/2d past
-    // where it began — and ER 12 / 43.
+/// Unhomed and enabled at 0, jogging at 15 u/s with `jerk` towards a
+/// limit switch at 3.
+fn jogging_towards_a_switch(jerk: f64) -> Rig {
     let plant = motion_plant::PlantConfig {
         overtravel: Some((-3.0, 3.0)),
         ..op_plant(0.0)
     };
     let mut r = Rig::new(op_axis(), plant);
     r.enable();
-    r.op(jog_j(15.0, 2_000.0)).unwrap();
+    r.op(jog_j(15.0, jerk)).unwrap();
+    r
+}
+
+/// Steps with `request()` (at most 2000 cycles) until the limit switch
+/// has tripped and the stop it began has ended: the cycle of the step
+/// it tripped in, `None` if it never tripped.
+fn stopped_by_the_switch(r: &mut Rig, request: impl Fn() -> Request) -> Option<u64> {
     let mut tripped = None;
     for _ in 0..2000 {
-        r.step(renew());
+        r.step(request());
         let s = *r.axis.status();
         if tripped.is_none() && s.last_stop == StopCause::LimitSwitch {
             tripped = Some(r.k - 1);
@@ -218,7 +223,16 @@ fn a_faults_stop_does_not_keep_the_jerk() {
             break;
         }
     }
-    let k = tripped.expect("the limit switch stopped it");
+    tripped
+}
+
+#[test]
+fn a_faults_stop_does_not_keep_the_jerk() {
+    // Unhomed towards a limit switch at 3: the trip stops the axis at
+    // max_deceleration (500) with jerk 0 — the shortest stop, v²/2d past
+    // where it began — and ER 12 / 43.
+    let mut r = jogging_towards_a_switch(2_000.0);
+    let k = stopped_by_the_switch(&mut r, renew).expect("the limit switch stopped it");
     let s = *r.axis.status();
     assert_eq!((s.er, s.err, s.exerr), (true, 12, EX_OVERTRAVEL));
     let cmds = &r.cmds[(k - 1) as usize..];
@@ -242,29 +256,13 @@ fn a_fault_during_an_s_curve_stop_replans_it_without_jerk() {
     // stop at 2 would end ≈ 3.8: past the limit switch at 3. The switch
     // trips during the S-curve stop: a fault, which does not let the
     // gentle stop run on but stops with jerk 0 (the acceleration steps).
-    let plant = motion_plant::PlantConfig {
-        overtravel: Some((-3.0, 3.0)),
-        ..op_plant(0.0)
-    };
-    let mut r = Rig::new(op_axis(), plant);
-    r.enable();
-    r.op(jog_j(15.0, 1_000.0)).unwrap();
+    let mut r = jogging_towards_a_switch(1_000.0);
     while r.cmds.last().unwrap().position < 2.0 {
         r.step(renew());
     }
     r.op(Operation::Stop).unwrap();
-    let mut tripped = None;
-    for _ in 0..2000 {
-        r.step(Request::default());
-        let s = *r.axis.status();
-        if tripped.is_none() && s.last_stop == StopCause::LimitSwitch {
-            tripped = Some(r.k - 1);
-        }
-        if !s.stopping {
-            break;
-        }
-    }
-    let k = tripped.expect("the switch tripped during the stop");
+    let k = stopped_by_the_switch(&mut r, Request::default)
+        .expect("the switch tripped during the stop");
     let s = *r.axis.status();
     assert_eq!((s.er, s.err, s.exerr), (true, 12, EX_OVERTRAVEL), "{s:?}");
     let tail = &r.cmds[(k - 2) as usize..];
@@ -379,6 +377,11 @@ fn a_change_of_a_jog_keeps_its_direction_and_its_lease() {
 #[test]
 fn a_change_is_refused_where_it_cannot_be_kept() {
     let none = ChangeSpec::none();
+    // A change any running motion could take.
+    let slower = ChangeSpec {
+        speed: Some(1.0),
+        ..none
+    };
     let nothing = (ERR_EXECUTION_COLLISION, EX_NOTHING_TO_CHANGE);
     let range = |ex| Err((ERR_PARAMETER_OUT_OF_RANGE, ex));
     let mut r = Rig::at(0.0);
@@ -444,29 +447,11 @@ fn a_change_is_refused_where_it_cannot_be_kept() {
     assert!(r.axis.status().jogging);
     // Stopping: nothing to change.
     r.op(Operation::Stop).unwrap();
-    assert_eq!(
-        change(
-            &mut r,
-            ChangeSpec {
-                speed: Some(1.0),
-                ..none
-            }
-        ),
-        Err(nothing)
-    );
+    assert_eq!(change(&mut r, slower), Err(nothing));
     assert!(r.run_until(1000, |s| !s.stopping));
     // A stream: its program owns the dynamics.
     r.op(Operation::StreamStart).unwrap();
-    assert_eq!(
-        change(
-            &mut r,
-            ChangeSpec {
-                speed: Some(1.0),
-                ..none
-            }
-        ),
-        Err((ERR_EXECUTION_COLLISION, 0))
-    );
+    assert_eq!(change(&mut r, slower), Err((ERR_EXECUTION_COLLISION, 0)));
     r.op(Operation::StreamEnd).unwrap();
     assert!(r.run_until(1000, |s| !s.stopping && !s.streaming));
     // Homing in process: 16.
@@ -485,16 +470,21 @@ fn a_change_is_refused_where_it_cannot_be_kept() {
     h.step(home());
     h.run(10);
     assert!(h.axis.status().ip);
-    assert_eq!(
-        change(
-            &mut h,
-            ChangeSpec {
-                speed: Some(1.0),
-                ..none
-            }
-        ),
-        Err((ERR_HOME_IN_PROCESS, 0))
-    );
+    assert_eq!(change(&mut h, slower), Err((ERR_HOME_IN_PROCESS, 0)));
+}
+
+/// Homed at 0, jogging at 20 u/s (a = d = 500, trapezoid) towards the
+/// travel limit 10, renewed until its command is at `at` or past it: the
+/// rig and the first cycle after homing.
+fn jogging_to_the_limit_past(at: f64) -> (Rig, u64) {
+    let mut r = Rig::at(0.0);
+    r.enable_and_home();
+    let from = r.k;
+    r.op(jog(20.0)).unwrap();
+    while r.cmd_axis() < at {
+        r.step(renew());
+    }
+    (r, from)
 }
 
 #[test]
@@ -502,30 +492,24 @@ fn a_deceleration_that_cannot_stop_inside_the_limit_is_refused() {
     // Homed jog +20 towards the limit 10 (a = d = 500): at 8 its stop needs
     // 0.4; a deceleration of 100 would need 2 and end at 10+: refused
     // 13 / 4, and the jog still rests exactly on the limit.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k;
-    r.op(jog(20.0)).unwrap();
-    while r.cmd_axis() < 8.0 {
-        r.step(renew());
-    }
+    let (mut r, from) = jogging_to_the_limit_past(8.0);
+    // The softer deceleration, then a jerk so soft its stop runs past the
+    // limit: both refused.
     let softer = ChangeSpec {
         decel: Some(100.0),
         ..ChangeSpec::none()
     };
-    assert_eq!(
-        change(&mut r, softer),
-        Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET))
-    );
-    // A jerk so soft its stop runs past the limit: refused too.
     let soft_jerk = ChangeSpec {
         jerk: Some(100.0),
         ..ChangeSpec::none()
     };
-    assert_eq!(
-        change(&mut r, soft_jerk),
-        Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET))
-    );
+    for c in [softer, soft_jerk] {
+        assert_eq!(
+            change(&mut r, c),
+            Err((ERR_PARAMETER_OUT_OF_RANGE, EX_PARAM_TARGET)),
+            "{c:?}"
+        );
+    }
     while r.axis.status().jogging {
         r.step(renew());
     }
@@ -538,13 +522,7 @@ fn a_supersede_whose_s_curve_stop_would_cross_the_limit_is_refused() {
     // Cruising at 20 towards 10, at 8: a move back to 0 must first stop.
     // With jerk 1000 that stop takes 2·√(20/1000) ≈ 0.28 s and ≈ 2.8
     // units — past the limit; the trapezoid's v²/2d = 0.4 would not be.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    let from = r.k;
-    r.op(jog(20.0)).unwrap();
-    while r.cmd_axis() < 8.0 {
-        r.step(renew());
-    }
+    let (mut r, _) = jogging_to_the_limit_past(8.0);
     let back = Operation::Move(MoveSpec {
         supersede: true,
         ..spec_of(move_j(0.0, 1_000.0))
@@ -555,12 +533,7 @@ fn a_supersede_whose_s_curve_stop_would_cross_the_limit_is_refused() {
     );
     // Earlier, at 5, the same move fits (ends ≈ 7.8): accepted, and it
     // never passes the limit on its way back.
-    let mut r = Rig::at(0.0);
-    r.enable_and_home();
-    r.op(jog(20.0)).unwrap();
-    while r.cmd_axis() < 5.0 {
-        r.step(renew());
-    }
+    let (mut r, from) = jogging_to_the_limit_past(5.0);
     r.op(back).unwrap();
     assert!(r.run_until(5000, |s| !s.moving));
     assert_eq!(r.cmd_axis(), 0.0);

@@ -11,9 +11,9 @@
 //! was stopped).
 
 use super::client_error;
-use super::moves::{op_error, report};
+use super::moves::{follow_to_rest, op_error, report};
 use crate::cli::JogArgs;
-use motion_control::follow::{follow, followed, Followed};
+use motion_control::follow::{followed, Followed};
 use motion_control::progress::Progress;
 use motion_control::*;
 use motion_report::MotionReport;
@@ -35,16 +35,9 @@ pub fn jog(client: &mut Client, a: &JogArgs) -> i32 {
     if let Some(problem) = handle.end() {
         log::warn!("{problem}");
     }
-    match follow(
-        client,
-        &axes,
-        cycle,
-        Duration::from_secs(600),
-        |st, m| progress.show_motion(st, m),
-        || false,
-    ) {
+    match follow_to_rest(client, &axes, cycle, &mut progress) {
         Err(e) => client_error(a.json, &e),
-        Ok((rows, _)) => report(a.json, MotionReport { axes: rows }),
+        Ok(rows) => report(a.json, MotionReport { axes: rows }),
     }
 }
 

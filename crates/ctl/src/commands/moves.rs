@@ -5,10 +5,10 @@
 
 use super::{client_error, fail, signal_code, EXIT_FAILED, EXIT_OK};
 use crate::cli::MoveArgs;
-use motion_control::follow::{follow, followed};
+use motion_control::follow::{follow, followed, Followed};
 use motion_control::progress::Progress;
 use motion_control::*;
-use motion_report::{print_json, AcceptedReport, MotionReport};
+use motion_report::{print_json, AcceptedReport, MotionReport, MotionRow};
 use std::time::Duration;
 
 /// How long a move may take before `motionctl` gives up following it (the
@@ -42,6 +42,30 @@ pub fn move_axis(client: &mut Client, a: &MoveArgs) -> i32 {
         Err(e) => client_error(a.json, &e),
         Ok((rows, _)) => report(a.json, MotionReport { axes: rows }),
     }
+}
+
+/// How long a hold-to-run command (`jog`, `stream`) follows its axes to
+/// rest once it has ended its operation.
+const SETTLE_WALL: Duration = Duration::from_secs(600);
+
+/// Follows `axes` from `cycle` until their operations are over, after a
+/// hold-to-run command ended them (a signal has done its work by then: it
+/// does not cut this short): a row per axis.
+pub fn follow_to_rest(
+    client: &mut Client,
+    axes: &[Followed],
+    cycle: u64,
+    progress: &mut Progress,
+) -> Result<Vec<MotionRow>, ClientError> {
+    let (rows, _) = follow(
+        client,
+        axes,
+        cycle,
+        SETTLE_WALL,
+        |st, m| progress.show_motion(st, m),
+        || false,
+    )?;
+    Ok(rows)
 }
 
 /// Prints the rows (JSON or a table) and returns the exit code: the

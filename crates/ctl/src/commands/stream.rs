@@ -18,10 +18,10 @@
 //! stop).
 
 use super::csv::{self, Row};
-use super::moves::{op_error, report};
+use super::moves::{follow_to_rest, op_error, report};
 use super::{client_error, fail, EXIT_FAILED};
 use crate::cli::StreamArgs;
-use motion_control::follow::{follow, followed, Followed};
+use motion_control::follow::{followed, Followed};
 use motion_control::progress::Progress;
 use motion_control::stream::{Stream, StreamError};
 use motion_control::*;
@@ -65,16 +65,9 @@ pub fn stream(client: &mut Client, a: &StreamArgs) -> i32 {
         }
     };
     let last = &rows[rows.len() - 1];
-    match follow(
-        client,
-        &axes,
-        cycle,
-        Duration::from_secs(600),
-        |st, m| progress.show_motion(st, m),
-        || false,
-    ) {
+    match follow_to_rest(client, &axes, cycle, &mut progress) {
         Err(e) => client_error(a.json, &e),
-        Ok((rows, _)) => {
+        Ok(rows) => {
             let rows = rows
                 .into_iter()
                 .zip(&column)

@@ -354,9 +354,47 @@ pub fn jog(speed: f64) -> Operation {
     })
 }
 
-/// A move to `target` (axis position) at 20, acceleration and deceleration 500.
-pub fn move_to(target: f64) -> Operation {
-    Operation::Move(MoveSpec {
+/// A switch homing on the test machine, with a speed bound.
+pub fn switch_homing() -> AxisConfig {
+    AxisConfig {
+        max_speed: 50.0,
+        ..axis(HomeSequence::Switch, HomeDirection::BidirectionalForward)
+    }
+}
+
+/// [`switch_homing`] on the [`machine`], homing just begun: in its seek.
+pub fn at_the_seek() -> Rig {
+    let mut r = Rig::new(switch_homing(), machine());
+    r.step(home());
+    assert!(r.run_until(100, |s| s.phase == Phase::Seek));
+    r
+}
+
+/// Unhomed, enabled at 0 and at rest ([`Rig::at`]).
+pub fn idle() -> Rig {
+    let mut r = Rig::at(0.0);
+    r.enable();
+    r
+}
+
+/// [`idle`], then jogging at 10 u/s for 50 steps (past its acceleration):
+/// the rig and the jog's operation id.
+pub fn jogging_with_id() -> (Rig, u32) {
+    let mut r = idle();
+    let id = r.op(jog(10.0)).unwrap();
+    r.run(50);
+    (r, id)
+}
+
+/// [`jogging_with_id`] without the id.
+pub fn jogging() -> Rig {
+    jogging_with_id().0
+}
+
+/// The move most tests give: to `target` (axis position) at 20,
+/// acceleration and deceleration 500, a trapezoid, not superseding.
+pub fn move_spec(target: f64) -> MoveSpec {
+    MoveSpec {
         target,
         relative: false,
         speed: Some(20.0),
@@ -364,7 +402,12 @@ pub fn move_to(target: f64) -> Operation {
         decel: Some(500.0),
         supersede: false,
         jerk: None,
-    })
+    }
+}
+
+/// A move to `target` (axis position) at 20, acceleration and deceleration 500.
+pub fn move_to(target: f64) -> Operation {
+    Operation::Move(move_spec(target))
 }
 
 /// Largest |second difference| / cycle² of the commanded positions: the

@@ -29,14 +29,20 @@ travel_limits = [-20.0, 20.0]
 
 pub(super) const TOKEN: u64 = 0x0bad_cafe;
 
-/// X homed, enabled, and streamed by [`TOKEN`], at rest at 0.
-pub(super) fn streaming() -> Bench {
+/// X homed (by [`ONE_AXIS`]'s sequence), then enabled, at rest at 0.
+fn homed_and_enabled() -> Bench {
     let mut b = Bench::new(ONE_AXIS);
     b.run(5);
     b.home(1, false);
     b.run(5);
     b.op(1, Operation::Enable, 0);
     b.run(20);
+    b
+}
+
+/// X homed, enabled, and streamed by [`TOKEN`], at rest at 0.
+pub(super) fn streaming() -> Bench {
+    let mut b = homed_and_enabled();
     let s = b.snap().axes[0];
     assert!(s.status.homed && s.status.servo_action, "{:?}", s.status);
     b.ask(
@@ -257,12 +263,7 @@ fn after_a_redefine_the_monitor_keeps_the_soft_limits_on_the_machine() {
     // read [-15, 25], the same raw places. A move to 25 ends on raw 20
     // and the cycle monitor, which checks every command against the soft
     // limits on its own, sees nothing wrong.
-    let mut b = Bench::new(ONE_AXIS);
-    b.run(5);
-    b.home(1, false);
-    b.run(5);
-    b.op(1, Operation::Enable, 0);
-    b.run(20);
+    let mut b = homed_and_enabled();
     b.op(1, Operation::Redefine(RedefineSpec::by(5.0)), 0);
     b.run(2);
     assert_eq!(b.snap().axes[0].status.soft_limits, Some((-15.0, 25.0)));
