@@ -2,30 +2,17 @@
 //! place on the machine when the positions are redefined.
 
 mod common;
-use common::{Rig, MS};
-use motion_homing::*;
-use motion_plant::PlantConfig;
+use common::{op, Rig};
 
+/// Soft limits ±`lim`, `max_deceleration` 100.
 fn axis(lim: f64) -> AxisConfig {
     AxisConfig {
-        counts_per_unit: 1000.0,
-        home_sequence: HomeSequence::Immediate,
-        home_speed: 20.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-lim, lim)),
-        max_speed: 50.0,
         max_deceleration: 100.0,
-        cycle_ns: MS,
-        ..AxisConfig::default()
+        ..common::immediate_axis(lim)
     }
 }
-fn op(o: Operation) -> Request {
-    Request {
-        op: Some(o),
-        ..Request::default()
-    }
-}
+use motion_homing::*;
+use motion_plant::PlantConfig;
 
 /// Armed around the switch edge (axis 3, window [2.5, 3.5]), then
 /// redefined by +100: the window follows the positions, so the same edge

@@ -6,30 +6,18 @@
 //! deceleration at once).
 
 mod common;
-use common::{Rig, MS};
+use common::{op, Rig};
+
+/// Soft limits ±`lim`, `max_deceleration` 100.
+fn axis(lim: f64) -> AxisConfig {
+    AxisConfig {
+        max_deceleration: 100.0,
+        ..common::immediate_axis(lim)
+    }
+}
 use motion_homing::*;
 use motion_plant::PlantConfig;
 
-fn axis(lim: f64) -> AxisConfig {
-    AxisConfig {
-        counts_per_unit: 1000.0,
-        home_sequence: HomeSequence::Immediate,
-        home_speed: 20.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-lim, lim)),
-        max_speed: 50.0,
-        max_deceleration: 100.0,
-        cycle_ns: MS,
-        ..AxisConfig::default()
-    }
-}
-fn op(o: Operation) -> Request {
-    Request {
-        op: Some(o),
-        ..Request::default()
-    }
-}
 fn ready(lim: f64) -> Rig {
     let mut r = Rig::new(axis(lim), PlantConfig::default());
     r.step(op(Operation::Enable));

@@ -9,37 +9,18 @@
 
 mod common;
 
-use common::{Rig, MS};
+use common::{op, Rig, MS};
+
+/// Soft limits ±10 (`max_deceleration` defaults to the homing's 500).
+fn axis() -> AxisConfig {
+    common::immediate_axis(10.0)
+}
 use motion_homing::codes::*;
 use motion_homing::*;
 use motion_homing::{JogSpec, MoveSpec};
 use motion_monitor::{Category, Invariant, Withdrawn};
 use motion_plant::PlantConfig;
 use std::cell::Cell;
-
-/// A servo axis homed where it stands (Immediate), soft limits ±10,
-/// `max_speed` 50, Home Speed 20, accelerations 500 (so `max_deceleration`
-/// 500).
-fn axis() -> AxisConfig {
-    AxisConfig {
-        counts_per_unit: 1000.0,
-        home_sequence: HomeSequence::Immediate,
-        home_speed: 20.0,
-        home_acceleration: 500.0,
-        home_deceleration: 500.0,
-        travel_limits: Some((-10.0, 10.0)),
-        max_speed: 50.0,
-        cycle_ns: MS,
-        ..AxisConfig::default()
-    }
-}
-
-fn op(o: Operation) -> Request {
-    Request {
-        op: Some(o),
-        ..Request::default()
-    }
-}
 
 /// Enabled and homed at 0, at rest.
 fn ready(cfg: AxisConfig) -> Rig {

@@ -3,7 +3,7 @@
 
 #![allow(dead_code)]
 
-use motion_homing::{Axis, AxisConfig, Command, Feedback, Request};
+use motion_homing::{Axis, AxisConfig, Command, Feedback, HomeSequence, Operation, Request};
 use motion_monitor::{Cycle, Monitor, Trip};
 use motion_plant::{Plant, PlantConfig};
 
@@ -88,5 +88,29 @@ impl Rig {
     /// Axis position of the last command sent.
     pub fn out_axis(&self) -> f64 {
         self.axis.to_axis(self.out.position)
+    }
+}
+
+/// A servo axis homed where it stands (Immediate), soft limits ±`lim`,
+/// `max_speed` 50, Home Speed 20, accelerations 500.
+pub fn immediate_axis(lim: f64) -> AxisConfig {
+    AxisConfig {
+        counts_per_unit: 1000.0,
+        home_sequence: HomeSequence::Immediate,
+        home_speed: 20.0,
+        home_acceleration: 500.0,
+        home_deceleration: 500.0,
+        travel_limits: Some((-lim, lim)),
+        max_speed: 50.0,
+        cycle_ns: MS,
+        ..AxisConfig::default()
+    }
+}
+
+/// A request carrying operation `o`.
+pub fn op(o: Operation) -> Request {
+    Request {
+        op: Some(o),
+        ..Request::default()
     }
 }
