@@ -565,3 +565,24 @@ fn lost_feedback_withdraws_the_enable_once_nothing_is_left_to_stop() {
         assert!(!r.axis.status().servo_action);
     }
 }
+
+#[test]
+fn a_stop_asked_while_a_disable_waits_for_rest_still_switches_the_power_off() {
+    // Jogging; a disable (it stops first, then the power stage goes off),
+    // a reset, a stop while the jog still ramps down: the stop answers in
+    // the disable's place, and at rest the power stage goes off all the
+    // same (before: the stop's wait replaced the disable's, the power
+    // stage stayed on, and the cycle monitor tripped on it).
+    let mut r = Rig::new(op_axis(), op_plant(0.0));
+    r.enable_and_home();
+    r.op(jog(5.0)).unwrap();
+    r.run(200);
+    assert!(r.axis.status().jogging);
+    r.op(Operation::Disable).unwrap();
+    r.op(Operation::Reset).unwrap();
+    r.op(Operation::Stop).unwrap();
+    assert!(r.run_until(2000, |s| !s.jogging && !s.stopping && s.op.pc));
+    r.run(5);
+    assert!(!r.cmds.last().unwrap().enable, "the power stage stayed on");
+    assert!(!r.axis.status().servo_action);
+}

@@ -186,7 +186,11 @@ impl Axis {
             self.abort_homing(now);
         }
         if !self.stop_motion(now, Some(id), StopCause::Operator) {
-            self.ops.await_rest = Some((id, false));
+            // A disable already waiting for rest stays a disable: the stop
+            // answers in its place, and the power stage still goes off at
+            // rest (it stayed on before, and the cycle monitor tripped).
+            let disabling = matches!(self.ops.await_rest, Some((_, true)));
+            self.ops.await_rest = Some((id, disabling));
         }
     }
 
