@@ -348,8 +348,8 @@ fn asyncua_against_the_daemon_and_motion_opcua() {
         assert_eq!(
             a["_methods"],
             serde_json::json!([
-                "Arm", "Disable", "Disarm", "Enable", "Home", "Jog", "Move", "Reset", "Stop",
-                "Unhome"
+                "Arm", "Change", "Disable", "Disarm", "Enable", "Gear", "Home", "Jog", "Move",
+                "Redefine", "Reset", "Stop", "Unhome"
             ]),
             "{a}"
         );
