@@ -43,16 +43,21 @@ fn jog(speed: f64, decel: f64, jerk: Option<f64>) -> Operation {
     })
 }
 
-#[test]
-fn scurve_jog_stop_vs_monitor() {
-    let mut r = ready(1000.0);
-    r.step(op(jog(20.0, 100.0, Some(500.0))));
-    for k in 0..400 {
+/// `n` cycles of a jog held: its lease renewed every 50.
+fn hold(r: &mut Rig, n: u64) {
+    for k in 0..n {
         r.step(Request {
             jog_renew: k % 50 == 0,
             ..Request::default()
         });
     }
+}
+
+#[test]
+fn scurve_jog_stop_vs_monitor() {
+    let mut r = ready(1000.0);
+    r.step(op(jog(20.0, 100.0, Some(500.0))));
+    hold(&mut r, 400);
     r.step(op(Operation::Stop));
     r.idle(1000);
     assert!(r.tripped.is_none());
@@ -70,24 +75,14 @@ fn scurve_jog_lease_end_vs_monitor() {
 fn change_adds_jerk_then_stop() {
     let mut r = ready(1000.0);
     r.step(op(jog(20.0, 100.0, None)));
-    for k in 0..300 {
-        r.step(Request {
-            jog_renew: k % 50 == 0,
-            ..Request::default()
-        });
-    }
+    hold(&mut r, 300);
     r.step(op(Operation::Change(ChangeSpec {
         speed: None,
         accel: None,
         decel: None,
         jerk: Some(300.0),
     })));
-    for k in 0..100 {
-        r.step(Request {
-            jog_renew: k % 50 == 0,
-            ..Request::default()
-        });
-    }
+    hold(&mut r, 100);
     r.step(op(Operation::Stop));
     r.idle(1000);
     assert!(r.tripped.is_none());
